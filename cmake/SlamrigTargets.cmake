@@ -1,0 +1,45 @@
+# Shared compile settings and helpers for every slamrig target.
+
+# One place for warnings, floating-point determinism and sanitizers.
+function(slamrig_set_target_options target)
+  target_compile_options(${target} PRIVATE
+    -Wall -Wextra -Wpedantic -Wconversion -Wshadow -Wno-sign-conversion
+    # Same results whatever the compiler decides about fused multiply-add.
+    -ffp-contract=off)
+  if(SLAMRIG_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
+                                             -fno-sanitize-recover=undefined)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
+  if(SLAMRIG_VALIDATE)
+    target_compile_definitions(${target} PRIVATE SLAMRIG_VALIDATE=1)
+  endif()
+endfunction()
+
+# slamrig_add_library(name SOURCES ... [PUBLIC_DEPS ...] [PRIVATE_DEPS ...])
+function(slamrig_add_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(${name} STATIC ${ARG_SOURCES})
+  target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
+  target_link_libraries(${name} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  slamrig_set_target_options(${name})
+endfunction()
+
+# slamrig_add_test(name SOURCES ... DEPS ... [LABEL unit|integration|scenario])
+# One gtest executable; each TEST becomes its own ctest entry carrying the label.
+function(slamrig_add_test name)
+  if(NOT SLAMRIG_BUILD_TESTS)
+    return()
+  endif()
+  cmake_parse_arguments(ARG "" "LABEL" "SOURCES;DEPS" ${ARGN})
+  if(NOT ARG_LABEL)
+    set(ARG_LABEL unit)
+  endif()
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main GTest::gmock)
+  slamrig_set_target_options(${name})
+  gtest_discover_tests(${name}
+    WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+    PROPERTIES LABELS ${ARG_LABEL}
+    DISCOVERY_TIMEOUT 60)
+endfunction()

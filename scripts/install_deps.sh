@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages slamrig builds and tests with, and only those that are missing.
+# Idempotent: a second run installs nothing and makes no network request.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config clang-format
+  libbox2d-dev libeigen3-dev libopencv-dev libmujoco-dev libyaml-cpp-dev libceres-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libsqlite3-dev zlib1g-dev
+  libegl-dev libegl-mesa0 libgl1-mesa-dri
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if ((${#missing[@]} == 0)); then
+  echo "install_deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install_deps: installing ${missing[*]}"
+sudo_cmd=()
+if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi
+"${sudo_cmd[@]}" apt-get update -qq
+DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,59 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <numbers>
+
+namespace slamrig {
+
+/// Wraps an angle into (-pi, pi].
+inline double NormalizeAngle(double angle_rad) {
+  double a = std::remainder(angle_rad, 2.0 * std::numbers::pi);  // in [-pi, pi]
+  if (a <= -std::numbers::pi) a += 2.0 * std::numbers::pi;
+  return a;
+}
+
+/// A rigid transform in SE(2): rotation by `theta` then translation by (x, y).
+/// Read `a_from_b` as the pose of frame b expressed in frame a, so that
+/// `world_from_robot * robot_from_laser == world_from_laser`. `theta` is always in (-pi, pi].
+class Pose2 {
+ public:
+  constexpr Pose2() = default;
+  Pose2(double x_m, double y_m, double theta_rad) : x_(x_m), y_(y_m), theta_(NormalizeAngle(theta_rad)) {}
+
+  double x() const { return x_; }
+  double y() const { return y_; }
+  double theta() const { return theta_; }
+  Eigen::Vector2d translation() const { return {x_, y_}; }
+
+  /// Composition: (*this) followed by `other`, i.e. a_from_c = a_from_b * b_from_c.
+  Pose2 operator*(const Pose2& other) const {
+    const double c = std::cos(theta_), s = std::sin(theta_);
+    return Pose2(x_ + c * other.x_ - s * other.y_, y_ + s * other.x_ + c * other.y_,
+                 theta_ + other.theta_);
+  }
+
+  /// Maps a point from the child frame into this pose's parent frame.
+  Eigen::Vector2d operator*(const Eigen::Vector2d& point) const {
+    const double c = std::cos(theta_), s = std::sin(theta_);
+    return {x_ + c * point.x() - s * point.y(), y_ + s * point.x() + c * point.y()};
+  }
+
+  /// The inverse transform: b_from_a for a_from_b.
+  Pose2 Inverse() const {
+    const double c = std::cos(theta_), s = std::sin(theta_);
+    return Pose2(-c * x_ - s * y_, s * x_ - c * y_, -theta_);
+  }
+
+  /// Relative pose `this^-1 * other`: where `other` is, seen from this pose.
+  Pose2 Between(const Pose2& other) const { return Inverse() * other; }
+
+  friend bool operator==(const Pose2&, const Pose2&) = default;
+
+ private:
+  double x_ = 0.0;
+  double y_ = 0.0;
+  double theta_ = 0.0;
+};
+
+}  // namespace slamrig

@@ -1,0 +1,47 @@
+#include "slam/types/trajectory.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "slam/types/check.h"
+
+namespace slamrig {
+
+Trajectory::Trajectory(std::vector<StampedPose> poses) : poses_(std::move(poses)) {
+  SLAMRIG_CHECK(std::is_sorted(poses_.begin(), poses_.end(),
+                               [](const StampedPose& a, const StampedPose& b) { return a.time < b.time; }),
+                "trajectory times must be non-decreasing");
+}
+
+void Trajectory::Append(Time time, const Pose2& pose) {
+  SLAMRIG_CHECK(poses_.empty() || poses_.back().time <= time,
+                "trajectory times must be non-decreasing");
+  poses_.push_back({time, pose});
+}
+
+std::optional<Pose2> Trajectory::Interpolate(Time time) const {
+  if (poses_.empty() || time < poses_.front().time || time > poses_.back().time) {
+    return std::nullopt;
+  }
+  const auto after = std::lower_bound(
+      poses_.begin(), poses_.end(), time,
+      [](const StampedPose& p, Time t) { return p.time < t; });
+  if (after->time == time || after == poses_.begin()) return after->pose;
+  const auto before = after - 1;
+  const double span = SecondsBetween(after->time, before->time);
+  const double s = SecondsBetween(time, before->time) / span;
+  const Pose2& a = before->pose;
+  const Pose2& b = after->pose;
+  return Pose2(a.x() + s * (b.x() - a.x()), a.y() + s * (b.y() - a.y()),
+               a.theta() + s * NormalizeAngle(b.theta() - a.theta()));
+}
+
+double Trajectory::PathLength() const {
+  double length = 0.0;
+  for (std::size_t i = 1; i < poses_.size(); ++i) {
+    length += (poses_[i].pose.translation() - poses_[i - 1].pose.translation()).norm();
+  }
+  return length;
+}
+
+}  // namespace slamrig
