@@ -1,0 +1,152 @@
+#include "slam/config/yaml_node.h"
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace slamrig {
+namespace {
+
+std::string MarkString(const std::string& file, const YAML::Mark& mark) {
+  if (mark.is_null()) return file;
+  return file + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
+}
+
+}  // namespace
+
+YamlNode YamlNode::LoadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(path + ": cannot open file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return LoadString(buffer.str(), path);
+}
+
+YamlNode YamlNode::LoadString(const std::string& text, const std::string& source_name) {
+  auto usage = std::make_shared<Usage>();
+  usage->file = source_name;
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(MarkString(source_name, e.mark) + ": YAML syntax error: " + e.msg);
+  }
+  return YamlNode(root, "", usage);
+}
+
+std::string YamlNode::ChildPath(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+std::string YamlNode::Where() const {
+  const std::string location = MarkString(usage_->file, node_.Mark());
+  return path_.empty() ? location : location + ": " + path_;
+}
+
+void YamlNode::Fail(const std::string& message) const { throw ConfigError(Where() + ": " + message); }
+
+void YamlNode::ThrowIfInvalid(const std::vector<std::string>& errors) const {
+  if (errors.empty()) return;
+  std::string joined;
+  for (const auto& e : errors) joined += (joined.empty() ? "" : "; ") + e;
+  throw ConfigError(MarkString(usage_->file, node_.Mark()) + ": " + joined);
+}
+
+std::string YamlNode::Describe() const {
+  if (node_.IsScalar()) return "'" + node_.Scalar() + "'";
+  if (node_.IsMap()) return "a map";
+  if (node_.IsSequence()) return "a list";
+  return "nothing";
+}
+
+bool YamlNode::Has(const std::string& key) const { return node_.IsMap() && node_[key]; }
+
+YamlNode YamlNode::Required(const std::string& key) const {
+  auto child = Optional(key);
+  if (!child) Fail("missing required key '" + key + "'");
+  return *child;
+}
+
+std::optional<YamlNode> YamlNode::Optional(const std::string& key) const {
+  if (node_.IsNull()) return std::nullopt;
+  if (!node_.IsMap()) Fail("expected a map with key '" + key + "', got " + Describe());
+  const YAML::Node child = node_[key];
+  if (!child) return std::nullopt;
+  usage_->used_keys[path_].insert(key);
+  return YamlNode(child, ChildPath(key), usage_);
+}
+
+std::vector<std::string> YamlNode::Keys() const {
+  std::vector<std::string> keys;
+  if (node_.IsNull()) return keys;
+  if (!node_.IsMap()) Fail("expected a map, got " + Describe());
+  for (const auto& kv : node_) keys.push_back(kv.first.Scalar());
+  return keys;
+}
+
+std::vector<YamlNode> YamlNode::Elements() const {
+  if (!node_.IsSequence()) Fail("expected a list, got " + Describe());
+  std::vector<YamlNode> elements;
+  for (std::size_t i = 0; i < node_.size(); ++i) {
+    elements.push_back(YamlNode(node_[i], path_ + "[" + std::to_string(i) + "]", usage_));
+  }
+  return elements;
+}
+
+template <typename T>
+T YamlNode::As() const {
+  const char* expected = "a value";
+  if constexpr (std::is_same_v<T, bool>) {
+    expected = "true or false";
+  } else if constexpr (std::is_integral_v<T>) {
+    expected = "an integer";
+  } else if constexpr (std::is_floating_point_v<T>) {
+    expected = "a number";
+  } else {
+    expected = "a string";
+  }
+  if (!node_.IsScalar()) Fail("expected " + std::string(expected) + ", got " + Describe());
+  T value{};
+  try {
+    value = node_.as<T>();
+  } catch (const YAML::Exception&) {
+    Fail("expected " + std::string(expected) + ", got " + Describe());
+  }
+  if constexpr (std::is_floating_point_v<T>) {
+    if (!std::isfinite(value)) Fail("expected a finite number, got " + Describe());
+  }
+  return value;
+}
+
+template bool YamlNode::As<bool>() const;
+template int YamlNode::As<int>() const;
+template std::int64_t YamlNode::As<std::int64_t>() const;
+template std::uint64_t YamlNode::As<std::uint64_t>() const;
+template float YamlNode::As<float>() const;
+template double YamlNode::As<double>() const;
+template std::string YamlNode::As<std::string>() const;
+
+void YamlNode::CheckAllKeysUsed() const { CheckUsedRecursive(node_, path_); }
+
+void YamlNode::CheckUsedRecursive(const YAML::Node& node, const std::string& path) const {
+  if (node.IsMap()) {
+    const auto used = usage_->used_keys.find(path);
+    for (const auto& kv : node) {
+      const std::string key = kv.first.Scalar();
+      const std::string child_path = path.empty() ? key : path + "." + key;
+      if (used == usage_->used_keys.end() || !used->second.count(key)) {
+        throw ConfigError(MarkString(usage_->file, kv.first.Mark()) + ": " + child_path +
+                          ": unknown key");
+      }
+      CheckUsedRecursive(kv.second, child_path);
+    }
+  } else if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      CheckUsedRecursive(node[i], path + "[" + std::to_string(i) + "]");
+    }
+  }
+}
+
+}  // namespace slamrig

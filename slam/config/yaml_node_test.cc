@@ -1,0 +1,66 @@
+#include "slam/config/yaml_node.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace slamrig {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(YamlNodeTest, ReadsValuesAndKeepsDefaults) {
+  const auto root = YamlNode::LoadString("a: 1.5\nb: {c: 3, d: [1, 2]}\nname: x\n", "t.yaml");
+  double a = 0, missing = 7;
+  root.Read("a", &a);
+  root.Read("zzz", &missing);
+  EXPECT_EQ(a, 1.5);
+  EXPECT_EQ(missing, 7);
+  const auto b = root.Required("b");
+  EXPECT_EQ(b.Get<int>("c"), 3);
+  const auto d = b.Required("d").Elements();
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d[1].As<int>(), 2);
+  EXPECT_EQ(root.Get<std::string>("name"), "x");
+  root.CheckAllKeysUsed();
+}
+
+TEST(YamlNodeTest, UnknownKeyNamesFileLineAndPath) {
+  const auto root = YamlNode::LoadString("robot:\n  radius_m: 1\n  raduis: 2\n", "w.yaml");
+  double r = 0;
+  root.Required("robot").Read("radius_m", &r);
+  EXPECT_EQ(ErrorOf([&] { root.CheckAllKeysUsed(); }), "w.yaml:3:3: robot.raduis: unknown key");
+}
+
+TEST(YamlNodeTest, WrongTypeNamesLocationAndText) {
+  const auto root = YamlNode::LoadString("list:\n  - {v: abc}\n", "w.yaml");
+  const auto e = ErrorOf([&] { root.Required("list").Elements()[0].Get<double>("v"); });
+  EXPECT_THAT(e, HasSubstr("w.yaml:2:9: list[0].v: expected a number, got 'abc'"));
+  EXPECT_THAT(ErrorOf([&] { root.Get<int>("list"); }), HasSubstr("list: expected an integer, got a list"));
+}
+
+TEST(YamlNodeTest, MissingRequiredKeyAndSyntaxErrors) {
+  const auto root = YamlNode::LoadString("a: 1\n", "m.yaml");
+  EXPECT_THAT(ErrorOf([&] { root.Get<double>("b"); }), HasSubstr("missing required key 'b'"));
+  EXPECT_THAT(ErrorOf([] { YamlNode::LoadString("a: [1, 2\n", "s.yaml"); }),
+              HasSubstr("s.yaml:"));
+  EXPECT_THAT(ErrorOf([] { YamlNode::LoadFile("/nonexistent/x.yaml"); }),
+              HasSubstr("/nonexistent/x.yaml: cannot open file"));
+}
+
+TEST(YamlNodeTest, RejectsNonFiniteNumbersAndFractionalIntegers) {
+  const auto root = YamlNode::LoadString("a: .nan\nb: 1.5\n", "n.yaml");
+  EXPECT_THAT(ErrorOf([&] { root.Get<double>("a"); }), HasSubstr("finite"));
+  EXPECT_THAT(ErrorOf([&] { root.Get<int>("b"); }), HasSubstr("expected an integer"));
+}
+
+}  // namespace
+}  // namespace slamrig
