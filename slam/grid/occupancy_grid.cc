@@ -1,0 +1,153 @@
+#include "slam/grid/occupancy_grid.h"
+
+#include <sstream>
+
+#include "slam/grid/ray_trace.h"
+#include "slam/types/check.h"
+
+namespace slamrig::slam {
+namespace {
+
+template <typename T>
+std::string Rule(const char* field, T value, const char* rule) {
+  std::ostringstream s;
+  s << field << " = " << value << "; " << rule;
+  return s.str();
+}
+
+}  // namespace
+
+std::vector<std::string> OccupancyGridOptions::Validate() const {
+  std::vector<std::string> errors;
+  if (!(resolution_m > 0.0)) errors.push_back(Rule("resolution_m", resolution_m, "must be > 0"));
+  if (!(hit_log_odds > 0.0f)) errors.push_back(Rule("hit_log_odds", hit_log_odds, "must be > 0"));
+  if (!(miss_log_odds < 0.0f)) {
+    errors.push_back(Rule("miss_log_odds", miss_log_odds, "must be < 0"));
+  }
+  if (!(min_log_odds < 0.0f)) errors.push_back(Rule("min_log_odds", min_log_odds, "must be < 0"));
+  if (!(max_log_odds > 0.0f)) errors.push_back(Rule("max_log_odds", max_log_odds, "must be > 0"));
+  if (!(max_range_m > 0.0)) errors.push_back(Rule("max_range_m", max_range_m, "must be > 0"));
+  if (!(no_return_clear_range_m >= 0.0)) {
+    errors.push_back(Rule("no_return_clear_range_m", no_return_clear_range_m, "must be >= 0"));
+  }
+  if (!(grow_margin_m >= 0.0)) errors.push_back(Rule("grow_margin_m", grow_margin_m, "must be >= 0"));
+  return errors;
+}
+
+OccupancyGrid::OccupancyGrid(const OccupancyGridOptions& options) : options_(options) {
+  SLAMRIG_CHECK(options_.Validate().empty(), "invalid OccupancyGridOptions");
+}
+
+CellState OccupancyGrid::State(const Eigen::Array2i& cell, double occupied_probability,
+                               double free_probability) const {
+  const float l = LogOdds(cell);
+  if (l == 0.0f) return CellState::kUnknown;
+  const double p = Probability(cell);
+  if (p > occupied_probability) return CellState::kOccupied;
+  if (p < free_probability) return CellState::kFree;
+  return CellState::kUnknown;
+}
+
+void OccupancyGrid::EnsureContains(const Eigen::AlignedBox2d& box) {
+  if (box.isEmpty()) return;
+  const double res = options_.resolution_m;
+  if (width_ > 0) {
+    const Eigen::Array2i lo = WorldToCell(box.min());
+    const Eigen::Array2i hi = WorldToCell(box.max());
+    if (Contains(lo) && Contains(hi)) return;
+  }
+  // New bounds: union of the old grid and the box, plus a margin, snapped to the old cell lattice.
+  Eigen::AlignedBox2d wanted = box;
+  if (width_ > 0) {
+    wanted.extend(origin_);
+    wanted.extend(origin_ + Eigen::Vector2d(width_ * res, height_ * res));
+  }
+  const Eigen::Vector2d margin = Eigen::Vector2d::Constant(options_.grow_margin_m + res);
+  const Eigen::Vector2d anchor = width_ > 0 ? origin_ : Eigen::Vector2d::Zero();
+  const Eigen::Vector2d lo_cells = ((wanted.min() - margin - anchor) / res).array().floor();
+  const Eigen::Vector2d hi_cells = ((wanted.max() + margin - anchor) / res).array().ceil();
+  const Eigen::Vector2d new_origin = anchor + lo_cells * res;
+  const int new_width = static_cast<int>(hi_cells.x() - lo_cells.x());
+  const int new_height = static_cast<int>(hi_cells.y() - lo_cells.y());
+  SLAMRIG_CHECK(static_cast<double>(new_width) * new_height < 2e9, "occupancy grid too large");
+
+  std::vector<float> grown(static_cast<std::size_t>(new_width) * new_height, 0.0f);
+  std::vector<std::uint32_t> grown_updates(grown.size(), 0);
+  const int shift_x = static_cast<int>(-lo_cells.x());
+  const int shift_y = static_cast<int>(-lo_cells.y());
+  for (int iy = 0; iy < height_; ++iy) {
+    const std::size_t dst = static_cast<std::size_t>(iy + shift_y) * new_width + shift_x;
+    std::copy_n(log_odds_.begin() + static_cast<std::ptrdiff_t>(Index(0, iy)), width_,
+                grown.begin() + static_cast<std::ptrdiff_t>(dst));
+    std::copy_n(last_update_.begin() + static_cast<std::ptrdiff_t>(Index(0, iy)), width_,
+                grown_updates.begin() + static_cast<std::ptrdiff_t>(dst));
+  }
+  log_odds_ = std::move(grown);
+  last_update_ = std::move(grown_updates);
+  origin_ = new_origin;
+  width_ = new_width;
+  height_ = new_height;
+}
+
+int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_base) {
+  const Pose2 world_from_laser = world_from_base * scan.base_from_laser;
+  const Eigen::Vector2d origin_world = world_from_laser.translation();
+  const double max_hit_range = std::min(scan.range_max_m, options_.max_range_m);
+  const double clear_range = std::min(max_hit_range, options_.no_return_clear_range_m);
+
+  // Beam end points in the world, and which of them are hits.
+  Eigen::AlignedBox2d bounds(origin_world, origin_world);
+  std::vector<std::pair<Eigen::Vector2d, bool>>& ends = beam_ends_;
+  ends.clear();
+  for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
+    const double r = scan.ranges_m[i];
+    if (!(r >= scan.range_min_m)) continue;  // too short: no information
+    const bool hit = r < max_hit_range;
+    const double length = hit ? r : clear_range;
+    if (length <= 0.0) continue;
+    const double angle = world_from_laser.theta() + scan.BeamAngle(i);
+    const Eigen::Vector2d end = origin_world + length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    if (!end.allFinite()) continue;  // sources reject NaN; never index with one
+    bounds.extend(end);
+    ends.emplace_back(end, hit);
+  }
+  EnsureContains(bounds);
+
+  ++scan_count_;
+  const bool once = options_.update_once_per_scan;
+  const Eigen::Array2i start = WorldToCell(origin_world);
+  int hits = 0;
+  // Hits first, so that with update_once_per_scan a free ray cannot erase them.
+  for (const auto& [end, hit] : ends) {
+    if (!hit) continue;
+    const Eigen::Array2i cell = WorldToCell(end);
+    ++hits;
+    std::uint32_t& stamp = last_update_[Index(cell.x(), cell.y())];
+    if (once && stamp == scan_count_) continue;
+    stamp = scan_count_;
+    Update(cell, options_.hit_log_odds);
+  }
+  for (const auto& [end, hit] : ends) {
+    const Eigen::Array2i cell = WorldToCell(end);
+    TraceRay(start, cell, [&](int x, int y) {
+      const std::size_t index = Index(x, y);
+      if (once) {
+        if (last_update_[index] == scan_count_) return;
+        last_update_[index] = scan_count_;
+      }
+      float& l = log_odds_[index];
+      l = std::max(l + options_.miss_log_odds, options_.min_log_odds);
+    });
+    // A no-return beam's last cell is free too.
+    if (!hit) {
+      const std::size_t index = Index(cell.x(), cell.y());
+      if (!once || last_update_[index] != scan_count_) {
+        last_update_[index] = scan_count_;
+        log_odds_[index] = std::max(log_odds_[index] + options_.miss_log_odds, options_.min_log_odds);
+      }
+    }
+  }
+  return hits;
+}
+
+}  // namespace slamrig::slam

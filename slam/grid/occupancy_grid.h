@@ -1,0 +1,115 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "slam/types/pose2.h"
+#include "slam/types/records.h"
+
+namespace slamrig::slam {
+
+/// How scans change the log-odds grid. Defaults follow the ECE276A reports: an 80 % trusted
+/// hit adds log(4); free cells lose half of that (Kansal's asymmetric update), clamped.
+struct OccupancyGridOptions {
+  double resolution_m = 0.05;                         ///< cell edge length
+  float hit_log_odds = 1.3862944f;                    ///< added to a beam's end cell, log(4)
+  float miss_log_odds = -0.6931472f;                  ///< added to cells a beam passes through
+  float min_log_odds = -5.0f;                         ///< clamp (keeps the map able to change)
+  float max_log_odds = 5.0f;                          ///< clamp
+  double max_range_m = 30.0;                          ///< longer returns are treated as no return
+  double no_return_clear_range_m = 10.0;              ///< free space cleared along a no-return beam
+  /// Update each cell at most once per scan, hits first (Cartographer's rule): a wall cell grazed
+  /// by a neighbouring beam's free ray in the same scan stays a wall. false: every beam counts, as
+  /// in the reports.
+  bool update_once_per_scan = true;
+  double grow_margin_m = 5.0;                         ///< extra room added when the map grows
+
+  /// One message per broken rule, e.g. "resolution_m = 0; must be > 0".
+  std::vector<std::string> Validate() const;
+};
+
+/// Occupancy state of a cell after thresholding its probability.
+enum class CellState : std::int8_t { kUnknown = -1, kFree = 0, kOccupied = 100 };
+
+/// A 2D log-odds occupancy grid (Thrun, Burgard, Fox, "Probabilistic Robotics", Table 9.1)
+/// that grows to fit the data. Cell (ix, iy) covers
+/// [origin.x + ix*res, origin.x + (ix+1)*res) x [origin.y + iy*res, ...); storage is row-major
+/// with row 0 at the lowest y. Cells outside the grid read as log-odds 0 (unknown).
+class OccupancyGrid {
+ public:
+  explicit OccupancyGrid(const OccupancyGridOptions& options);
+
+  const OccupancyGridOptions& options() const { return options_; }
+  double resolution() const { return options_.resolution_m; }
+  /// World position of the lower-left corner of cell (0, 0).
+  const Eigen::Vector2d& origin() const { return origin_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  /// Raw log-odds, row-major, width() * height() values.
+  const std::vector<float>& log_odds() const { return log_odds_; }
+
+  /// The cell containing world point `p` (may be outside the grid).
+  Eigen::Array2i WorldToCell(const Eigen::Vector2d& p) const {
+    return {static_cast<int>(std::floor((p.x() - origin_.x()) / options_.resolution_m)),
+            static_cast<int>(std::floor((p.y() - origin_.y()) / options_.resolution_m))};
+  }
+  /// World position of the centre of `cell`.
+  Eigen::Vector2d CellCenter(const Eigen::Array2i& cell) const {
+    return origin_ + (cell.cast<double>() + 0.5).matrix() * options_.resolution_m;
+  }
+  bool Contains(const Eigen::Array2i& cell) const {
+    return cell.x() >= 0 && cell.y() >= 0 && cell.x() < width_ && cell.y() < height_;
+  }
+  /// Log-odds of `cell`, 0 outside the grid.
+  float LogOdds(const Eigen::Array2i& cell) const {
+    return Contains(cell) ? log_odds_[Index(cell.x(), cell.y())] : 0.0f;
+  }
+  /// Occupancy probability of `cell`, 0.5 outside the grid.
+  double Probability(const Eigen::Array2i& cell) const {
+    return 1.0 - 1.0 / (1.0 + std::exp(static_cast<double>(LogOdds(cell))));
+  }
+  /// ROS map_server style thresholding: occupied above `occupied_probability`, free below
+  /// `free_probability`, unknown in between or never observed.
+  CellState State(const Eigen::Array2i& cell, double occupied_probability = 0.65,
+                  double free_probability = 0.196) const;
+
+  /// Grows the grid (keeping its contents and cell alignment) so that `box` lies inside it.
+  void EnsureContains(const Eigen::AlignedBox2d& box);
+
+  /// Inserts one scan taken at `world_from_base`: each hit's end cell gains hit_log_odds and the
+  /// cells before it lose miss_log_odds; a no-return beam only clears free space, up to
+  /// no_return_clear_range_m. Returns the number of beams that produced a hit.
+  int InsertScan(const LaserScan& scan, const Pose2& world_from_base);
+
+  /// Adds `delta` to `cell` with clamping; the grid must contain the cell.
+  void Update(const Eigen::Array2i& cell, float delta) {
+    float& l = log_odds_[Index(cell.x(), cell.y())];
+    l = std::clamp(l + delta, options_.min_log_odds, options_.max_log_odds);
+  }
+  /// Sets `cell` to `value` unclamped (map loading); the grid must contain the cell.
+  void Set(const Eigen::Array2i& cell, float value) { log_odds_[Index(cell.x(), cell.y())] = value; }
+
+ private:
+  std::size_t Index(int ix, int iy) const {
+    return static_cast<std::size_t>(iy) * static_cast<std::size_t>(width_) +
+           static_cast<std::size_t>(ix);
+  }
+
+  OccupancyGridOptions options_;
+  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
+  int width_ = 0;
+  int height_ = 0;
+  std::vector<float> log_odds_;
+  // Scan number that last touched each cell, for update_once_per_scan.
+  std::vector<std::uint32_t> last_update_;
+  std::uint32_t scan_count_ = 0;
+  // Scratch buffer reused across scans: beam end points and whether each is a hit.
+  std::vector<std::pair<Eigen::Vector2d, bool>> beam_ends_;
+};
+
+}  // namespace slamrig::slam

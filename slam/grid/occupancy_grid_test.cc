@@ -1,0 +1,139 @@
+#include "slam/grid/occupancy_grid.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <numbers>
+#include <random>
+
+namespace slamrig::slam {
+namespace {
+
+// A laser at the origin looking along +x with `n` beams over +-0.1 rad, all reading `range`.
+LaserScan FanScan(int n, float range, double range_max = 20.0) {
+  LaserScan scan;
+  scan.angle_min_rad = -0.1;
+  scan.angle_increment_rad = n > 1 ? 0.2 / (n - 1) : 0.0;
+  scan.range_min_m = 0.1;
+  scan.range_max_m = range_max;
+  scan.ranges_m.assign(n, range);
+  return scan;
+}
+
+OccupancyGridOptions Options() {
+  OccupancyGridOptions o;
+  o.resolution_m = 0.1;
+  o.grow_margin_m = 1.0;
+  return o;
+}
+
+TEST(OccupancyGridTest, HitsOccupyFreeRaysClearBehindStaysUnknown) {
+  OccupancyGrid grid(Options());
+  const LaserScan scan = FanScan(1, 2.0f);
+  // Beam straight ahead from (0.05, 0.05) so cell boundaries are unambiguous.
+  LaserScan one = scan;
+  one.angle_min_rad = 0.0;
+  EXPECT_EQ(grid.InsertScan(one, Pose2(0.05, 0.05, 0.0)), 1);
+  EXPECT_EQ(grid.State(grid.WorldToCell({2.05, 0.05})), CellState::kOccupied);
+  EXPECT_FLOAT_EQ(grid.LogOdds(grid.WorldToCell({2.05, 0.05})), Options().hit_log_odds);
+  for (double x = 0.05; x < 1.99; x += 0.1) {
+    EXPECT_FLOAT_EQ(grid.LogOdds(grid.WorldToCell({x, 0.05})), Options().miss_log_odds) << x;
+  }
+  EXPECT_EQ(grid.State(grid.WorldToCell({2.25, 0.05})), CellState::kUnknown);
+  EXPECT_EQ(grid.State(grid.WorldToCell({1.0, 0.35})), CellState::kUnknown);
+}
+
+TEST(OccupancyGridTest, NoReturnBeamsClearWithoutHit) {
+  OccupancyGridOptions options = Options();
+  options.no_return_clear_range_m = 3.0;
+  OccupancyGrid grid(options);
+  LaserScan scan = FanScan(1, 20.0f, 20.0);  // reading == range_max: no return
+  scan.angle_min_rad = 0.0;
+  EXPECT_EQ(grid.InsertScan(scan, Pose2(0.05, 0.05, 0.0)), 0);
+  EXPECT_LT(grid.LogOdds(grid.WorldToCell({2.95, 0.05})), 0.0f);
+  EXPECT_EQ(grid.LogOdds(grid.WorldToCell({3.25, 0.05})), 0.0f);
+  for (const float l : grid.log_odds()) EXPECT_LE(l, 0.0f);
+}
+
+TEST(OccupancyGridTest, RespectsPoseAndLaserMount) {
+  OccupancyGrid grid(Options());
+  LaserScan scan = FanScan(1, 1.0f);
+  scan.angle_min_rad = 0.0;
+  scan.base_from_laser = Pose2(0.5, 0.0, 0.0);
+  // Robot at (3, 3) facing +y: laser at (3, 3.5), beam ends at (3, 4.5).
+  grid.InsertScan(scan, Pose2(3.05, 3.05, std::numbers::pi / 2));
+  EXPECT_EQ(grid.State(grid.WorldToCell({3.05, 4.55})), CellState::kOccupied);
+  EXPECT_LT(grid.LogOdds(grid.WorldToCell({3.05, 4.0})), 0.0f);
+  EXPECT_EQ(grid.LogOdds(grid.WorldToCell({3.05, 3.2})), 0.0f);  // behind the laser
+}
+
+TEST(OccupancyGridTest, ClampsLogOdds) {
+  OccupancyGrid grid(Options());
+  LaserScan scan = FanScan(1, 1.0f);
+  scan.angle_min_rad = 0.0;
+  for (int i = 0; i < 20; ++i) grid.InsertScan(scan, Pose2(0.05, 0.05, 0.0));
+  EXPECT_FLOAT_EQ(grid.LogOdds(grid.WorldToCell({1.05, 0.05})), Options().max_log_odds);
+  EXPECT_FLOAT_EQ(grid.LogOdds(grid.WorldToCell({0.55, 0.05})), Options().min_log_odds);
+}
+
+TEST(OccupancyGridTest, OncePerScanKeepsGrazedWallCells) {
+  // Many beams end in the same cells: with once-per-scan each cell changes by at most one update.
+  OccupancyGridOptions options = Options();
+  OccupancyGrid once(options);
+  options.update_once_per_scan = false;
+  OccupancyGrid every(options);
+  const LaserScan scan = FanScan(200, 3.0f);
+  once.InsertScan(scan, Pose2());
+  every.InsertScan(scan, Pose2());
+  for (const float l : once.log_odds()) {
+    EXPECT_TRUE(l == 0.0f || l == options.hit_log_odds || l == options.miss_log_odds) << l;
+  }
+  EXPECT_FLOAT_EQ(every.LogOdds(every.WorldToCell({1.0, 0.0})), options.min_log_odds);
+}
+
+TEST(OccupancyGridTest, GrowingKeepsContentsAligned) {
+  OccupancyGrid grid(Options());
+  LaserScan scan = FanScan(30, 2.0f);
+  grid.InsertScan(scan, Pose2(0.0, 0.0, 0.3));
+  std::vector<std::pair<Eigen::Vector2d, float>> before;
+  for (int iy = 0; iy < grid.height(); ++iy) {
+    for (int ix = 0; ix < grid.width(); ++ix) {
+      const float l = grid.LogOdds({ix, iy});
+      if (l != 0.0f) before.emplace_back(grid.CellCenter({ix, iy}), l);
+    }
+  }
+  ASSERT_FALSE(before.empty());
+  const int old_width = grid.width();
+  grid.EnsureContains(Eigen::AlignedBox2d(Eigen::Vector2d(-40, -30), Eigen::Vector2d(25, 50)));
+  EXPECT_GT(grid.width(), old_width);
+  for (const auto& [center, l] : before) {
+    EXPECT_EQ(grid.LogOdds(grid.WorldToCell(center)), l);
+    EXPECT_NEAR((grid.CellCenter(grid.WorldToCell(center)) - center).norm(), 0.0, 1e-9);
+  }
+  EXPECT_TRUE(grid.Contains(grid.WorldToCell({-40, -30})));
+  EXPECT_TRUE(grid.Contains(grid.WorldToCell({25, 50})));
+}
+
+TEST(OccupancyGridTest, WorldCellRoundTripWithinHalfCell) {
+  OccupancyGrid grid(Options());
+  grid.EnsureContains(Eigen::AlignedBox2d(Eigen::Vector2d(-10, -10), Eigen::Vector2d(10, 10)));
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> coord(-10.0, 10.0);
+  for (int i = 0; i < 10000; ++i) {
+    const Eigen::Vector2d p(coord(rng), coord(rng));
+    const Eigen::Vector2d c = grid.CellCenter(grid.WorldToCell(p));
+    ASSERT_LE((c - p).cwiseAbs().maxCoeff(), 0.05 + 1e-12);
+  }
+}
+
+TEST(OccupancyGridOptionsTest, ValidateNamesFieldValueAndRule) {
+  OccupancyGridOptions o;
+  o.resolution_m = 0.0;
+  o.miss_log_odds = 0.5f;
+  EXPECT_THAT(o.Validate(), ::testing::ElementsAre("resolution_m = 0; must be > 0",
+                                                   "miss_log_odds = 0.5; must be < 0"));
+  EXPECT_TRUE(OccupancyGridOptions().Validate().empty());
+}
+
+}  // namespace
+}  // namespace slamrig::slam
