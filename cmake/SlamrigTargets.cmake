@@ -4,6 +4,8 @@
 function(slamrig_set_target_options target)
   target_compile_options(${target} PRIVATE
     -Wall -Wextra -Wpedantic -Wconversion -Wshadow -Wno-sign-conversion
+    # GCC 12 reports impossible overlaps inside std::string operator+ (GCC bug 105651).
+    $<$<CXX_COMPILER_ID:GNU>:-Wno-restrict>
     # Same results whatever the compiler decides about fused multiply-add.
     -ffp-contract=off)
   if(SLAMRIG_SANITIZE)

@@ -38,6 +38,17 @@ OccupancyGrid::OccupancyGrid(const OccupancyGridOptions& options) : options_(opt
   SLAMRIG_CHECK(options_.Validate().empty(), "invalid OccupancyGridOptions");
 }
 
+OccupancyGrid::OccupancyGrid(const OccupancyGridOptions& options, const Eigen::Vector2d& origin,
+                             int width, int height)
+    : OccupancyGrid(options) {
+  SLAMRIG_CHECK(width >= 0 && height >= 0, "grid size must not be negative");
+  origin_ = origin;
+  width_ = width;
+  height_ = height;
+  log_odds_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0.0f);
+  last_update_.assign(log_odds_.size(), 0);
+}
+
 CellState OccupancyGrid::State(const Eigen::Array2i& cell, double occupied_probability,
                                double free_probability) const {
   const float l = LogOdds(cell);

@@ -42,7 +42,12 @@ enum class CellState : std::int8_t { kUnknown = -1, kFree = 0, kOccupied = 100 }
 /// with row 0 at the lowest y. Cells outside the grid read as log-odds 0 (unknown).
 class OccupancyGrid {
  public:
+  /// An empty grid; it takes its size from the first scan.
   explicit OccupancyGrid(const OccupancyGridOptions& options);
+  /// A grid of `width` x `height` unknown cells whose cell (0, 0) has its lower-left corner at
+  /// `origin` (loading a map); it still grows when data falls outside.
+  OccupancyGrid(const OccupancyGridOptions& options, const Eigen::Vector2d& origin, int width,
+                int height);
 
   const OccupancyGridOptions& options() const { return options_; }
   double resolution() const { return options_.resolution_m; }

@@ -1,0 +1,84 @@
+#include "slam/io/dataset.h"
+
+#include <algorithm>
+
+namespace slamrig::slam {
+namespace {
+
+// A message of the log in file order.
+struct Entry {
+  int line;
+  const CarmenScan* scan = nullptr;
+  const CarmenOdometry* odometry = nullptr;
+};
+
+std::vector<Entry> InFileOrder(const CarmenLog& log) {
+  std::vector<Entry> entries;
+  entries.reserve(log.scans.size() + log.odometry.size());
+  for (const auto& s : log.scans) entries.push_back({s.line, &s, nullptr});
+  for (const auto& o : log.odometry) entries.push_back({o.line, nullptr, &o});
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.line < b.line; });
+  return entries;
+}
+
+}  // namespace
+
+Dataset CarmenToDataset(const CarmenLog& log) {
+  Dataset data;
+  data.source = log.path;
+  data.notes = log.notes;
+  const std::vector<Entry> entries = InFileOrder(log);
+
+  if (log.is_corrected) {
+    data.reference_kind = "GMapping-corrected scan poses";
+    // raw_from_corrected maps the corrected pose of the previous scan to the recovered odometry
+    // pose there; motion after it comes from ODOM lines relative to that corrected pose.
+    bool started = false;
+    Pose2 previous_corrected;  // P_{k-1}
+    Pose2 previous_odometry;   // recovered odometry at scan k-1
+    int dropped = 0;
+    for (const Entry& e : entries) {
+      if (e.odometry != nullptr) {
+        if (!started) {
+          ++dropped;
+          continue;
+        }
+        const Pose2 recovered = previous_odometry * previous_corrected.Between(e.odometry->odometry.odom_from_base);
+        data.records.push_back(OdometryPose{e.odometry->odometry.time, recovered});
+        continue;
+      }
+      const CarmenScan& s = *e.scan;
+      if (!started) {
+        started = true;
+        previous_odometry = s.logged_pose;
+        data.records.push_back(OdometryPose{s.scan.time, previous_odometry});
+      } else {
+        // The odometry at this scan is the last ODOM before it (or no motion if there was none).
+        const auto last = std::find_if(data.records.rbegin(), data.records.rend(),
+                                       [](const Record& r) { return std::holds_alternative<OdometryPose>(r); });
+        previous_odometry = std::get<OdometryPose>(*last).odom_from_base;
+      }
+      previous_corrected = s.logged_pose;
+      data.records.push_back(s.scan);
+      data.reference.push_back({s.scan.time, s.logged_pose});
+    }
+    if (dropped > 0) {
+      data.notes.push_back(std::to_string(dropped) + " ODOM lines before the first scan dropped");
+    }
+    return data;
+  }
+
+  data.reference_kind = log.true_poses.empty() ? "" : "TRUEPOS";
+  for (const Entry& e : entries) {
+    if (e.odometry != nullptr) {
+      data.records.push_back(e.odometry->odometry);
+      continue;
+    }
+    if (e.scan->has_pose) data.records.push_back(OdometryPose{e.scan->scan.time, e.scan->odom_pose});
+    data.records.push_back(e.scan->scan);
+  }
+  data.reference = log.true_poses;
+  return data;
+}
+
+}  // namespace slamrig::slam

@@ -1,0 +1,30 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "slam/io/carmen_reader.h"
+#include "slam/types/records.h"
+
+namespace slamrig::slam {
+
+/// A log as the SLAM stack sees it: sensor records in time order, plus the reference poses on
+/// their own channel, which only evaluation may read.
+struct Dataset {
+  std::vector<Record> records;
+  std::vector<GroundTruthPose> reference;
+  std::string source;              ///< file it came from
+  std::string reference_kind;      ///< what `reference` is, e.g. "GMapping-corrected poses"
+  std::vector<std::string> notes;  ///< quirks found while reading, for the user
+};
+
+/// Turns a CARMEN log into a Dataset.
+/// - GMapping-corrected logs: the scans' poses become the reference; the raw odometry is
+///   recovered from the ODOM lines as u_k = inverse(P_{k-1}) * O_k (SOURCE.md of
+///   carmen_corrected) and chained from the first scan's pose, so dead reckoning and SLAM see
+///   the robot's real odometry. ODOM lines before the first scan are dropped (counted in notes).
+/// - Other logs: ODOM lines and the odometry pose stored with each laser line are the odometry;
+///   TRUEPOS lines, if any, are the reference.
+Dataset CarmenToDataset(const CarmenLog& log);
+
+}  // namespace slamrig::slam
