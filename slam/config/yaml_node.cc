@@ -45,7 +45,9 @@ std::string YamlNode::Where() const {
   return path_.empty() ? location : location + ": " + path_;
 }
 
-void YamlNode::Fail(const std::string& message) const { throw ConfigError(Where() + ": " + message); }
+void YamlNode::Fail(const std::string& message) const {
+  throw ConfigError(Where() + ": " + message);
+}
 
 void YamlNode::ThrowIfInvalid(const std::vector<std::string>& errors) const {
   if (errors.empty()) return;

@@ -44,14 +44,14 @@ TEST(YamlNodeTest, WrongTypeNamesLocationAndText) {
   const auto root = YamlNode::LoadString("list:\n  - {v: abc}\n", "w.yaml");
   const auto e = ErrorOf([&] { root.Required("list").Elements()[0].Get<double>("v"); });
   EXPECT_THAT(e, HasSubstr("w.yaml:2:9: list[0].v: expected a number, got 'abc'"));
-  EXPECT_THAT(ErrorOf([&] { root.Get<int>("list"); }), HasSubstr("list: expected an integer, got a list"));
+  EXPECT_THAT(ErrorOf([&] { root.Get<int>("list"); }),
+              HasSubstr("list: expected an integer, got a list"));
 }
 
 TEST(YamlNodeTest, MissingRequiredKeyAndSyntaxErrors) {
   const auto root = YamlNode::LoadString("a: 1\n", "m.yaml");
   EXPECT_THAT(ErrorOf([&] { root.Get<double>("b"); }), HasSubstr("missing required key 'b'"));
-  EXPECT_THAT(ErrorOf([] { YamlNode::LoadString("a: [1, 2\n", "s.yaml"); }),
-              HasSubstr("s.yaml:"));
+  EXPECT_THAT(ErrorOf([] { YamlNode::LoadString("a: [1, 2\n", "s.yaml"); }), HasSubstr("s.yaml:"));
   EXPECT_THAT(ErrorOf([] { YamlNode::LoadFile("/nonexistent/x.yaml"); }),
               HasSubstr("/nonexistent/x.yaml: cannot open file"));
 }

@@ -30,7 +30,8 @@ std::vector<std::string> OccupancyGridOptions::Validate() const {
   if (!(no_return_clear_range_m >= 0.0)) {
     errors.push_back(Rule("no_return_clear_range_m", no_return_clear_range_m, "must be >= 0"));
   }
-  if (!(grow_margin_m >= 0.0)) errors.push_back(Rule("grow_margin_m", grow_margin_m, "must be >= 0"));
+  if (!(grow_margin_m >= 0.0))
+    errors.push_back(Rule("grow_margin_m", grow_margin_m, "must be >= 0"));
   return errors;
 }
 
@@ -117,7 +118,8 @@ int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_bas
     const double length = hit ? r : clear_range;
     if (length <= 0.0) continue;
     const double angle = world_from_laser.theta() + scan.BeamAngle(i);
-    const Eigen::Vector2d end = origin_world + length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    const Eigen::Vector2d end =
+        origin_world + length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
     if (!end.allFinite()) continue;  // sources reject NaN; never index with one
     bounds.extend(end);
     ends.emplace_back(end, hit);
@@ -154,7 +156,8 @@ int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_bas
       const std::size_t index = Index(cell.x(), cell.y());
       if (!once || last_update_[index] != scan_count_) {
         last_update_[index] = scan_count_;
-        log_odds_[index] = std::max(log_odds_[index] + options_.miss_log_odds, options_.min_log_odds);
+        log_odds_[index] =
+            std::max(log_odds_[index] + options_.miss_log_odds, options_.min_log_odds);
       }
     }
   }

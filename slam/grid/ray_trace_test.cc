@@ -31,7 +31,8 @@ TEST(TraceRayTest, PropertiesOverRandomRays) {
       }
       // Distance along the minor axis to the exact line stays within half a cell.
       const Eigen::Array2i d = cells[i] - from;
-      const double cross = std::abs(static_cast<double>(d.x()) * dy - static_cast<double>(d.y()) * dx);
+      const double cross =
+          std::abs(static_cast<double>(d.x()) * dy - static_cast<double>(d.y()) * dx);
       const double minor_offset = cross / std::max(std::abs(dx), std::abs(dy));
       ASSERT_LE(minor_offset, 0.5 + 1e-9) << "trial " << trial << " length " << length;
     }

@@ -43,7 +43,8 @@ class Fields {
   void ExpectAtLeast(std::size_t expected, const std::string& what) const {
     if (tokens_.size() < expected) {
       throw LineError{"line", "expected at least " + std::to_string(expected) + " fields" + what +
-                                  ", found " + std::to_string(tokens_.size()) + " (truncated line?)"};
+                                  ", found " + std::to_string(tokens_.size()) +
+                                  " (truncated line?)"};
     }
   }
 
@@ -68,8 +69,8 @@ class Fields {
       throw LineError{field, "expected a whole number, got '" + std::string(t) + "'"};
     }
     if (value < 0 || value > max_value) {
-      throw LineError{field, std::to_string(value) + " is out of range [0, " +
-                                 std::to_string(max_value) + "]"};
+      throw LineError{
+          field, std::to_string(value) + " is out of range [0, " + std::to_string(max_value) + "]"};
     }
     return value;
   }
@@ -82,7 +83,8 @@ class Fields {
   std::vector<float> Ranges(std::size_t first, int n) const {
     std::vector<float> ranges(static_cast<std::size_t>(n));
     for (int k = 0; k < n; ++k) {
-      const double r = Number(first + static_cast<std::size_t>(k), "range[" + std::to_string(k) + "]");
+      const double r =
+          Number(first + static_cast<std::size_t>(k), "range[" + std::to_string(k) + "]");
       if (r < 0.0) {
         throw LineError{"range[" + std::to_string(k) + "]", "negative range " + std::to_string(r)};
       }
@@ -98,11 +100,15 @@ class Fields {
 constexpr int kMaxBeams = 100000;
 constexpr double kDeg = std::numbers::pi / 180.0;
 
+// Control characters anywhere, or a non-ASCII message type: not a CARMEN text line.
 bool IsBinary(std::string_view line) {
-  return std::any_of(line.begin(), line.end(), [](char c) {
+  const bool control = std::any_of(line.begin(), line.end(), [](char c) {
     const auto u = static_cast<unsigned char>(c);
     return (u < 0x20 && c != '\t') || u == 0x7f;
   });
+  const std::string_view type = line.substr(0, line.find_first_of(" \t"));
+  return control || std::any_of(type.begin(), type.end(),
+                                [](char c) { return static_cast<unsigned char>(c) >= 0x80; });
 }
 
 // A message before times are fixed up: which list it went to and its raw stamp.
@@ -115,8 +121,7 @@ struct Stamped {
 
 class CarmenParser {
  public:
-  CarmenParser(const std::string& path, const CarmenReadOptions& options)
-      : options_(options) {
+  CarmenParser(const std::string& path, const CarmenReadOptions& options) : options_(options) {
     log_.path = path;
   }
 
@@ -128,7 +133,8 @@ class CarmenParser {
       ParseOldLaser(f, type, line_number);
     } else if (type == "ROBOTLASER1" || type == "ROBOTLASER2") {
       ParseRobotLaser(f, line_number);
-    } else if (type.starts_with("RAWLASER") && type.size() == 9 && type[8] >= '1' && type[8] <= '4') {
+    } else if (type.starts_with("RAWLASER") && type.size() == 9 && type[8] >= '1' &&
+               type[8] <= '4') {
       ParseRawLaser(f, line_number);
     } else if (type == "ODOM") {
       ParseOdometry(f, line_number);
@@ -137,7 +143,8 @@ class CarmenParser {
       GroundTruthPose truth;
       truth.map_from_base = f.PoseAt(1, "true");
       f.PoseAt(4, "odom");
-      Record(Stamped::Kind::kTruth, log_.true_poses.size(), f.Number(7, "ipc_timestamp"), line_number);
+      Record(Stamped::Kind::kTruth, log_.true_poses.size(), f.Number(7, "ipc_timestamp"),
+             line_number);
       log_.true_poses.push_back(truth);
     } else if (type == "PARAM") {
       f.ExpectAtLeast(3, " for PARAM");
@@ -166,7 +173,8 @@ class CarmenParser {
   void ParseOldLaser(const Fields& f, const std::string& type, int line_number) {
     f.ExpectAtLeast(2, " for " + type);
     const int n = f.Count(1, "num_readings", kMaxBeams);
-    f.ExpectCount(static_cast<std::size_t>(n) + 11, " for " + type + " with " + std::to_string(n) + " readings");
+    f.ExpectCount(static_cast<std::size_t>(n) + 11,
+                  " for " + type + " with " + std::to_string(n) + " readings");
     CarmenScan s;
     s.scan.ranges_m = f.Ranges(2, n);
     const std::size_t p = 2 + static_cast<std::size_t>(n);
@@ -174,7 +182,8 @@ class CarmenParser {
     s.odom_pose = f.PoseAt(p + 3, "odom");
     s.line = line_number;
     s.scan.angle_min_rad = -90.0 * kDeg;
-    s.scan.angle_increment_rad = n > 1 ? (n % 2 == 0 ? 180.0 * kDeg / n : 180.0 * kDeg / (n - 1)) : 0.0;
+    s.scan.angle_increment_rad =
+        n > 1 ? (n % 2 == 0 ? 180.0 * kDeg / n : 180.0 * kDeg / (n - 1)) : 0.0;
     s.scan.range_min_m = 1e-3;
     if (type == "RLASER") s.scan.base_from_laser = Pose2(0.0, 0.0, std::numbers::pi);
     rear_.push_back(type == "RLASER");
@@ -191,7 +200,8 @@ class CarmenParser {
     s->scan.range_max_m = f.Number(5, "maximum_range");
     s->scan.range_min_m = 1e-3;
     const int n = f.Count(8, "num_readings", kMaxBeams);
-    f.ExpectAtLeast(10 + static_cast<std::size_t>(n), " for " + type + " with " + std::to_string(n) + " readings");
+    f.ExpectAtLeast(10 + static_cast<std::size_t>(n),
+                    " for " + type + " with " + std::to_string(n) + " readings");
     s->scan.ranges_m = f.Ranges(9, n);
     const std::size_t remissions_at = 9 + static_cast<std::size_t>(n);
     const int m = f.Count(remissions_at, "num_remissions", kMaxBeams);
@@ -201,8 +211,8 @@ class CarmenParser {
   void ParseRobotLaser(const Fields& f, int line_number) {
     CarmenScan s;
     const std::size_t p = ParseLaserConfig(f, "ROBOTLASER1", &s);
-    f.ExpectCount(p + 14, " for ROBOTLASER1 with " + std::to_string(s.scan.ranges_m.size()) +
-                              " readings");
+    f.ExpectCount(p + 14,
+                  " for ROBOTLASER1 with " + std::to_string(s.scan.ranges_m.size()) + " readings");
     const Pose2 world_from_laser = f.PoseAt(p, "laser_pose");
     s.logged_pose = f.PoseAt(p + 3, "robot_pose");
     s.odom_pose = s.logged_pose;
@@ -253,9 +263,11 @@ class CarmenParser {
       const auto it = log_.params.find(key);
       if (it == log_.params.end()) return std::nullopt;
       double v = 0;
-      const auto [end, ec] = std::from_chars(it->second.data(), it->second.data() + it->second.size(), v);
+      const auto [end, ec] =
+          std::from_chars(it->second.data(), it->second.data() + it->second.size(), v);
       if (ec != std::errc() || !std::isfinite(v)) {
-        throw ParseError(log_.path + ": PARAM " + key + ": expected a number, got '" + it->second + "'");
+        throw ParseError(log_.path + ": PARAM " + key + ": expected a number, got '" + it->second +
+                         "'");
       }
       return v;
     };
@@ -281,12 +293,15 @@ class CarmenParser {
       }
       if (total > 0 && at_top * 200 >= total) {
         max_range = top;
-        log_.notes.push_back("readings of " + std::to_string(top).substr(0, 6) + " m (" +
-                             std::to_string(100.0 * static_cast<double>(at_top) / static_cast<double>(total)).substr(0, 4) +
-                             " % of beams) taken as the scanner's no-return value");
+        log_.notes.push_back(
+            "readings of " + std::to_string(top).substr(0, 6) + " m (" +
+            std::to_string(100.0 * static_cast<double>(at_top) / static_cast<double>(total))
+                .substr(0, 4) +
+            " % of beams) taken as the scanner's no-return value");
       }
     }
-    const double range_max = std::min(max_range.value_or(options_.no_return_range_m), options_.no_return_range_m);
+    const double range_max =
+        std::min(max_range.value_or(options_.no_return_range_m), options_.no_return_range_m);
     for (std::size_t i = 0; i < log_.scans.size(); ++i) {
       LaserScan& scan = log_.scans[i].scan;
       if (IsExplicit(i)) {
@@ -296,7 +311,8 @@ class CarmenParser {
       scan.range_max_m = range_max;
       if (resolution_deg) scan.angle_increment_rad = *resolution_deg * kDeg;
       const double offset = rear_[i] ? rear_offset : front_offset;
-      scan.base_from_laser = Pose2(offset * (rear_[i] ? -1.0 : 1.0), 0.0, scan.base_from_laser.theta());
+      scan.base_from_laser =
+          Pose2(offset * (rear_[i] ? -1.0 : 1.0), 0.0, scan.base_from_laser.theta());
     }
   }
 
@@ -316,14 +332,15 @@ class CarmenParser {
     // Real logs advance their clock on most messages; %g-printed unix times or zeros do not.
     log_.timestamps_usable = n < 2 || (zero * 10 < n && increasing * 4 >= n);
     if (!log_.timestamps_usable && n > 0) {
-      log_.notes.push_back("timestamps unusable (" + std::to_string(zero) + " of " + std::to_string(n) +
-                           " zero, " + std::to_string(increasing) +
+      log_.notes.push_back("timestamps unusable (" + std::to_string(zero) + " of " +
+                           std::to_string(n) + " zero, " + std::to_string(increasing) +
                            " increasing); times synthesized from file order, 1 ms per line");
     }
     Time previous = Time::FromNanoseconds(std::numeric_limits<std::int64_t>::min());
     for (const Stamped& s : stamped_) {
-      Time t = log_.timestamps_usable ? Time::FromSeconds(s.stamp_s)
-                                      : Time::FromNanoseconds(static_cast<std::int64_t>(s.line) * 1'000'000);
+      Time t = log_.timestamps_usable
+                   ? Time::FromSeconds(s.stamp_s)
+                   : Time::FromNanoseconds(static_cast<std::int64_t>(s.line) * 1'000'000);
       if (t < previous) {
         ++log_.stats.out_of_order_times;
         t = previous;

@@ -48,9 +48,9 @@ struct CarmenStats {
 /// zero and garbage stamps (see shared/datasets/carmen_corrected/SOURCE.md).
 struct CarmenLog {
   std::string path;
-  std::vector<CarmenScan> scans;         ///< FLASER, RLASER, ROBOTLASER1, RAWLASER1-4
-  std::vector<CarmenOdometry> odometry;  ///< ODOM lines, GMapping echo lines excluded
-  std::vector<GroundTruthPose> true_poses;  ///< TRUEPOS lines
+  std::vector<CarmenScan> scans;              ///< FLASER, RLASER, ROBOTLASER1, RAWLASER1-4
+  std::vector<CarmenOdometry> odometry;       ///< ODOM lines, GMapping echo lines excluded
+  std::vector<GroundTruthPose> true_poses;    ///< TRUEPOS lines
   std::map<std::string, std::string> params;  ///< PARAM name -> value
   /// The log is a GMapping "corrected" log: its FLASER poses are a reference, its ODOM lines
   /// are corrected-pose-plus-raw-increment (detected from the echo ODOM lines, timestamp 0).

@@ -40,10 +40,10 @@ std::string ErrorOf(const std::string& path, CarmenReadOptions options = {}) {
 
 TEST(CarmenReaderTest, ReadsFlaserOdomParamAndTruePos) {
   TempDir dir;
-  const std::string path = dir.Write(
-      "a.log", "# comment\nPARAM robot_frontlaser_offset 0.1 nohost 0\n" + Odom(0, 0, 0, 1.0) +
-                   Flaser(181, 2.5, 1.0, 2.0, 0.5, 1.1) +
-                   "TRUEPOS 1.01 2.02 0.51 1 2 0.5 1.1 host 1.1\nNEFF 12\n");
+  const std::string path =
+      dir.Write("a.log", "# comment\nPARAM robot_frontlaser_offset 0.1 nohost 0\n" +
+                             Odom(0, 0, 0, 1.0) + Flaser(181, 2.5, 1.0, 2.0, 0.5, 1.1) +
+                             "TRUEPOS 1.01 2.02 0.51 1 2 0.5 1.1 host 1.1\nNEFF 12\n");
   const CarmenLog log = ReadCarmenLog(path);
   ASSERT_EQ(log.scans.size(), 1u);
   const LaserScan& scan = log.scans[0].scan;
@@ -132,7 +132,7 @@ TEST(CarmenReaderTest, ReadsRobotLaserWithItsOwnGeometry) {
   EXPECT_DOUBLE_EQ(s.scan.angle_increment_rad, 0.5);
   EXPECT_DOUBLE_EQ(s.scan.range_max_m, 30.0);
   EXPECT_FALSE(s.scan.IsHit(1));
-  EXPECT_NEAR(s.scan.base_from_laser.x(), 0.2 * std::cos(-0.1) , 1e-9);
+  EXPECT_NEAR(s.scan.base_from_laser.x(), 0.2 * std::cos(-0.1), 1e-9);
   EXPECT_EQ(s.logged_pose, Pose2(1, 2, 0.1));
 }
 
@@ -157,13 +157,15 @@ TEST(CarmenReaderTest, BadInputNamesFileLineAndField) {
               HasSubstr("t.log:2: FLASER line: expected 16 fields"));
   EXPECT_THAT(ErrorOf(dir.Write("n.log", "FLASER 3 1.0 nan 1.0 0 0 0 0 0 0 1 h 1\n")),
               HasSubstr("n.log:1: FLASER range[1]: not a finite number: 'nan'"));
-  EXPECT_THAT(ErrorOf(dir.Write("w.log", "FLASER 4 1.0 1.0 1.0 0 0 0 0 0 0 1 h 1\n")),
-              HasSubstr("w.log:1: FLASER line: expected 15 fields for FLASER with 4 readings, found 14"));
+  EXPECT_THAT(
+      ErrorOf(dir.Write("w.log", "FLASER 4 1.0 1.0 1.0 0 0 0 0 0 0 1 h 1\n")),
+      HasSubstr("w.log:1: FLASER line: expected 15 fields for FLASER with 4 readings, found 14"));
   EXPECT_THAT(ErrorOf(dir.Write("x.log", "ODOM 0 0 zero 0 0 0 1 h 1\n")),
               HasSubstr("x.log:1: ODOM pose.theta: expected a number, got 'zero'"));
   EXPECT_THAT(ErrorOf(dir.Write("e.log", "")), HasSubstr("e.log: empty file"));
-  EXPECT_THAT(ErrorOf(dir.Write("b.log", std::string("\x7f\x45\x4c\x46\x02\x01\x01\x00garbage", 15))),
-              HasSubstr("b.log:1: line: binary data"));
+  EXPECT_THAT(
+      ErrorOf(dir.Write("b.log", std::string("\x7f\x45\x4c\x46\x02\x01\x01\x00garbage", 15))),
+      HasSubstr("b.log:1: line: binary data"));
   EXPECT_THAT(ErrorOf(dir.File("missing.log")), HasSubstr("missing.log: no such file"));
   EXPECT_THAT(ErrorOf(dir.Write("u.log", "HELLO 1 2 3\nWORLD\n")), HasSubstr("no CARMEN messages"));
   EXPECT_THAT(ErrorOf(dir.Write("neg.log", "FLASER 1 -1.0 0 0 0 0 0 0 1 h 1\n")),
@@ -172,8 +174,8 @@ TEST(CarmenReaderTest, BadInputNamesFileLineAndField) {
 
 TEST(CarmenReaderTest, LenientModeCountsSkippedLines) {
   TempDir dir;
-  const std::string text = Odom(0, 0, 0, 1.0) + "ODOM 1 2\n" + Flaser(3, 1.0, 0, 0, 0, 1.2) +
-                           "FLASER 3 1 1\n";
+  const std::string text =
+      Odom(0, 0, 0, 1.0) + "ODOM 1 2\n" + Flaser(3, 1.0, 0, 0, 0, 1.2) + "FLASER 3 1 1\n";
   CarmenReadOptions options;
   options.lenient = true;
   const CarmenLog log = ReadCarmenLog(dir.Write("l.log", text), options);

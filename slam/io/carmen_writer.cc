@@ -1,11 +1,12 @@
 #include "slam/io/carmen_writer.h"
 
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
-#include <unistd.h>
 
 namespace slamrig::slam {
 namespace {

@@ -17,7 +17,8 @@ std::vector<Entry> InFileOrder(const CarmenLog& log) {
   entries.reserve(log.scans.size() + log.odometry.size());
   for (const auto& s : log.scans) entries.push_back({s.line, &s, nullptr});
   for (const auto& o : log.odometry) entries.push_back({o.line, nullptr, &o});
-  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.line < b.line; });
+  std::sort(entries.begin(), entries.end(),
+            [](const Entry& a, const Entry& b) { return a.line < b.line; });
   return entries;
 }
 
@@ -43,7 +44,8 @@ Dataset CarmenToDataset(const CarmenLog& log) {
           ++dropped;
           continue;
         }
-        const Pose2 recovered = previous_odometry * previous_corrected.Between(e.odometry->odometry.odom_from_base);
+        const Pose2 recovered =
+            previous_odometry * previous_corrected.Between(e.odometry->odometry.odom_from_base);
         data.records.push_back(OdometryPose{e.odometry->odometry.time, recovered});
         continue;
       }
@@ -54,8 +56,9 @@ Dataset CarmenToDataset(const CarmenLog& log) {
         data.records.push_back(OdometryPose{s.scan.time, previous_odometry});
       } else {
         // The odometry at this scan is the last ODOM before it (or no motion if there was none).
-        const auto last = std::find_if(data.records.rbegin(), data.records.rend(),
-                                       [](const Record& r) { return std::holds_alternative<OdometryPose>(r); });
+        const auto last =
+            std::find_if(data.records.rbegin(), data.records.rend(),
+                         [](const Record& r) { return std::holds_alternative<OdometryPose>(r); });
         previous_odometry = std::get<OdometryPose>(*last).odom_from_base;
       }
       previous_corrected = s.logged_pose;
@@ -74,7 +77,8 @@ Dataset CarmenToDataset(const CarmenLog& log) {
       data.records.push_back(e.odometry->odometry);
       continue;
     }
-    if (e.scan->has_pose) data.records.push_back(OdometryPose{e.scan->scan.time, e.scan->odom_pose});
+    if (e.scan->has_pose)
+      data.records.push_back(OdometryPose{e.scan->scan.time, e.scan->odom_pose});
     data.records.push_back(e.scan->scan);
   }
   data.reference = log.true_poses;

@@ -30,8 +30,10 @@ TEST(DatasetTest, RecoversRawOdometryFromCorrectedLog) {
       // Two ODOM lines between scans: half and all of this step's raw motion.
       const Pose2 step(0.4, 0.02 * k, 0.1 * std::sin(k));
       const Pose2 half(0.2, 0.01 * k, 0.05 * std::sin(k));
-      text += "ODOM " + PoseText(corrected.back() * half) + " 0 0 0 " + std::to_string(t += 0.1) + " h 0\n";
-      text += "ODOM " + PoseText(corrected.back() * step) + " 0 0 0 " + std::to_string(t += 0.1) + " h 0\n";
+      text += "ODOM " + PoseText(corrected.back() * half) + " 0 0 0 " + std::to_string(t += 0.1) +
+              " h 0\n";
+      text += "ODOM " + PoseText(corrected.back() * step) + " 0 0 0 " + std::to_string(t += 0.1) +
+              " h 0\n";
       odometry = odometry * step;
       truth = corrected.back() * step * Pose2(noise(rng), noise(rng), 0.2 * noise(rng));
     }

@@ -49,7 +49,8 @@ std::string RenderMapPng(const OccupancyGrid& grid, const std::vector<Trajectory
   double px_per_m = scale / res;
   if (largest * scale > options.max_size_px) px_per_m = options.max_size_px / (largest * res);
   const int width = std::max(1, static_cast<int>(std::lround(region.sizes().x() * px_per_m)));
-  const int legend_h = 28 * static_cast<int>(overlays.size() + (options.title.empty() ? 0 : 1)) + 40;
+  const int legend_h =
+      28 * static_cast<int>(overlays.size() + (options.title.empty() ? 0 : 1)) + 40;
   const int height = std::max(1, static_cast<int>(std::lround(region.sizes().y() * px_per_m)));
 
   cv::Mat image(height + legend_h, width, CV_8UC3, cv::Scalar(255, 255, 255));
@@ -84,20 +85,21 @@ std::string RenderMapPng(const OccupancyGrid& grid, const std::vector<Trajectory
       points.emplace_back(static_cast<int>(std::lround(q.x)), static_cast<int>(std::lround(q.y)));
     }
     if (points.size() >= 2) cv::polylines(image, points, false, colour, thickness, cv::LINE_AA);
-    if (!points.empty()) cv::circle(image, points.front(), 3 * thickness, colour, cv::FILLED, cv::LINE_AA);
+    if (!points.empty())
+      cv::circle(image, points.front(), 3 * thickness, colour, cv::FILLED, cv::LINE_AA);
   }
   // Legend: title, one line per trajectory, scale bar.
   int y = 24;
   if (!options.title.empty()) {
-    cv::putText(image, options.title, {10, y}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(0, 0, 0), 1,
-                cv::LINE_AA);
+    cv::putText(image, options.title, {10, y}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(0, 0, 0),
+                1, cv::LINE_AA);
     y += 28;
   }
   for (const auto& overlay : overlays) {
     const cv::Scalar colour(overlay.blue, overlay.green, overlay.red);
     cv::line(image, {10, y - 6}, {40, y - 6}, colour, 3, cv::LINE_AA);
-    cv::putText(image, overlay.label, {50, y}, cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0), 1,
-                cv::LINE_AA);
+    cv::putText(image, overlay.label, {50, y}, cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0),
+                1, cv::LINE_AA);
     y += 28;
   }
   const double bar_m = NiceLength(0.25 * width / px_per_m);
@@ -105,8 +107,8 @@ std::string RenderMapPng(const OccupancyGrid& grid, const std::vector<Trajectory
   cv::rectangle(image, {10, y - 4}, {10 + bar_px, y + 4}, cv::Scalar(0, 0, 0), cv::FILLED);
   char label[32];
   std::snprintf(label, sizeof(label), "%g m", bar_m);
-  cv::putText(image, label, {16 + bar_px, y + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0),
-              1, cv::LINE_AA);
+  cv::putText(image, label, {16 + bar_px, y + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.55,
+              cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   cv::line(image, {0, legend_h - 1}, {width, legend_h - 1}, cv::Scalar(160, 160, 160), 1);
 
   std::vector<std::uint8_t> png;

@@ -17,10 +17,10 @@ struct TrajectoryOverlay {
 
 /// Rendering of a map picture.
 struct MapImageOptions {
-  int min_size_px = 800;    ///< small maps are scaled up (nearest) to about this many pixels
-  int max_size_px = 4000;   ///< large maps are scaled down to fit
-  double margin_m = 1.0;    ///< room around the observed cells and the trajectories
-  std::string title;        ///< printed top left, e.g. the log's name
+  int min_size_px = 800;   ///< small maps are scaled up (nearest) to about this many pixels
+  int max_size_px = 4000;  ///< large maps are scaled down to fit
+  double margin_m = 1.0;   ///< room around the observed cells and the trajectories
+  std::string title;       ///< printed top left, e.g. the log's name
 };
 
 /// A PNG picture of `grid` (occupied black, free white, unknown grey; probability as shade) with
@@ -30,6 +30,7 @@ std::string RenderMapPng(const OccupancyGrid& grid, const std::vector<Trajectory
 
 /// RenderMapPng written to `path` atomically.
 void WriteMapPng(const std::string& path, const OccupancyGrid& grid,
-                 const std::vector<TrajectoryOverlay>& overlays, const MapImageOptions& options = {});
+                 const std::vector<TrajectoryOverlay>& overlays,
+                 const MapImageOptions& options = {});
 
 }  // namespace slamrig::slam

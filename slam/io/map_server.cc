@@ -51,7 +51,8 @@ cv::Mat ReadPgm(const std::string& path) {
   if (!in) throw ParseError(path + ": cannot open map image");
   std::string magic;
   in >> magic;
-  if (magic != "P5" && magic != "P2") throw ParseError(path + ": not a PGM file (magic '" + magic + "')");
+  if (magic != "P5" && magic != "P2")
+    throw ParseError(path + ": not a PGM file (magic '" + magic + "')");
   auto next_int = [&](const char* field) {
     while (in >> std::ws && in.peek() == '#') {
       std::string comment;
@@ -66,7 +67,8 @@ cv::Mat ReadPgm(const std::string& path) {
   const int width = next_int("width");
   const int height = next_int("height");
   const int maxval = next_int("maxval");
-  if (maxval > 255) throw ParseError(path + ": 16-bit PGM (maxval " + std::to_string(maxval) + ") not supported");
+  if (maxval > 255)
+    throw ParseError(path + ": 16-bit PGM (maxval " + std::to_string(maxval) + ") not supported");
   cv::Mat image(height, width, CV_8UC1);
   if (magic == "P5") {
     in.get();  // the single whitespace after maxval
@@ -118,7 +120,8 @@ std::string WriteMapServerMap(const OccupancyGrid& grid, const std::string& base
   }
   const std::string pgm_path = base + ".pgm";
   const std::string yaml_path = base + ".yaml";
-  const Eigen::Vector2d origin = grid.origin() + Eigen::Vector2d(box.x0, box.y0) * grid.resolution();
+  const Eigen::Vector2d origin =
+      grid.origin() + Eigen::Vector2d(box.x0, box.y0) * grid.resolution();
   const std::string yaml =
       "image: " + std::filesystem::path(pgm_path).filename().string() + "\n" +
       "mode: " + options.mode + "\n" + "resolution: " + FormatDouble(grid.resolution()) + "\n" +
@@ -159,7 +162,8 @@ MapImage ReadMapServerMap(const std::string& yaml_path) {
   root.CheckAllKeysUsed();
 
   std::filesystem::path image_path(image_name);
-  if (image_path.is_relative()) image_path = std::filesystem::path(yaml_path).parent_path() / image_path;
+  if (image_path.is_relative())
+    image_path = std::filesystem::path(yaml_path).parent_path() / image_path;
   if (!std::filesystem::exists(image_path)) {
     image_node.Fail("map image '" + image_path.string() + "' does not exist");
   }
@@ -189,7 +193,8 @@ MapImage ReadMapServerMap(const std::string& yaml_path) {
       } else if (p < free_thresh) {
         cell = 0;
       } else if (mode == "scale") {
-        cell = static_cast<std::int8_t>(std::lround(99.0 * (p - free_thresh) / (occupied_thresh - free_thresh)));
+        cell = static_cast<std::int8_t>(
+            std::lround(99.0 * (p - free_thresh) / (occupied_thresh - free_thresh)));
       }
     }
   }

@@ -61,17 +61,18 @@ TEST(MapServerTest, WrittenMapReadsBackToTheSameGrid) {
 TEST(MapServerTest, ReadsAsciiPgmNegateAndScale) {
   testing::TempDir dir;
   dir.Write("m.pgm", "P2\n# c\n3 2\n255\n0 255 205\n100 200 30\n");
-  const MapImage map = ReadMapServerMap(dir.Write(
-      "m.yaml", "image: m.pgm\nresolution: 0.1\norigin: [-1.0, 2.0, 0.0]\nnegate: 1\n"
+  const MapImage map = ReadMapServerMap(
+      dir.Write("m.yaml",
+                "image: m.pgm\nresolution: 0.1\norigin: [-1.0, 2.0, 0.0]\nnegate: 1\n"
                 "occupied_thresh: 0.65\nfree_thresh: 0.196\n"));
   ASSERT_EQ(map.width, 3);
   ASSERT_EQ(map.height, 2);
   // negate: p = value / 255. Bottom row (y = 0) is the image's last row.
-  EXPECT_EQ(map.at(0, 1), 0);     // 0 -> p 0 -> free
-  EXPECT_EQ(map.at(1, 1), 100);   // 255 -> occupied
-  EXPECT_EQ(map.at(2, 1), 100);   // 205 -> p 0.80 -> occupied
-  EXPECT_EQ(map.at(0, 0), -1);    // 100 -> p 0.39 -> unknown
-  EXPECT_EQ(map.at(2, 0), 0);     // 30 -> p 0.12 -> free
+  EXPECT_EQ(map.at(0, 1), 0);    // 0 -> p 0 -> free
+  EXPECT_EQ(map.at(1, 1), 100);  // 255 -> occupied
+  EXPECT_EQ(map.at(2, 1), 100);  // 205 -> p 0.80 -> occupied
+  EXPECT_EQ(map.at(0, 0), -1);   // 100 -> p 0.39 -> unknown
+  EXPECT_EQ(map.at(2, 0), 0);    // 30 -> p 0.12 -> free
   EXPECT_DOUBLE_EQ(map.origin.x(), -1.0);
 }
 
@@ -85,13 +86,16 @@ TEST(MapServerTest, BadYamlAndImagesNameFileAndKey) {
     }
     return std::string();
   };
-  const std::string rest = "origin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.2\n";
+  const std::string rest =
+      "origin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.2\n";
   EXPECT_THAT(error("image: nope.pgm\nresolution: 0.05\n" + rest),
               HasSubstr("bad.yaml:1:8: image: map image"));
-  EXPECT_THAT(error("image: x.pgm\nresolution: -1\n" + rest), HasSubstr("bad.yaml:2:13: resolution: must be > 0"));
+  EXPECT_THAT(error("image: x.pgm\nresolution: -1\n" + rest),
+              HasSubstr("bad.yaml:2:13: resolution: must be > 0"));
   EXPECT_THAT(error("image: x.pgm\nresolution: 0.05\ncolour: red\n" + rest),
               HasSubstr("bad.yaml:3:1: colour: unknown key"));
-  EXPECT_THAT(error("image: x.pgm\nresolution: 0.05\n"), HasSubstr("missing required key 'origin'"));
+  EXPECT_THAT(error("image: x.pgm\nresolution: 0.05\n"),
+              HasSubstr("missing required key 'origin'"));
   dir.Write("t.pgm", "P5\n4 4\n255\nab");
   EXPECT_THAT(error("image: t.pgm\nresolution: 0.05\n" + rest), HasSubstr("truncated PGM"));
 }

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <charconv>
-#include <optional>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "slam/io/atomic_file.h"
 #include "slam/io/line_reader.h"
@@ -22,7 +22,8 @@ std::optional<Time> ParseStamp(std::string_view text) {
   std::int64_t seconds = 0;
   const bool negative = !whole.empty() && whole.front() == '-';
   const auto [end, ec] = std::from_chars(whole.data(), whole.data() + whole.size(), seconds);
-  const bool digits_only = std::all_of(frac.begin(), frac.end(), [](char c) { return c >= '0' && c <= '9'; });
+  const bool digits_only =
+      std::all_of(frac.begin(), frac.end(), [](char c) { return c >= '0' && c <= '9'; });
   if (ec == std::errc() && end == whole.data() + whole.size() && digits_only && frac.size() <= 9 &&
       !whole.empty()) {
     std::int64_t nanos = 0;
@@ -97,7 +98,8 @@ Trajectory ReadTum(const std::string& path) {
       while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == ',')) ++i;
     }
     if (n != 8) {
-      throw ParseError(where + "expected 8 fields (t x y z qx qy qz qw), found " + std::to_string(n));
+      throw ParseError(where + "expected 8 fields (t x y z qx qy qz qw), found " +
+                       std::to_string(n));
     }
     const double qx = v[4], qy = v[5], qz = v[6], qw = v[7];
     const double norm = std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw);
@@ -109,7 +111,8 @@ Trajectory ReadTum(const std::string& path) {
     }
     const Time t = *stamp;
     if (!trajectory.empty() && t < trajectory.poses().back().time) {
-      throw ParseError(where + "timestamp: " + std::to_string(t.seconds()) + " is earlier than the line before");
+      throw ParseError(where + "timestamp: " + std::to_string(t.seconds()) +
+                       " is earlier than the line before");
     }
     trajectory.Append(t, Pose2(v[1], v[2], 2.0 * std::atan2(qz, qw)));
   }

@@ -37,7 +37,8 @@ TEST(TumIoTest, RoundTripsRandomTrajectoriesExactly) {
 TEST(TumIoTest, ReadsYawFromQuaternion) {
   testing::TempDir dir;
   // 90 degrees about z.
-  const auto path = dir.Write("q.tum", "# header\n\n1.5 1 2 0 0 0 0.7071067811865476 0.7071067811865476\n");
+  const auto path =
+      dir.Write("q.tum", "# header\n\n1.5 1 2 0 0 0 0.7071067811865476 0.7071067811865476\n");
   const Trajectory t = ReadTum(path);
   ASSERT_EQ(t.size(), 1u);
   EXPECT_NEAR(t[0].pose.theta(), 1.5707963267948966, 1e-12);
@@ -55,7 +56,8 @@ TEST(TumIoTest, BadLinesNameFileLineAndField) {
     return std::string();
   };
   EXPECT_THAT(error("1 2 3 0 0 0 0 1\n2 2 3 0 0 0\n"), HasSubstr("b.tum:2: expected 8 fields"));
-  EXPECT_THAT(error("1 2 x 0 0 0 0 1\n"), HasSubstr("b.tum:1: ty: expected a finite number, got 'x'"));
+  EXPECT_THAT(error("1 2 x 0 0 0 0 1\n"),
+              HasSubstr("b.tum:1: ty: expected a finite number, got 'x'"));
   EXPECT_THAT(error("1 2 3 0 0 0 0 2\n"), HasSubstr("quaternion: norm"));
   EXPECT_THAT(error("1 2 3 0 1 0 0 0\n"), HasSubstr("leaves the plane"));
   EXPECT_THAT(error("2 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n"), HasSubstr("b.tum:2: timestamp"));

@@ -4,14 +4,14 @@
 #include <cstdlib>
 
 /// Invariant checks that stay on in every build. A failed check is a bug in slamrig, never bad
-/// user input (that is a ConfigError or ParseError at the boundary): it prints file:line and aborts.
-#define SLAMRIG_CHECK(cond, msg)                                                     \
-  do {                                                                               \
-    if (!(cond)) {                                                                   \
-      std::fprintf(stderr, "%s:%d: check failed: %s: %s\n", __FILE__, __LINE__, #cond, \
-                   (msg));                                                           \
-      std::abort();                                                                  \
-    }                                                                                \
+/// user input (that is a ConfigError or ParseError at the boundary): it prints file:line and
+/// aborts.
+#define SLAMRIG_CHECK(cond, msg)                                                               \
+  do {                                                                                         \
+    if (!(cond)) {                                                                             \
+      std::fprintf(stderr, "%s:%d: check failed: %s: %s\n", __FILE__, __LINE__, #cond, (msg)); \
+      std::abort();                                                                            \
+    }                                                                                          \
   } while (false)
 
 /// Like SLAMRIG_CHECK, for hot loops: compiled out unless NDEBUG is unset.

@@ -19,7 +19,8 @@ inline double NormalizeAngle(double angle_rad) {
 class Pose2 {
  public:
   constexpr Pose2() = default;
-  Pose2(double x_m, double y_m, double theta_rad) : x_(x_m), y_(y_m), theta_(NormalizeAngle(theta_rad)) {}
+  Pose2(double x_m, double y_m, double theta_rad)
+      : x_(x_m), y_(y_m), theta_(NormalizeAngle(theta_rad)) {}
 
   double x() const { return x_; }
   double y() const { return y_; }

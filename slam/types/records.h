@@ -41,8 +41,8 @@ struct OdometryPose {
 };
 
 /// Encoder tick increments since the previous WheelTicks record, per wheel, front to back on
-/// each side. A two-wheel robot has one entry per side; the ECE276A robot has two (FR, RR / FL, RL).
-/// Ticks per revolution and wheel radius are robot parameters, not part of the record.
+/// each side. A two-wheel robot has one entry per side; the ECE276A robot has two (FR, RR / FL,
+/// RL). Ticks per revolution and wheel radius are robot parameters, not part of the record.
 struct WheelTicks {
   Time time;
   std::vector<std::int32_t> right_ticks;

@@ -8,9 +8,10 @@
 namespace slamrig {
 
 Trajectory::Trajectory(std::vector<StampedPose> poses) : poses_(std::move(poses)) {
-  SLAMRIG_CHECK(std::is_sorted(poses_.begin(), poses_.end(),
-                               [](const StampedPose& a, const StampedPose& b) { return a.time < b.time; }),
-                "trajectory times must be non-decreasing");
+  SLAMRIG_CHECK(
+      std::is_sorted(poses_.begin(), poses_.end(),
+                     [](const StampedPose& a, const StampedPose& b) { return a.time < b.time; }),
+      "trajectory times must be non-decreasing");
 }
 
 void Trajectory::Append(Time time, const Pose2& pose) {
@@ -23,9 +24,8 @@ std::optional<Pose2> Trajectory::Interpolate(Time time) const {
   if (poses_.empty() || time < poses_.front().time || time > poses_.back().time) {
     return std::nullopt;
   }
-  const auto after = std::lower_bound(
-      poses_.begin(), poses_.end(), time,
-      [](const StampedPose& p, Time t) { return p.time < t; });
+  const auto after = std::lower_bound(poses_.begin(), poses_.end(), time,
+                                      [](const StampedPose& p, Time t) { return p.time < t; });
   if (after->time == time || after == poses_.begin()) return after->pose;
   const auto before = after - 1;
   const double span = SecondsBetween(after->time, before->time);

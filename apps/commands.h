@@ -1,0 +1,21 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace slamrig::app {
+
+/// One `slamrig` subcommand: it parses its own arguments (without the program and command
+/// names), returns the process exit code, and throws ConfigError/ParseError for bad input.
+struct Command {
+  const char* name;
+  const char* summary;
+  int (*run)(const std::vector<std::string>& args);
+};
+
+int RunMapCommand(const std::vector<std::string>& args);
+
+/// All subcommands, in the order `slamrig --help` lists them.
+const std::vector<Command>& Commands();
+
+}  // namespace slamrig::app

@@ -1,0 +1,83 @@
+// slamrig: the one command line of the test bench. Each subcommand lives in its own
+// *_command.cc; this file dispatches and turns every error into one line and an exit code.
+
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "apps/commands.h"
+#include "slam/types/error.h"
+
+namespace slamrig::app {
+
+const std::vector<Command>& Commands() {
+  static const std::vector<Command> commands = {
+      {"map", "build the occupancy map of a log from its logged poses", RunMapCommand},
+  };
+  return commands;
+}
+
+namespace {
+
+constexpr int kExitUsage = 2;
+constexpr int kExitDataError = 1;
+
+void PrintHelp() {
+  std::string help =
+      "slamrig: a test bench for 2D SLAM\n\n"
+      "Usage: slamrig <command> [arguments]\n\n"
+      "Commands:\n";
+  for (const Command& c : Commands()) {
+    const std::string name = c.name;
+    help +=
+        "  " + name + std::string(name.size() < 12 ? 12 - name.size() : 1, ' ') + c.summary + "\n";
+  }
+  help +=
+      "\nRun 'slamrig <command> --help' for a command's arguments.\n"
+      "Datasets are found through SLAMRIG_DATA_DIR (default ../shared/datasets).\n";
+  std::fputs(help.c_str(), stdout);
+}
+
+int Main(int argc, char** argv) {
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) {
+    PrintHelp();
+    return kExitUsage;
+  }
+  const std::string& name = args[0];
+  if (name == "-h" || name == "--help" || (name == "help" && args.size() == 1)) {
+    PrintHelp();
+    return 0;
+  }
+  // `slamrig help map` is `slamrig map --help`.
+  const bool help_for_command = name == "help";
+  const std::string& command = help_for_command ? args[1] : name;
+  const std::vector<std::string> command_args =
+      help_for_command ? std::vector<std::string>{"--help"}
+                       : std::vector<std::string>(args.begin() + 1, args.end());
+  if (name == "--version") {
+    std::puts("slamrig 0.1.0");
+    return 0;
+  }
+  for (const Command& c : Commands()) {
+    if (command != c.name) continue;
+    try {
+      return c.run(command_args);
+    } catch (const ConfigError& e) {
+      std::fprintf(stderr, "slamrig: error: %s\n", e.what());
+      return kExitUsage;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "slamrig: error: %s\n", e.what());
+      return kExitDataError;
+    }
+  }
+  std::fprintf(stderr, "slamrig: error: unknown command '%s' (see 'slamrig --help')\n",
+               command.c_str());
+  return kExitUsage;
+}
+
+}  // namespace
+}  // namespace slamrig::app
+
+int main(int argc, char** argv) { return slamrig::app::Main(argc, argv); }

@@ -1,0 +1,107 @@
+// The slamrig command line as a user meets it: help, a real run, and hostile input.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "tests/util/dataset.h"
+#include "tests/util/run_command.h"
+#include "tests/util/temp_dir.h"
+
+namespace slamrig {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::RunCommand;
+using ::testing::StartsWith;
+using testing::TempDir;
+
+std::string Slamrig(const std::string& args) { return std::string(SLAMRIG_BINARY) + " " + args; }
+
+int CountLines(const std::string& text) {
+  int lines = 0;
+  for (const char c : text) lines += c == '\n';
+  return lines;
+}
+
+TEST(CliTest, HelpListsCommandsAndPerCommandHelp) {
+  const auto help = RunCommand(Slamrig("--help"));
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_THAT(help.output, HasSubstr("map "));
+  const auto map_help = RunCommand(Slamrig("map --help"));
+  EXPECT_EQ(map_help.exit_code, 0);
+  EXPECT_THAT(map_help.output, HasSubstr("Usage: slamrig map LOG --out DIR"));
+  EXPECT_THAT(map_help.output, HasSubstr("--resolution M"));
+  EXPECT_EQ(RunCommand(Slamrig("help map")).output, map_help.output);
+  const auto unknown = RunCommand(Slamrig("mapp"));
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_THAT(unknown.output, HasSubstr("unknown command 'mapp'"));
+}
+
+TEST(CliTest, MapsASliceOfIntel) {
+  SLAMRIG_REQUIRE_DATASET(intel, "carmen_corrected/intel-corrected.log.gz");
+  TempDir dir;
+  // The first 3,000 lines: about 150 scans.
+  const std::string slice = dir.File("slice.log");
+  ASSERT_EQ(std::system(("zcat " + intel + " | head -n 3000 > " + slice).c_str()), 0);
+  const auto run = RunCommand(Slamrig("map " + slice + " --out " + dir.File("out")));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("scans mapped"));
+  for (const char* f : {"map.pgm", "map.yaml", "map.png", "trajectory.tum"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir.File(std::string("out/") + f))) << f;
+  }
+}
+
+// Each broken input: one error line naming the file (and line), non-zero exit, no output.
+TEST(CliTest, BrokenCarmenInputFailsCleanly) {
+  TempDir dir;
+  const std::string good =
+      "ODOM 0 0 0 0 0 0 1.0 h 1.0\n"
+      "FLASER 3 1.0 1.5 2.0 0 0 0 0 0 0 1.1 h 1.1\n";
+  struct Case {
+    std::string name, contents, expected;
+  };
+  const std::vector<Case> cases = {
+      {"truncated.log", good + "FLASER 3 1.0 1.5 2.0 0 0\n",
+       "truncated.log:3: FLASER line: expected 14 fields"},
+      {"nan.log", good + "FLASER 3 1.0 nan 2.0 0 0 0 0 0 0 1.2 h 1.2\n",
+       "nan.log:3: FLASER range[1]: not a finite number"},
+      {"beams.log", good + "FLASER 4 1.0 1.5 2.0 0 0 0 0 0 0 1.2 h 1.2\n",
+       "beams.log:3: FLASER line: expected 15 fields"},
+      {"empty.log", "", "empty.log: empty file"},
+      {"garbage.log", std::string("\x89PNG\r\n\x1a\n\x01\x02\x03binary", 17),
+       "garbage.log:1: line: binary data"},
+  };
+  for (const Case& c : cases) {
+    const std::string out = dir.File("out_" + c.name);
+    const auto run = RunCommand(Slamrig("map " + dir.Write(c.name, c.contents) + " --out " + out));
+    EXPECT_NE(run.exit_code, 0) << c.name;
+    EXPECT_EQ(CountLines(run.output), 1) << run.output;
+    EXPECT_THAT(run.output, StartsWith("slamrig: error: "));
+    EXPECT_THAT(run.output, HasSubstr(c.expected)) << c.name;
+    EXPECT_FALSE(std::filesystem::exists(out)) << c.name;
+  }
+  const auto missing =
+      RunCommand(Slamrig("map " + dir.File("nope.log") + " --out " + dir.File("o")));
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_THAT(missing.output, HasSubstr("nope.log: no such file"));
+  EXPECT_FALSE(std::filesystem::exists(dir.File("o")));
+}
+
+TEST(CliTest, BadFlagsFailWithUsageError) {
+  TempDir dir;
+  const std::string log = dir.Write("a.log", "FLASER 3 1.0 1.5 2.0 0 0 0 0 0 0 1.1 h 1.1\n");
+  auto run = RunCommand(Slamrig("map " + log + " --out " + dir.File("o") + " --resolution -1"));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("resolution_m = -1; must be > 0"));
+  run = RunCommand(Slamrig("map " + log + " --out " + dir.File("o") + " --resolution abc"));
+  EXPECT_THAT(run.output, HasSubstr("--resolution: expected a number, got 'abc'"));
+  run = RunCommand(Slamrig("map " + log));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("--out DIR is required"));
+  EXPECT_FALSE(std::filesystem::exists(dir.File("o")));
+}
+
+}  // namespace
+}  // namespace slamrig
