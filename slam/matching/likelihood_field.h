@@ -1,0 +1,55 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "slam/grid/occupancy_grid.h"
+#include "slam/matching/grid_view.h"
+
+namespace slamrig::slam {
+
+/// Parameters of the likelihood-field observation model.
+struct LikelihoodFieldOptions {
+  double sigma_m = 0.05;            ///< standard deviation of a hit around the nearest wall
+  double z_hit = 0.9;               ///< weight of the Gaussian part
+  double z_rand = 0.1;              ///< weight of the uniform part (outliers, unknown space)
+  float occupied_threshold = 0.0f;  ///< log-odds above this is a wall
+  double cutoff_sigmas = 3.0;       ///< walls further than this many sigmas count as "none near"
+
+  /// One message per broken rule (prefixed "likelihood_field.").
+  std::vector<std::string> Validate() const;
+};
+
+/// A likelihood field (Thrun, Burgard, Fox, "Probabilistic Robotics", Sec. 6.4, Table 6.3)
+/// computed from the occupied cells of an OccupancyGrid over a window. Cell value:
+/// log(z_hit * exp(-d^2 / (2 sigma^2)) + z_rand) - log(z_rand), with d the distance from the cell
+/// centre to the nearest occupied cell centre; 0 when no wall is within the cutoff and outside the
+/// window. Summed over a scan's end points it is the scan's log-likelihood up to a constant, so it
+/// plugs into MapCorrelator (CorrelationValue::kRawValue) and gets its shift search for free.
+class LikelihoodField {
+ public:
+  explicit LikelihoodField(const LikelihoodFieldOptions& options);
+
+  /// Recomputes the field over the part of `grid` that overlaps `region` (world coordinates),
+  /// on the grid's own cell lattice.
+  void Update(const OccupancyGrid& grid, const Eigen::AlignedBox2d& region);
+
+  /// The field as a raster (valid until the next Update).
+  GridView view() const;
+  /// Value of a cell at distance `distance_m` from the nearest wall.
+  double Score(double distance_m) const;
+
+ private:
+  LikelihoodFieldOptions options_;
+  int radius_cells_ = 0;
+  double kernel_resolution_ = 0.0;
+  std::vector<float> kernel_;  // (2r+1)^2 scores by cell offset
+  std::vector<float> values_;
+  int width_ = 0;
+  int height_ = 0;
+  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
+  double resolution_ = 1.0;
+};
+
+}  // namespace slamrig::slam

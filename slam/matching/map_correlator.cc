@@ -1,0 +1,207 @@
+// Map correlation over a shift grid: Wang, "Simultaneous Localization and Mapping with Texture"
+// (UCSD ECE276A), Sec. II-D and Eq. 7 (corr(y, m), softmax weights); the 9x9 grid of Zafari and
+// Kansal (ECE276A reports); yaw shifts as in Wang Sec. III-C.
+#include "slam/matching/map_correlator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <sstream>
+
+#include "slam/types/check.h"
+
+namespace slamrig::slam {
+namespace {
+
+// Four floats in one SIMD register (GCC/Clang vector extension: SSE2 on x86-64, NEON on ARM).
+typedef float V4 __attribute__((vector_size(16)));
+typedef std::int32_t V4i __attribute__((vector_size(16)));
+
+inline V4 Load4(const float* p) {
+  V4 v;
+  std::memcpy(&v, p, sizeof(v));
+  return v;
+}
+
+// Per-cell contribution: the raw value, or 1 for cells above the threshold.
+struct RawOp {
+  V4 operator()(V4 v) const { return v; }
+  float operator()(float v) const { return v; }
+};
+struct IndicatorOp {
+  float threshold;
+  V4 operator()(V4 v) const {
+    const V4 t = {threshold, threshold, threshold, threshold};
+    const V4 one = {1.0f, 1.0f, 1.0f, 1.0f};
+    V4i ones;
+    std::memcpy(&ones, &one, sizeof(ones));
+    const V4i mask = (v > t) & ones;
+    V4 out;
+    std::memcpy(&out, &mask, sizeof(out));
+    return out;
+  }
+  float operator()(float v) const { return v > threshold ? 1.0f : 0.0f; }
+};
+
+// Adds, for every patch row r and column c < 4*K, the contribution of cell
+// values[offset + r*width + c] over all `offsets` into sums[r*4K + c].
+template <int K, typename Op>
+void AccumulateRows(const float* values, int width, int side, const std::vector<std::int64_t>& offsets,
+                    const Op& op, float* sums) {
+  for (int r = 0; r < side; ++r) {
+    V4 acc[K] = {};
+    const float* row_base = values + static_cast<std::ptrdiff_t>(r) * width;
+    for (const std::int64_t offset : offsets) {
+      const float* p = row_base + offset;
+      for (int k = 0; k < K; ++k) acc[k] += op(Load4(p + 4 * k));
+    }
+    std::memcpy(sums + static_cast<std::ptrdiff_t>(r) * 4 * K, acc, sizeof(acc));
+  }
+}
+
+template <typename Op>
+void AccumulateDispatch(int chunks, const float* values, int width, int side,
+                        const std::vector<std::int64_t>& offsets, const Op& op, float* sums) {
+  switch (chunks) {
+    case 1: return AccumulateRows<1>(values, width, side, offsets, op, sums);
+    case 2: return AccumulateRows<2>(values, width, side, offsets, op, sums);
+    case 3: return AccumulateRows<3>(values, width, side, offsets, op, sums);
+    case 4: return AccumulateRows<4>(values, width, side, offsets, op, sums);
+    case 5: return AccumulateRows<5>(values, width, side, offsets, op, sums);
+    case 6: return AccumulateRows<6>(values, width, side, offsets, op, sums);
+    case 7: return AccumulateRows<7>(values, width, side, offsets, op, sums);
+    case 8: return AccumulateRows<8>(values, width, side, offsets, op, sums);
+    default: SLAMRIG_CHECK(false, "shift grid too wide");
+  }
+}
+
+// floor() for values well inside the int range, without the libm call.
+inline int FastFloor(double v) {
+  const int i = static_cast<int>(v);
+  return i - (v < static_cast<double>(i) ? 1 : 0);
+}
+
+// Scratch reused across calls on the same thread.
+struct Scratch {
+  std::vector<std::int64_t> offsets;    // patch corner offsets of points fully inside
+  std::vector<Eigen::Array2i> border;   // patch corner cells of points near or over the edge
+  std::vector<float> sums;
+};
+
+}  // namespace
+
+std::vector<std::string> MapCorrelatorOptions::Validate() const {
+  std::vector<std::string> errors;
+  auto add = [&](const char* field, double got, const char* rule) {
+    std::ostringstream s;
+    s << "correlation." << field << " = " << got << "; " << rule;
+    errors.push_back(s.str());
+  };
+  if (xy_half_width_cells < 0 || xy_half_width_cells > 15) {
+    add("xy_half_width_cells", xy_half_width_cells, "must be in [0, 15]");
+  }
+  if (yaw_half_steps < 0) add("yaw_half_steps", yaw_half_steps, "must be >= 0");
+  if (yaw_half_steps > 0 && !(yaw_step_rad > 0.0)) {
+    add("yaw_step_rad", yaw_step_rad, "must be > 0 when yaw_half_steps > 0");
+  }
+  return errors;
+}
+
+MapCorrelator::MapCorrelator(const MapCorrelatorOptions& options) : options_(options) {
+  SLAMRIG_CHECK(options_.Validate().empty(), "invalid MapCorrelatorOptions");
+}
+
+CorrelationResult MapCorrelator::Correlate(const GridView& grid,
+                                           std::span<const Eigen::Vector2d> points_base,
+                                           const Pose2& world_from_base,
+                                           std::vector<float>* table) const {
+  thread_local Scratch scratch;
+  const int n = options_.xy_half_width_cells;
+  const int side = options_.side();
+  const int chunks = (side + 3) / 4;
+  const int padded = 4 * chunks;  // columns actually read per patch row
+  const double inv_res = 1.0 / grid.resolution;
+  const IndicatorOp indicator{options_.occupied_threshold};
+  const RawOp raw;
+  if (table != nullptr) table->assign(static_cast<std::size_t>(options_.num_yaws() * side * side), 0.0f);
+
+  CorrelationResult best;
+  best.score = -std::numeric_limits<float>::infinity();
+  long best_rank = std::numeric_limits<long>::max();
+  for (int yaw_index = -options_.yaw_half_steps; yaw_index <= options_.yaw_half_steps; ++yaw_index) {
+    const double yaw = world_from_base.theta() + yaw_index * options_.yaw_step_rad;
+    const double c = std::cos(yaw) * inv_res;
+    const double s = std::sin(yaw) * inv_res;
+    const double tx = (world_from_base.x() - grid.origin.x()) * inv_res;
+    const double ty = (world_from_base.y() - grid.origin.y()) * inv_res;
+
+    // Points to patch-corner cells, consecutive duplicates dropped.
+    scratch.offsets.clear();
+    scratch.border.clear();
+    int last_x = std::numeric_limits<int>::min(), last_y = 0;
+    int distinct = 0;
+    for (const Eigen::Vector2d& p : points_base) {
+      const int ix = FastFloor(tx + c * p.x() - s * p.y());
+      const int iy = FastFloor(ty + s * p.x() + c * p.y());
+      if (ix == last_x && iy == last_y) continue;
+      last_x = ix;
+      last_y = iy;
+      ++distinct;
+      const int x0 = ix - n, y0 = iy - n;
+      if (x0 >= 0 && y0 >= 0 && x0 + padded <= grid.width && y0 + side <= grid.height) {
+        scratch.offsets.push_back(static_cast<std::int64_t>(y0) * grid.width + x0);
+      } else {
+        scratch.border.push_back({x0, y0});
+      }
+    }
+
+    scratch.sums.assign(static_cast<std::size_t>(side * padded), 0.0f);
+    if (!scratch.offsets.empty()) {
+      if (options_.value == CorrelationValue::kOccupiedIndicator) {
+        AccumulateDispatch(chunks, grid.values, grid.width, side, scratch.offsets, indicator,
+                           scratch.sums.data());
+      } else {
+        AccumulateDispatch(chunks, grid.values, grid.width, side, scratch.offsets, raw,
+                           scratch.sums.data());
+      }
+    }
+    // Points near the edge: cell by cell, outside reads as 0.
+    for (const Eigen::Array2i& corner : scratch.border) {
+      for (int r = 0; r < side; ++r) {
+        for (int col = 0; col < side; ++col) {
+          const float v = grid.At(corner.x() + col, corner.y() + r);
+          scratch.sums[static_cast<std::size_t>(r * padded + col)] +=
+              options_.value == CorrelationValue::kOccupiedIndicator ? indicator(v) : v;
+        }
+      }
+    }
+
+    for (int r = 0; r < side; ++r) {
+      for (int col = 0; col < side; ++col) {
+        const float score = scratch.sums[static_cast<std::size_t>(r * padded + col)];
+        const int dx = col - n, dy = r - n;
+        if (table != nullptr) {
+          (*table)[static_cast<std::size_t>(((yaw_index + options_.yaw_half_steps) * side + r) * side + col)] =
+              score;
+        }
+        const long rank = static_cast<long>(dx) * dx + static_cast<long>(dy) * dy +
+                          static_cast<long>(yaw_index) * yaw_index;
+        if (score > best.score || (score == best.score && rank < best_rank)) {
+          best.score = score;
+          best_rank = rank;
+          best.dx_cells = dx;
+          best.dy_cells = dy;
+          best.dyaw_steps = yaw_index;
+        }
+      }
+    }
+    if (yaw_index == 0) best.points_used = distinct;
+  }
+  best.pose = Pose2(world_from_base.x() + best.dx_cells * grid.resolution,
+                    world_from_base.y() + best.dy_cells * grid.resolution,
+                    world_from_base.theta() + best.dyaw_steps * options_.yaw_step_rad);
+  return best;
+}
+
+}  // namespace slamrig::slam

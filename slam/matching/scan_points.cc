@@ -1,0 +1,66 @@
+#include "slam/matching/scan_points.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <sstream>
+
+#include "slam/types/check.h"
+
+namespace slamrig::slam {
+namespace {
+
+std::string Rule(const char* field, double value, const char* rule) {
+  std::ostringstream s;
+  s << "points." << field << " = " << value << "; " << rule;
+  return s.str();
+}
+
+}  // namespace
+
+std::vector<std::string> ScanPointsOptions::Validate() const {
+  std::vector<std::string> errors;
+  if (!(min_range_m >= 0.0)) errors.push_back(Rule("min_range_m", min_range_m, "must be >= 0"));
+  if (!(max_range_m > min_range_m)) {
+    errors.push_back(Rule("max_range_m", max_range_m, "must be > min_range_m"));
+  }
+  if (beam_stride < 1) errors.push_back(Rule("beam_stride", beam_stride, "must be >= 1"));
+  if (!(voxel_size_m >= 0.0)) errors.push_back(Rule("voxel_size_m", voxel_size_m, "must be >= 0"));
+  return errors;
+}
+
+std::vector<Eigen::Vector2d> ScanToBasePoints(const LaserScan& scan,
+                                              const ScanPointsOptions& options) {
+  SLAMRIG_DCHECK(options.Validate().empty(), "invalid ScanPointsOptions");
+  std::vector<Eigen::Vector2d> points;
+  points.reserve(scan.ranges_m.size() / static_cast<std::size_t>(options.beam_stride) + 1);
+  const double min_range = std::max(options.min_range_m, scan.range_min_m);
+  const double max_range = std::min(options.max_range_m, scan.range_max_m);
+  for (std::size_t i = 0; i < scan.ranges_m.size(); i += static_cast<std::size_t>(options.beam_stride)) {
+    const double r = scan.ranges_m[i];
+    if (!(r >= min_range && r < max_range)) continue;
+    const double angle = scan.BeamAngle(i);
+    points.push_back(scan.base_from_laser * Eigen::Vector2d(r * std::cos(angle), r * std::sin(angle)));
+  }
+  if (options.voxel_size_m <= 0.0 || points.empty()) return points;
+
+  // Voxel filter: sort (voxel key, beam index), keep the first index per key, restore beam order.
+  std::vector<std::pair<std::int64_t, std::uint32_t>> keys(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const auto vx = static_cast<std::int64_t>(std::floor(points[i].x() / options.voxel_size_m));
+    const auto vy = static_cast<std::int64_t>(std::floor(points[i].y() / options.voxel_size_m));
+    keys[i] = {vx * 4000003 + vy, static_cast<std::uint32_t>(i)};
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<std::uint32_t> kept;
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (i == 0 || keys[i].first != keys[i - 1].first) kept.push_back(keys[i].second);
+  }
+  std::sort(kept.begin(), kept.end());
+  std::vector<Eigen::Vector2d> filtered;
+  filtered.reserve(kept.size());
+  for (const std::uint32_t i : kept) filtered.push_back(points[i]);
+  return filtered;
+}
+
+}  // namespace slamrig::slam

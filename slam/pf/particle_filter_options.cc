@@ -1,0 +1,65 @@
+#include "slam/pf/particle_filter_options.h"
+
+#include <sstream>
+
+namespace slamrig::slam {
+namespace {
+
+template <typename T>
+std::string Rule(const char* field, T value, const char* rule) {
+  std::ostringstream s;
+  s << "pf." << field << " = " << value << "; " << rule;
+  return s.str();
+}
+
+void Prefixed(const std::vector<std::string>& from, std::vector<std::string>& to) {
+  for (const std::string& e : from) to.push_back("pf." + e);
+}
+
+}  // namespace
+
+ParticleFilterOptions ParticleFilterOptions::ReportsPreset() {
+  ParticleFilterOptions o;
+  o.motion_noise = MotionNoiseModel::kGaussianPerStep;
+  o.sigma_xy_m = 0.005;
+  o.sigma_yaw_rad = 0.003;
+  o.observation = ObservationModel::kMapCorrelation;
+  o.points = ScanPointsOptions{0.1, 30.0, 1, 0.0};
+  o.correlation = MapCorrelatorOptions{4, 0, 0.01, CorrelationValue::kOccupiedIndicator, 0.0f};
+  o.observation_scale = 1.0;
+  o.move_to_best_shift = false;
+  o.resampling = ResamplingScheme::kStratified;
+  o.resample_neff_ratio = 0.5;
+  // 80 % trust: +log 4 on hits, -log 4 on free cells, every beam counts.
+  o.map.hit_log_odds = 1.3862944f;
+  o.map.miss_log_odds = -1.3862944f;
+  o.map.min_log_odds = -10.0f;
+  o.map.max_log_odds = 10.0f;
+  o.map.update_once_per_scan = false;
+  return o;
+}
+
+std::vector<std::string> ParticleFilterOptions::Validate() const {
+  std::vector<std::string> errors;
+  if (num_particles <= 0) errors.push_back(Rule("num_particles", num_particles, "must be > 0"));
+  if (!(sigma_xy_m >= 0.0)) errors.push_back(Rule("sigma_xy_m", sigma_xy_m, "must be >= 0"));
+  if (!(sigma_yaw_rad >= 0.0)) errors.push_back(Rule("sigma_yaw_rad", sigma_yaw_rad, "must be >= 0"));
+  if (!(observation_scale > 0.0)) {
+    errors.push_back(Rule("observation_scale", observation_scale, "must be > 0"));
+  }
+  if (!(resample_neff_ratio >= 0.0 && resample_neff_ratio <= 1.0)) {
+    errors.push_back(Rule("resample_neff_ratio", resample_neff_ratio, "must be in [0, 1]"));
+  }
+  if (num_threads < 1) errors.push_back(Rule("num_threads", num_threads, "must be >= 1"));
+  if (cloud_every_n_scans < 0) {
+    errors.push_back(Rule("cloud_every_n_scans", cloud_every_n_scans, "must be >= 0"));
+  }
+  Prefixed(rot_trans_rot.Validate(), errors);
+  Prefixed(points.Validate(), errors);
+  Prefixed(correlation.Validate(), errors);
+  Prefixed(likelihood_field.Validate(), errors);
+  for (const std::string& e : map.Validate()) errors.push_back("pf.map." + e);
+  return errors;
+}
+
+}  // namespace slamrig::slam

@@ -1,0 +1,71 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "slam/grid/occupancy_grid.h"
+#include "slam/matching/likelihood_field.h"
+#include "slam/matching/map_correlator.h"
+#include "slam/matching/scan_points.h"
+#include "slam/odometry/rot_trans_rot_model.h"
+#include "slam/pf/resampling.h"
+
+namespace slamrig::slam {
+
+/// How each particle's motion is perturbed in the prediction step.
+enum class MotionNoiseModel {
+  /// Odometry increment plus zero-mean Gaussian noise on x, y and yaw with fixed standard
+  /// deviations per scan step (the w terms of Wang's Eq. 6).
+  kGaussianPerStep,
+  /// Rotation-translation-rotation with alpha noise (Probabilistic Robotics, Table 5.6): the
+  /// spread grows with the motion, so one setting fits 40 Hz logs and 0.5 m CARMEN steps alike.
+  kRotTransRot,
+};
+
+/// How a particle's scan is scored against the map.
+enum class ObservationModel {
+  kMapCorrelation,   ///< the reports' correlation with the thresholded map (Wang, Eq. 7)
+  kLikelihoodField,  ///< sum of likelihood-field log-likelihoods (Probabilistic Robotics, 6.4)
+};
+
+/// Everything the particle filter can be told. Defaults are the improved filter;
+/// `ReportsPreset()` reproduces the ECE276A reports.
+struct ParticleFilterOptions {
+  int num_particles = 100;
+  std::uint64_t seed = 1;  ///< one RNG stream for prediction and resampling
+
+  MotionNoiseModel motion_noise = MotionNoiseModel::kRotTransRot;
+  double sigma_xy_m = 0.01;      ///< kGaussianPerStep: per step, x and y (world frame)
+  double sigma_yaw_rad = 0.005;  ///< kGaussianPerStep: per step, yaw
+  RotTransRotNoise rot_trans_rot{0.02, 0.002, 0.01, 0.0005, 0.005, 0.003};  ///< kRotTransRot
+
+  ObservationModel observation = ObservationModel::kMapCorrelation;
+  ScanPointsOptions points{0.1, 30.0, 1, 0.05};  ///< beams used for weighting (voxel-filtered)
+  MapCorrelatorOptions correlation{4, 2, 0.01, CorrelationValue::kOccupiedIndicator, 0.0f};
+  LikelihoodFieldOptions likelihood_field;
+  /// log-weight += observation_scale * score (the softmax temperature; 1 in the reports).
+  double observation_scale = 1.0;
+  /// Move each particle to its best shift (the reports' "future work"); false: only weight it.
+  bool move_to_best_shift = true;
+
+  ResamplingScheme resampling = ResamplingScheme::kSystematic;
+  /// Resample when Neff = 1 / sum(w^2) < resample_neff_ratio * num_particles (reports: 0.5).
+  double resample_neff_ratio = 0.5;
+
+  OccupancyGridOptions map;  ///< the map built from the best particle
+
+  int num_threads = 1;  ///< worker threads for the per-particle scoring (results do not depend on it)
+  /// Record the particle cloud every n scans (0: never).
+  int cloud_every_n_scans = 0;
+
+  /// The ECE276A reports' method: Gaussian prediction noise, all beams, 9x9 x/y shifts, no yaw
+  /// shift, softmax of correlations, stratified resampling at Neff < N/2, particles not moved,
+  /// per-beam map updates with +log 4 / -log 4 / clamps.
+  static ParticleFilterOptions ReportsPreset();
+
+  /// One message per broken rule, e.g. "pf.num_particles = 0; must be > 0".
+  std::vector<std::string> Validate() const;
+};
+
+}  // namespace slamrig::slam

@@ -1,0 +1,133 @@
+#include "slam/pf/particle_filter.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "slam/odometry/scan_sync.h"
+#include "slam/pf/slam_run.h"
+#include "slam/pf/testing/synthetic_run.h"
+
+namespace slamrig::slam {
+namespace {
+
+// A short, fast run: one leg and a corner of the office loop, a 181-beam lidar.
+struct ShortRun {
+  testing::SyntheticRun run;
+  std::vector<SyncedScan> scans;
+};
+
+const ShortRun& GetShortRun() {
+  static const ShortRun* run = [] {
+    auto* r = new ShortRun;
+    testing::SyntheticRunOptions options;
+    options.waypoints = testing::OfficeLoop();
+    options.max_duration_s = 50.0;
+    options.scan_rate_hz = 10.0;
+    options.lidar.num_beams = 271;
+    options.lidar.angle_increment_rad = 1.0 * 3.14159265358979 / 180.0;
+    options.right_scale_error = 0.03;
+    options.left_scale_error = -0.03;
+    options.gyro_bias_rad_s = 0.01;
+    r->run = testing::MakeSyntheticRun(testing::SegmentWorld::Office(), options);
+    r->scans = SyncToScans(r->run.records, ScanSyncOptions{}).scans;
+    return r;
+  }();
+  return *run;
+}
+
+// Position RMSE against the truth, with the estimate anchored at the first true pose.
+double PositionRmse(const Trajectory& estimate, const std::vector<GroundTruthPose>& truth) {
+  const Pose2 anchor = truth.front().map_from_base;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < estimate.size(); ++i) {
+    const Pose2 e = anchor * estimate[i].pose;
+    sum += (e.translation() - truth[i].map_from_base.translation()).squaredNorm();
+  }
+  return std::sqrt(sum / static_cast<double>(estimate.size()));
+}
+
+ParticleFilterOptions FastOptions() {
+  ParticleFilterOptions options;
+  options.num_particles = 30;
+  options.seed = 17;
+  return options;
+}
+
+TEST(ParticleFilterTest, BeatsDeadReckoningOnASyntheticOfficeRun) {
+  const ShortRun& run = GetShortRun();
+  ASSERT_EQ(run.scans.size(), run.run.truth.size());
+  const double dr = PositionRmse(RunDeadReckoning(run.scans, OccupancyGridOptions{}).trajectory, run.run.truth);
+  const SlamRunResult pf = RunParticleFilter(run.scans, FastOptions());
+  const double pf_rmse = PositionRmse(pf.trajectory, run.run.truth);
+  RecordProperty("dead_reckoning_rmse_m", std::to_string(dr));
+  RecordProperty("pf_rmse_m", std::to_string(pf_rmse));
+  EXPECT_GT(dr, 0.3);
+  EXPECT_LT(pf_rmse, 0.1) << "dead reckoning " << dr;
+  EXPECT_LT(pf_rmse, 0.5 * dr);
+  EXPECT_LT(PositionRmse(pf.mean_trajectory, run.run.truth), 0.1);
+}
+
+TEST(ParticleFilterTest, ReportsPresetRunsAndTracks) {
+  const ShortRun& run = GetShortRun();
+  ParticleFilterOptions options = ParticleFilterOptions::ReportsPreset();
+  options.num_particles = 30;
+  const SlamRunResult pf = RunParticleFilter(run.scans, options);
+  EXPECT_LT(PositionRmse(pf.trajectory, run.run.truth), 0.3);
+}
+
+TEST(ParticleFilterTest, LikelihoodFieldModelTracks) {
+  const ShortRun& run = GetShortRun();
+  ParticleFilterOptions options = FastOptions();
+  options.observation = ObservationModel::kLikelihoodField;
+  options.correlation.value = CorrelationValue::kRawValue;
+  options.observation_scale = 0.1;
+  const SlamRunResult pf = RunParticleFilter(run.scans, options);
+  EXPECT_LT(PositionRmse(pf.trajectory, run.run.truth), 0.1);
+}
+
+TEST(ParticleFilterTest, SameSeedSameTrajectoryWhateverTheThreadCount) {
+  const ShortRun& run = GetShortRun();
+  std::vector<SyncedScan> scans(run.scans.begin(), run.scans.begin() + 150);
+  ParticleFilterOptions options = FastOptions();
+  options.cloud_every_n_scans = 50;
+  const SlamRunResult a = RunParticleFilter(scans, options);
+  const SlamRunResult b = RunParticleFilter(scans, options);
+  options.num_threads = 3;
+  const SlamRunResult c = RunParticleFilter(scans, options);
+  ASSERT_EQ(a.trajectory.size(), scans.size());
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    ASSERT_EQ(a.trajectory[i].pose, b.trajectory[i].pose) << i;
+    ASSERT_EQ(a.trajectory[i].pose, c.trajectory[i].pose) << i;
+    ASSERT_EQ(a.mean_trajectory[i].pose, c.mean_trajectory[i].pose) << i;
+  }
+  EXPECT_EQ(a.map.log_odds(), c.map.log_odds());
+  ASSERT_EQ(a.clouds.size(), 3u);
+  EXPECT_EQ(a.clouds[1].particles.size(), 30u);
+  options.seed = 18;
+  options.num_threads = 1;
+  const SlamRunResult d = RunParticleFilter(scans, options);
+  EXPECT_NE(a.trajectory.poses().back().pose, d.trajectory.poses().back().pose);
+}
+
+TEST(ParticleFilterTest, ValidateNamesFieldValueAndRule) {
+  ParticleFilterOptions options;
+  options.num_particles = 0;
+  options.correlation.xy_half_width_cells = 20;
+  EXPECT_THAT(options.Validate(),
+              ::testing::ElementsAre("pf.num_particles = 0; must be > 0",
+                                     "pf.correlation.xy_half_width_cells = 20; must be in [0, 15]"));
+  EXPECT_TRUE(ParticleFilterOptions{}.Validate().empty());
+  EXPECT_TRUE(ParticleFilterOptions::ReportsPreset().Validate().empty());
+}
+
+TEST(ParticleFilterTest, WeightedMeanAveragesYawOnTheCircle) {
+  const std::vector<Particle> particles = {{Pose2(0, 0, 3.1), 0.5}, {Pose2(2, 0, -3.1), 0.5}};
+  const Pose2 mean = WeightedMeanPose(particles);
+  EXPECT_NEAR(mean.x(), 1.0, 1e-12);
+  EXPECT_NEAR(std::abs(mean.theta()), 3.14159265358979, 1e-9);
+}
+
+}  // namespace
+}  // namespace slamrig::slam

@@ -1,0 +1,46 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "slam/matching/testing/segment_world.h"
+#include "slam/odometry/wheel_odometry.h"
+#include "slam/types/records.h"
+
+namespace slamrig::slam::testing {
+
+/// A differential-drive robot driving laps of a closed waypoint loop through a SegmentWorld,
+/// with ECE276A-like sensors: encoders and lidar at 40 Hz, gyro at 100 Hz.
+struct SyntheticRunOptions {
+  std::vector<Eigen::Vector2d> waypoints;  ///< closed loop, driven in order, starting at [0]
+  int laps = 1;
+  double max_duration_s = 1e9;             ///< stop early after this long
+  double speed_m_s = 0.5;
+  double scan_rate_hz = 40.0;
+  double encoder_rate_hz = 40.0;
+  double imu_rate_hz = 100.0;
+  RangeFinderSpec lidar;
+  DiffDriveParams robot;
+  double right_scale_error = 0.01;   ///< systematic wheel-distance error (calibration), relative
+  double left_scale_error = -0.01;
+  double wheel_noise = 0.02;         ///< random relative error per encoder interval
+  double gyro_sigma_rad_s = 0.01;
+  double gyro_bias_rad_s = 0.002;
+  std::uint64_t seed = 1;
+};
+
+/// The records in time order and the true poses at every scan.
+struct SyntheticRun {
+  std::vector<Record> records;
+  std::vector<GroundTruthPose> truth;
+  int num_scans = 0;
+};
+
+/// Simulates the run at 1 kHz (kinematic, no dynamics) and samples the sensors.
+SyntheticRun MakeSyntheticRun(const SegmentWorld& world, const SyntheticRunOptions& options);
+
+/// The corridor loop of SegmentWorld::Office(), 52 m per lap.
+std::vector<Eigen::Vector2d> OfficeLoop();
+
+}  // namespace slamrig::slam::testing

@@ -1,0 +1,42 @@
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace slamrig::slam {
+
+/// A fixed set of worker threads for data-parallel loops. `ParallelFor` splits [0, n) into one
+/// contiguous block per thread (the caller runs the first) and returns when all are done. Which
+/// thread runs which index never changes a result as long as iterations are independent.
+class ThreadPool {
+ public:
+  /// `num_threads` >= 1 counts the calling thread; 1 runs everything inline.
+  explicit ThreadPool(int num_threads);
+  ~ThreadPool();
+  ThreadPool(const ThreadPool&) = delete;
+  ThreadPool& operator=(const ThreadPool&) = delete;
+
+  int num_threads() const { return static_cast<int>(workers_.size()) + 1; }
+
+  /// Calls `body(begin, end)` on disjoint blocks covering [0, n).
+  void ParallelFor(int n, const std::function<void(int begin, int end)>& body);
+
+ private:
+  void WorkerLoop(int worker_index);
+
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable start_;
+  std::condition_variable done_;
+  const std::function<void(int, int)>* body_ = nullptr;
+  int n_ = 0;
+  std::uint64_t generation_ = 0;
+  int pending_ = 0;
+  bool stop_ = false;
+};
+
+}  // namespace slamrig::slam
