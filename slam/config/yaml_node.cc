@@ -130,6 +130,68 @@ template float YamlNode::As<float>() const;
 template double YamlNode::As<double>() const;
 template std::string YamlNode::As<std::string>() const;
 
+void YamlNode::Override(const std::string& key_path, const std::string& value) {
+  const std::string where = usage_->file + ": override " + key_path + "=" + value + ": ";
+  // Split "a.b[2].c" into steps: names and indices.
+  struct Step {
+    std::string key;
+    long index = -1;
+  };
+  std::vector<Step> steps;
+  std::string token;
+  for (std::size_t i = 0; i <= key_path.size(); ++i) {
+    const char c = i < key_path.size() ? key_path[i] : '.';
+    if (c == '.' || c == '[') {
+      if (!token.empty()) steps.push_back({token, -1});
+      token.clear();
+      if (c == '[') {
+        const std::size_t close = key_path.find(']', i);
+        if (close == std::string::npos) throw ConfigError(where + "unclosed '['");
+        try {
+          steps.push_back({"", std::stol(key_path.substr(i + 1, close - i - 1))});
+        } catch (const std::exception&) {
+          throw ConfigError(where + "bad index");
+        }
+        i = close;
+      }
+    } else {
+      token += c;
+    }
+  }
+  if (steps.empty()) throw ConfigError(where + "empty key");
+  YAML::Node parsed;
+  try {
+    parsed = YAML::Load(value);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(where + "value is not valid YAML: " + e.msg);
+  }
+  // Walk with copies of YAML::Node handles; they refer to the same underlying tree.
+  YAML::Node node = node_;
+  for (std::size_t s = 0; s < steps.size(); ++s) {
+    const bool last = s + 1 == steps.size();
+    if (steps[s].index >= 0) {
+      if (!node.IsSequence() || static_cast<std::size_t>(steps[s].index) >= node.size()) {
+        throw ConfigError(where + "no list element [" + std::to_string(steps[s].index) + "]");
+      }
+      if (last) {
+        node[static_cast<std::size_t>(steps[s].index)] = parsed;
+        return;
+      }
+      node.reset(node[static_cast<std::size_t>(steps[s].index)]);
+      continue;
+    }
+    if (!node.IsMap() && !node.IsNull()) {
+      throw ConfigError(where + "'" + steps[s].key + "' is below a value that is not a map");
+    }
+    if (last) {
+      node[steps[s].key] = parsed;
+      return;
+    }
+    if (!node[steps[s].key]) node[steps[s].key] = YAML::Node(YAML::NodeType::Map);
+    node.reset(node[steps[s].key]);
+  }
+}
+
 void YamlNode::CheckAllKeysUsed() const { CheckUsedRecursive(node_, path_); }
 
 void YamlNode::CheckUsedRecursive(const YAML::Node& node, const std::string& path) const {

@@ -56,6 +56,11 @@ class YamlNode {
     return Required(key).As<T>();
   }
 
+  /// Sets the value at dotted `key_path` (`slam.pf.num_particles`, `drive.waypoints[2]`) to the
+  /// YAML text `value`, creating missing map keys: command-line overrides of a file. A path
+  /// through a scalar, or an index past a list's end, is a ConfigError naming the path.
+  void Override(const std::string& key_path, const std::string& value);
+
   /// Throws a ConfigError for the first map key, anywhere below this node, that was never read.
   void CheckAllKeysUsed() const;
 

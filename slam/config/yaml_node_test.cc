@@ -62,5 +62,19 @@ TEST(YamlNodeTest, RejectsNonFiniteNumbersAndFractionalIntegers) {
   EXPECT_THAT(ErrorOf([&] { root.Get<int>("b"); }), HasSubstr("expected an integer"));
 }
 
+TEST(YamlNodeTest, OverridesSetNestedKeysAndListElements) {
+  auto root = YamlNode::LoadString("slam:\n  pf: {num_particles: 30}\nlist: [1, 2, 3]\nx: 1\n", "o.yaml");
+  root.Override("slam.pf.num_particles", "100");
+  root.Override("slam.pf.new_key", "true");
+  root.Override("list[1]", "20");
+  root.Override("brand.new.path", "[1, 2]");
+  EXPECT_EQ(root.Required("slam").Required("pf").Get<int>("num_particles"), 100);
+  EXPECT_TRUE(root.Required("slam").Required("pf").Get<bool>("new_key"));
+  EXPECT_EQ(root.Required("list").Elements()[1].As<int>(), 20);
+  EXPECT_EQ(root.Required("brand").Required("new").Required("path").Elements().size(), 2u);
+  EXPECT_THAT(ErrorOf([&] { root.Override("x.y", "1"); }), HasSubstr("not a map"));
+  EXPECT_THAT(ErrorOf([&] { root.Override("list[7]", "1"); }), HasSubstr("no list element [7]"));
+}
+
 }  // namespace
 }  // namespace slamrig
