@@ -1,0 +1,400 @@
+#include "scenarios/sweep_runner.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "scenarios/plot.h"
+#include "slam/io/atomic_file.h"
+#include "slam/types/error.h"
+
+namespace slamrig::scenario {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (const char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+std::string JoinCsv(const std::vector<std::string>& fields) {
+  std::string line;
+  for (std::size_t i = 0; i < fields.size(); ++i) line += (i ? "," : "") + CsvField(fields[i]);
+  return line;
+}
+
+std::vector<std::string> SplitCsv(const std::string& line) {
+  std::vector<std::string> fields(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        fields.back() += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        fields.back() += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      fields.emplace_back();
+    } else {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
+std::string FormatValue(double v) {
+  if (!std::isfinite(v)) return "";
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.9g", v);
+  return buffer;
+}
+
+// Every "config.metric" number in a run's metrics.json (YAML reads JSON).
+std::map<std::string, double> ReadRunMetrics(const std::string& path, std::string* passed) {
+  std::map<std::string, double> metrics;
+  const YAML::Node root = YAML::LoadFile(path);
+  if (root["passed"]) *passed = root["passed"].as<bool>() ? "pass" : "fail";
+  for (const auto& config : root["configs"]) {
+    for (const auto& metric : config.second) {
+      if (!metric.second.IsScalar()) continue;
+      try {
+        metrics[config.first.as<std::string>() + "." + metric.first.as<std::string>()] =
+            metric.second.as<double>();
+      } catch (const YAML::Exception&) {
+        // Not a number (a name or a flag): not a metric.
+      }
+    }
+  }
+  return metrics;
+}
+
+std::string Duration(double seconds) {
+  const int s = static_cast<int>(std::lround(seconds));
+  char buffer[32];
+  if (s >= 3600) {
+    std::snprintf(buffer, sizeof(buffer), "%d:%02d:%02d", s / 3600, s / 60 % 60, s % 60);
+  } else {
+    std::snprintf(buffer, sizeof(buffer), "%d:%02d", s / 60, s % 60);
+  }
+  return buffer;
+}
+
+// Appends one line with a single write() and makes it durable before the next run starts.
+void AppendLine(int fd, const std::string& line, const std::string& path) {
+  const std::string text = line + "\n";
+  if (::write(fd, text.data(), text.size()) != static_cast<ssize_t>(text.size()) ||
+      ::fsync(fd) != 0) {
+    throw std::runtime_error(path + ": cannot append: " + std::strerror(errno));
+  }
+}
+
+struct Child {
+  std::size_t run;
+  Clock::time_point start;
+};
+
+}  // namespace
+
+std::vector<std::string> ResultsHeader(const SweepSpec& spec,
+                                       const std::vector<std::string>& metrics) {
+  std::vector<std::string> header = {"run"};
+  for (const auto& p : spec.parameters) header.push_back(p.key);
+  header.push_back("seed");
+  header.push_back("status");
+  for (const auto& m : metrics) header.push_back(m);
+  header.push_back("wall_time_s");
+  return header;
+}
+
+SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) {
+  namespace fs = std::filesystem;
+  const std::vector<SweepRun> runs = ExpandSweep(spec);
+  SweepSummary summary;
+  summary.total = static_cast<int>(runs.size());
+  fs::create_directories(fs::path(options.out_dir) / "runs");
+  const std::string csv_path = (fs::path(options.out_dir) / "results.csv").string();
+
+  // Without a metrics list the header is fixed by the first run's metrics.json; a resumed sweep
+  // takes it from the file.
+  std::vector<std::string> metrics = spec.metrics;
+  std::set<std::string> done;
+  std::vector<std::string> header;
+  if (fs::exists(csv_path)) {
+    // Keep complete lines only: a sweep killed mid-write leaves at most a partial last line.
+    std::ifstream in(csv_path, std::ios::binary);
+    std::string contents((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::size_t keep =
+        contents.rfind('\n') == std::string::npos ? 0 : contents.rfind('\n') + 1;
+    if (keep != contents.size()) fs::resize_file(csv_path, keep);
+    std::istringstream lines(contents.substr(0, keep));
+    std::string line;
+    if (std::getline(lines, line)) {
+      header = SplitCsv(line);
+      const std::size_t fixed = spec.parameters.size() + 3;  // run, params, seed, status
+      const std::vector<std::string> expected_start = ResultsHeader(spec, {});
+      if (header.size() < fixed + 1 ||
+          !std::equal(expected_start.begin(), expected_start.begin() + static_cast<long>(fixed),
+                      header.begin())) {
+        throw ConfigError(csv_path +
+                          ": written by a different sweep (header differs); use another --out");
+      }
+      metrics.assign(header.begin() + static_cast<long>(fixed), header.end() - 1);
+      while (std::getline(lines, line)) {
+        if (!line.empty()) done.insert(SplitCsv(line)[0]);
+      }
+    }
+  }
+  std::vector<std::size_t> todo;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    if (done.count(runs[i].id)) {
+      ++summary.already_done;
+    } else {
+      todo.push_back(i);
+    }
+  }
+  const int fd = ::open(csv_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  if (fd < 0) throw std::runtime_error(csv_path + ": cannot open: " + std::strerror(errno));
+  bool header_written = !header.empty();
+  if (header_written && header != ResultsHeader(spec, metrics)) {
+    ::close(fd);
+    throw ConfigError(csv_path +
+                      ": written by a different sweep (metrics differ); use another --out");
+  }
+
+  const int jobs = options.jobs > 0
+                       ? options.jobs
+                       : std::max(1, static_cast<int>(::sysconf(_SC_NPROCESSORS_ONLN)));
+  std::map<pid_t, Child> running;
+  std::size_t next = 0;
+  int finished_now = 0;
+  const Clock::time_point sweep_start = Clock::now();
+  const bool tty = ::isatty(STDERR_FILENO) != 0;
+  auto report = [&] {
+    if (!options.progress) return;
+    const int finished = summary.already_done + finished_now;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - sweep_start).count();
+    const int remaining = summary.total - finished;
+    std::string eta = "--:--";
+    if (finished_now > 0) eta = Duration(elapsed / finished_now * remaining);
+    constexpr int kWidth = 30;
+    const int filled = summary.total > 0 ? kWidth * finished / summary.total : kWidth;
+    const std::string bar = std::string(filled, '#') + std::string(kWidth - filled, '-');
+    std::fprintf(stderr, "%s[%s] %d/%d runs, %zu running, %d failed, elapsed %s, ETA %s%s",
+                 tty ? "\r" : "", bar.c_str(), finished, summary.total, running.size(),
+                 summary.failed, Duration(elapsed).c_str(), eta.c_str(), tty ? "  " : "\n");
+    std::fflush(stderr);
+  };
+
+  auto start_run = [&](std::size_t index) {
+    const SweepRun& run = runs[index];
+    char name[16];
+    std::snprintf(name, sizeof(name), "%04zu", index);
+    const std::string dir = (fs::path(options.out_dir) / "runs" / name).string();
+    fs::create_directories(dir);
+    fs::remove(fs::path(dir) / "metrics.json");
+    std::vector<std::string> args = {
+        options.slamrig_binary,   "run",    spec.scenario_path, "--out", dir, "--seed",
+        std::to_string(run.seed), "--quiet"};
+    for (std::size_t p = 0; p < spec.parameters.size(); ++p) {
+      args.push_back("--set");
+      args.push_back(spec.parameters[p].key + "=" + spec.parameters[p].values[run.value_index[p]]);
+    }
+    const std::string log_path = dir + "/log.txt";
+    const pid_t pid = ::fork();
+    if (pid < 0) throw std::runtime_error(std::string("fork failed: ") + std::strerror(errno));
+    if (pid == 0) {
+      // A child never outlives a killed sweep: it would finish a run nobody records.
+      ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+      const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (log >= 0) {
+        ::dup2(log, STDOUT_FILENO);
+        ::dup2(log, STDERR_FILENO);
+      }
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      ::execv(argv[0], argv.data());
+      std::perror("execv");
+      ::_exit(127);
+    }
+    running[pid] = {index, Clock::now()};
+  };
+
+  report();
+  while (next < todo.size() || !running.empty()) {
+    while (next < todo.size() && static_cast<int>(running.size()) < jobs) start_run(todo[next++]);
+    int status = 0;
+    const pid_t pid = ::waitpid(-1, &status, 0);
+    if (pid < 0) {
+      if (errno == EINTR) continue;
+      break;
+    }
+    const auto it = running.find(pid);
+    if (it == running.end()) continue;
+    const Child child = it->second;
+    running.erase(it);
+    const SweepRun& run = runs[child.run];
+    const double wall = std::chrono::duration<double>(Clock::now() - child.start).count();
+    char name[16];
+    std::snprintf(name, sizeof(name), "%04zu", child.run);
+    const std::string metrics_path =
+        (fs::path(options.out_dir) / "runs" / name / "metrics.json").string();
+    std::string state = "error";
+    std::map<std::string, double> values;
+    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    if ((code == 0 || code == 3) && fs::exists(metrics_path)) {
+      try {
+        values = ReadRunMetrics(metrics_path, &state);
+      } catch (const std::exception&) {
+        state = "error";
+      }
+    }
+    if (state != "pass") ++summary.failed;
+    if (!header_written) {
+      if (metrics.empty()) {
+        for (const auto& [key, value] : values) metrics.push_back(key);
+      }
+      AppendLine(fd, JoinCsv(ResultsHeader(spec, metrics)), csv_path);
+      header_written = true;
+    }
+    std::vector<std::string> row = {run.id};
+    for (std::size_t p = 0; p < spec.parameters.size(); ++p) {
+      row.push_back(spec.parameters[p].values[run.value_index[p]]);
+    }
+    row.push_back(std::to_string(run.seed));
+    row.push_back(state);
+    for (const auto& m : metrics) {
+      const auto v = values.find(m);
+      row.push_back(v == values.end() ? "" : FormatValue(v->second));
+    }
+    row.push_back(FormatValue(wall));
+    AppendLine(fd, JoinCsv(row), csv_path);
+    ++finished_now;
+    ++summary.ran;
+    report();
+  }
+  ::close(fd);
+  if (options.progress && tty) std::fputc('\n', stderr);
+  WriteSweepSummary(spec, options.out_dir);
+  return summary;
+}
+
+int WriteSweepSummary(const SweepSpec& spec, const std::string& out_dir) {
+  namespace fs = std::filesystem;
+  std::ifstream in(fs::path(out_dir) / "results.csv");
+  std::string line;
+  if (!std::getline(in, line)) return 0;
+  const std::vector<std::string> header = SplitCsv(line);
+  std::vector<std::vector<std::string>> rows;
+  while (std::getline(in, line)) {
+    if (!line.empty()) rows.push_back(SplitCsv(line));
+  }
+  const std::size_t num_params = spec.parameters.size();
+  const std::size_t first_metric = num_params + 3;
+  auto number = [](const std::string& s) {
+    if (s.empty()) return std::nan("");
+    try {
+      std::size_t used = 0;
+      const double v = std::stod(s, &used);
+      return used == s.size() ? v : std::nan("");
+    } catch (const std::exception&) {
+      return std::nan("");
+    }
+  };
+
+  std::string html =
+      "<!doctype html><html><head><meta charset=\"utf-8\"><title>sweep summary</title>"
+      "<style>body{font-family:sans-serif;margin:2em}img{max-width:100%;border:1px solid #ddd}"
+      "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:4px "
+      "8px}</style></head><body>"
+      "<h1>Sweep summary</h1><p>Scenario: " +
+      spec.scenario_path + "; " + std::to_string(rows.size()) +
+      " runs in results.csv; each point is the mean over seeds, bars the min-max spread.</p>";
+  int plots = 0;
+  for (std::size_t m = first_metric; m + 1 < header.size(); ++m) {
+    for (std::size_t p = 0; p < num_params; ++p) {
+      const SweepParameter& param = spec.parameters[p];
+      // x positions: the values themselves when numeric, else their index.
+      std::vector<double> xs;
+      bool numeric = true;
+      for (const auto& v : param.values) {
+        xs.push_back(number(v));
+        numeric = numeric && std::isfinite(xs.back());
+      }
+      if (!numeric) {
+        for (std::size_t i = 0; i < xs.size(); ++i) xs[i] = static_cast<double>(i);
+      }
+      // One series per combination of the other parameters.
+      std::map<std::string, std::map<std::size_t, std::vector<double>>> series;
+      for (const auto& row : rows) {
+        if (row.size() != header.size()) continue;
+        std::string others;
+        for (std::size_t q = 0; q < num_params; ++q) {
+          if (q != p)
+            others += (others.empty() ? "" : ", ") + spec.parameters[q].key + "=" + row[1 + q];
+        }
+        const auto value = std::find(param.values.begin(), param.values.end(), row[1 + p]);
+        if (value == param.values.end()) continue;
+        const double v = number(row[m]);
+        if (std::isfinite(v)) {
+          series[others][static_cast<std::size_t>(value - param.values.begin())].push_back(v);
+        }
+      }
+      if (series.empty()) continue;
+      std::vector<PlotSeries> plot;
+      for (const auto& [label, by_value] : series) {
+        PlotSeries s;
+        s.label = label;
+        s.colour = PaletteColour(plot.size());
+        s.markers = true;
+        for (const auto& [index, samples] : by_value) {
+          double sum = 0, lo = samples.front(), hi = samples.front();
+          for (const double v : samples) sum += v, lo = std::min(lo, v), hi = std::max(hi, v);
+          s.x.push_back(xs[index]);
+          s.y.push_back(sum / static_cast<double>(samples.size()));
+          s.y_low.push_back(lo);
+          s.y_high.push_back(hi);
+        }
+        plot.push_back(std::move(s));
+      }
+      PlotOptions options;
+      options.title = header[m] + " vs " + param.key;
+      options.x_label = param.key + (numeric ? "" : " (index of value)");
+      options.y_label = header[m];
+      const std::string file = "summary_" + header[m] + "__" + param.key + ".png";
+      slam::WriteFileAtomically((fs::path(out_dir) / file).string(),
+                                RenderLinePlotPng(plot, options));
+      html += "<h2>" + options.title + "</h2><img src=\"" + file + "\">";
+      ++plots;
+    }
+  }
+  html += "</body></html>\n";
+  slam::WriteFileAtomically((fs::path(out_dir) / "summary.html").string(), html);
+  return plots;
+}
+
+}  // namespace slamrig::scenario

@@ -1,0 +1,43 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "scenarios/sweep_spec.h"
+
+namespace slamrig::scenario {
+
+/// How to execute a sweep.
+struct SweepRunnerOptions {
+  std::string out_dir;         ///< results.csv, runs/<n>/ and the summary plots go here
+  std::string slamrig_binary;  ///< the program that runs one scenario (`slamrig run ...`)
+  int jobs = 0;                ///< parallel runs; 0: one per core
+  bool progress = true;        ///< progress bar with count and ETA on stderr
+};
+
+/// What a sweep did.
+struct SweepSummary {
+  int total = 0;         ///< runs in the grid
+  int already_done = 0;  ///< found in results.csv from an earlier, interrupted sweep
+  int ran = 0;           ///< run now
+  int failed = 0;        ///< runs (now or before) whose expectations failed or that errored
+};
+
+/// Runs every run of the grid that results.csv does not already hold, `jobs` at a time, each as
+/// a child process `slamrig run SCENARIO --out runs/<n> --seed S --set key=value ... --quiet`,
+/// appending one CSV row per finished run at once (a single write), so a sweep killed at any
+/// moment resumes with no run lost or run twice. A results.csv written for another grid is an
+/// error, never mixed. At the end writes one summary plot per metric and parameter
+/// (summary_<metric>__<parameter>.png: the mean over seeds with the min-max spread) and
+/// summary.html.
+SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options);
+
+/// Reads `out_dir`/results.csv and writes the summary plots and summary.html. Returns the
+/// number of plots written.
+int WriteSweepSummary(const SweepSpec& spec, const std::string& out_dir);
+
+/// The CSV header of `spec`'s results file.
+std::vector<std::string> ResultsHeader(const SweepSpec& spec,
+                                       const std::vector<std::string>& metrics);
+
+}  // namespace slamrig::scenario

@@ -1,0 +1,130 @@
+#include "scenarios/sweep_runner.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <fstream>
+#include <set>
+
+#include "slam/types/error.h"
+#include "tests/util/temp_dir.h"
+
+namespace slamrig::scenario {
+namespace {
+
+// A stand-in for `slamrig run`: writes a metrics.json whose value depends on the seed and the
+// swept values only, like a deterministic run.
+constexpr const char* kFakeRunner = R"(#!/bin/sh
+out=""; seed=0; sum=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --out) out="$2"; shift 2;;
+    --seed) seed="$2"; shift 2;;
+    --set) v="${2#*=}"; sum="$sum+$v"; shift 2;;
+    *) shift;;
+  esac
+done
+value=$(awk "BEGIN { print $sum + $seed / 100 }")
+printf '{"passed": true, "configs": {"pf": {"ate_rmse_m": %s, "name": "pf"}}}\n' "$value" > "$out/metrics.json"
+)";
+
+struct Fixture {
+  testing::TempDir dir;
+  SweepSpec spec;
+  SweepRunnerOptions options;
+  Fixture() {
+    const std::string runner = dir.Write("fake_runner.sh", kFakeRunner);
+    ::chmod(runner.c_str(), 0755);
+    dir.Write("scenario.yaml", "name: x\n");
+    spec = LoadSweepSpec(dir.Write("sweep.yaml",
+                                   "scenario: scenario.yaml\nseeds: 3\nparameters:\n"
+                                   "  a.noise: [1, 2]\n  b.count: [10, 20, 30]\n"));
+    options.out_dir = dir.File("out");
+    options.slamrig_binary = runner;
+    options.jobs = 2;
+    options.progress = false;
+  }
+  std::vector<std::string> Lines() const {
+    std::ifstream in(dir.File("out/results.csv"));
+    std::vector<std::string> lines;
+    for (std::string l; std::getline(in, l);) lines.push_back(l);
+    return lines;
+  }
+};
+
+// A row without its wall-time column, the one field allowed to differ between runs.
+std::string WithoutWallTime(const std::string& row) { return row.substr(0, row.rfind(',')); }
+
+TEST(SweepTest, ExpandsTheGridTimesSeedsInAFixedOrder) {
+  Fixture f;
+  const auto runs = ExpandSweep(f.spec);
+  ASSERT_EQ(runs.size(), 18u);
+  EXPECT_EQ(runs.front().id, "a.noise=1 b.count=10 seed=1");
+  EXPECT_EQ(runs[3].id, "a.noise=1 b.count=20 seed=1");
+  EXPECT_EQ(runs.back().id, "a.noise=2 b.count=30 seed=3");
+  std::set<std::string> ids;
+  for (const auto& r : runs) ids.insert(r.id);
+  EXPECT_EQ(ids.size(), runs.size());
+}
+
+TEST(SweepTest, RunsEveryRunOnceAndResumesAfterAKill) {
+  Fixture complete;
+  const SweepSummary all = RunSweep(complete.spec, complete.options);
+  EXPECT_EQ(all.ran, 18);
+  EXPECT_EQ(all.failed, 0);
+  std::vector<std::string> expected = complete.Lines();
+  ASSERT_EQ(expected.size(), 19u);
+  EXPECT_EQ(expected[0], "run,a.noise,b.count,seed,status,pf.ate_rmse_m,wall_time_s");
+
+  // A sweep killed after 7 rows, in the middle of writing the 8th.
+  Fixture resumed;
+  std::filesystem::create_directories(resumed.dir.File("out"));
+  {
+    std::ofstream out(resumed.dir.File("out/results.csv"));
+    for (int i = 0; i < 8; ++i) out << expected[i] << "\n";
+    out << expected[8].substr(0, 10);
+  }
+  const SweepSummary second = RunSweep(resumed.spec, resumed.options);
+  EXPECT_EQ(second.already_done, 7);
+  EXPECT_EQ(second.ran, 11);
+  std::vector<std::string> got = resumed.Lines();
+  ASSERT_EQ(got.size(), expected.size());
+  std::multiset<std::string> a, b;
+  for (const auto& l : expected) a.insert(WithoutWallTime(l));
+  for (const auto& l : got) b.insert(WithoutWallTime(l));
+  EXPECT_EQ(a, b);
+  EXPECT_TRUE(std::filesystem::exists(resumed.dir.File("out/summary.html")));
+  EXPECT_TRUE(std::filesystem::exists(resumed.dir.File("out/summary_pf.ate_rmse_m__a.noise.png")));
+}
+
+TEST(SweepTest, RefusesResultsOfAnotherSweep) {
+  Fixture f;
+  std::filesystem::create_directories(f.dir.File("out"));
+  f.dir.Write("out/results.csv", "run,x,seed,status,pf.ate_rmse_m,wall_time_s\n");
+  EXPECT_THROW(RunSweep(f.spec, f.options), ConfigError);
+}
+
+TEST(SweepTest, BadSweepFilesNameFileLineAndKey) {
+  testing::TempDir dir;
+  dir.Write("s.yaml", "name: x\n");
+  auto error = [&](const std::string& text) {
+    try {
+      LoadSweepSpec(dir.Write("sweep.yaml", text));
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_THAT(error("scenario: s.yaml\nseeds: 0\nparameters: {a: [1]}\n"),
+              ::testing::HasSubstr("sweep.yaml:2:8: seeds"));
+  EXPECT_THAT(error("scenario: nope.yaml\nseeds: 2\nparameters: {a: [1]}\n"),
+              ::testing::HasSubstr("does not exist"));
+  EXPECT_THAT(error("scenario: s.yaml\nseeds: 2\nparameters: {a: []}\n"),
+              ::testing::HasSubstr("needs at least one value"));
+  EXPECT_THAT(error("scenario: s.yaml\nseeds: 2\nparameters: {a: [1]}\nseed: 3\n"),
+              ::testing::HasSubstr("sweep.yaml:4:1: seed: unknown key"));
+}
+
+}  // namespace
+}  // namespace slamrig::scenario
