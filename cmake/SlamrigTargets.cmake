@@ -6,6 +6,9 @@ function(slamrig_set_target_options target)
     -Wall -Wextra -Wpedantic -Wconversion -Wshadow -Wno-sign-conversion
     # GCC 12 reports impossible overlaps inside std::string operator+ (GCC bug 105651).
     $<$<CXX_COMPILER_ID:GNU>:-Wno-restrict>
+    # GCC 12 at -O2 flags std::variant copies of records as maybe-uninitialized (false positives,
+    # GCC bugs 80635 and 105593); -Wuninitialized stays on.
+    $<$<CXX_COMPILER_ID:GNU>:-Wno-maybe-uninitialized>
     # Same results whatever the compiler decides about fused multiply-add.
     -ffp-contract=off)
   if(SLAMRIG_SANITIZE)
