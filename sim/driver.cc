@@ -1,0 +1,178 @@
+#include "sim/driver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "sim/messages.h"
+#include "slam/types/check.h"
+
+namespace slamrig::sim {
+
+const char* DriveModeName(DriveMode mode) {
+  switch (mode) {
+    case DriveMode::kIdle:
+      return "idle";
+    case DriveMode::kWaypoints:
+      return "waypoints";
+    case DriveMode::kSchedule:
+      return "schedule";
+  }
+  return "?";
+}
+
+std::vector<std::string> DriveOptions::Validate() const {
+  std::vector<std::string> errors;
+  auto positive = [&errors](const char* name, double value) {
+    if (!(value > 0.0))
+      errors.push_back(std::string(name) + " = " + FormatNumber(value) + "; must be > 0");
+  };
+  if (laps < 1) errors.push_back("laps = " + std::to_string(laps) + "; must be >= 1");
+  if (mode == DriveMode::kWaypoints) {
+    positive("speed_m_s", speed_m_s);
+    positive("lookahead_m", lookahead_m);
+    positive("max_yaw_rate_rad_s", max_yaw_rate_rad_s);
+    positive("max_decel_m_s2", max_decel_m_s2);
+    positive("goal_tolerance_m", goal_tolerance_m);
+    if (waypoints_m.size() < 2) {
+      errors.push_back("waypoints_m has " + std::to_string(waypoints_m.size()) +
+                       " points; pure pursuit needs at least 2");
+    }
+    for (std::size_t i = 0; i + 1 < waypoints_m.size(); ++i) {
+      if ((waypoints_m[i + 1] - waypoints_m[i]).norm() < 1e-3) {
+        errors.push_back("waypoints_m[" + std::to_string(i + 1) + "] repeats the point before it");
+      }
+    }
+    if (!closed && laps != 1) {
+      errors.push_back("laps = " + std::to_string(laps) + "; an open path (closed: false) has 1");
+    }
+  }
+  if (mode == DriveMode::kSchedule) {
+    if (schedule.empty()) errors.push_back("schedule is empty; schedule mode needs segments");
+    for (std::size_t i = 0; i < schedule.size(); ++i) {
+      if (!(schedule[i].duration_s > 0.0)) {
+        errors.push_back("schedule[" + std::to_string(i) + "].duration_s = " +
+                         FormatNumber(schedule[i].duration_s) + "; must be > 0");
+      }
+    }
+  }
+  return errors;
+}
+
+Driver::Driver(const DriveOptions& options) : options_(options) {
+  SLAMRIG_CHECK(options_.Validate().empty(), "invalid DriveOptions");
+  if (options_.mode != DriveMode::kWaypoints) return;
+  path_ = options_.waypoints_m;
+  if (options_.closed) path_.push_back(path_.front());
+  cumulative_m_.assign(path_.size(), 0.0);
+  for (std::size_t i = 1; i < path_.size(); ++i) {
+    cumulative_m_[i] = cumulative_m_[i - 1] + (path_[i] - path_[i - 1]).norm();
+  }
+  lap_length_m_ = cumulative_m_.back();
+  end_m_ = lap_length_m_ * options_.laps;
+}
+
+int Driver::laps_completed() const {
+  if (options_.mode != DriveMode::kWaypoints || lap_length_m_ <= 0.0) return 0;
+  if (finished_) return options_.laps;
+  return static_cast<int>(std::floor(progress_m_ / lap_length_m_));
+}
+
+Eigen::Vector2d Driver::PointAt(double s_m) const {
+  double s = std::clamp(s_m, 0.0, end_m_);
+  if (options_.closed) s = std::fmod(s, lap_length_m_);
+  const auto it = std::upper_bound(cumulative_m_.begin(), cumulative_m_.end(), s);
+  const std::size_t j = std::clamp<std::size_t>(
+      static_cast<std::size_t>(it - cumulative_m_.begin()), 1, path_.size() - 1);
+  const double length = cumulative_m_[j] - cumulative_m_[j - 1];
+  const double f = std::clamp((s - cumulative_m_[j - 1]) / length, 0.0, 1.0);
+  return path_[j - 1] + f * (path_[j] - path_[j - 1]);
+}
+
+VelocityCommand Driver::Update(Time time, const Pose2& map_from_base) {
+  if (finished_) return {};
+  switch (options_.mode) {
+    case DriveMode::kIdle:
+      return {};
+    case DriveMode::kWaypoints:
+      return FollowPath(map_from_base);
+    case DriveMode::kSchedule:
+      return FollowSchedule(time);
+  }
+  return {};
+}
+
+VelocityCommand Driver::FollowSchedule(Time time) {
+  if (!started_) {
+    started_ = true;
+    start_time_ = time;
+  }
+  double elapsed = SecondsBetween(time, start_time_);
+  for (int lap = 0; lap < options_.laps; ++lap) {
+    for (const auto& segment : options_.schedule) {
+      if (elapsed < segment.duration_s) return {segment.v_m_s, segment.omega_rad_s};
+      elapsed -= segment.duration_s;
+    }
+  }
+  finished_ = true;
+  return {};
+}
+
+VelocityCommand Driver::FollowPath(const Pose2& map_from_base) {
+  const Eigen::Vector2d position = map_from_base.translation();
+  // Project onto the path within a window ahead of the current progress (never behind it by more
+  // than a little, so a loop is not short-cut where the path passes near itself).
+  const double window_lo = std::max(0.0, progress_m_ - 0.25);
+  const double window_hi =
+      std::min(end_m_, progress_m_ + std::max(2.0 * options_.lookahead_m, 1.0));
+  double best_s = progress_m_;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  const int first_lap = static_cast<int>(std::floor(window_lo / lap_length_m_));
+  const int last_lap = std::min(options_.laps - 1, static_cast<int>(window_hi / lap_length_m_));
+  for (int lap = first_lap; lap <= last_lap; ++lap) {
+    const double lap_start = lap * lap_length_m_;
+    for (std::size_t j = 1; j < path_.size(); ++j) {
+      const double s0 = lap_start + cumulative_m_[j - 1];
+      const double s1 = lap_start + cumulative_m_[j];
+      if (s1 < window_lo || s0 > window_hi) continue;
+      const Eigen::Vector2d a = path_[j - 1], ab = path_[j] - path_[j - 1];
+      double f = std::clamp((position - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+      const double s = std::clamp(s0 + f * (s1 - s0), window_lo, window_hi);
+      f = (s - s0) / (s1 - s0);
+      const double d2 = (a + f * ab - position).squaredNorm();
+      if (d2 < best_d2) {
+        best_d2 = d2;
+        best_s = s;
+      }
+    }
+  }
+  progress_m_ = std::max(progress_m_, best_s);
+  const double remaining_m = end_m_ - progress_m_;
+  const Eigen::Vector2d goal = PointAt(end_m_);
+  // Done at the end of the path, or once the end is near and already behind the robot.
+  const Pose2 base_from_map = map_from_base.Inverse();
+  if (remaining_m <= options_.goal_tolerance_m ||
+      (remaining_m < options_.lookahead_m && (base_from_map * goal).x() <= 0.0)) {
+    finished_ = true;
+    progress_m_ = end_m_;
+    return {};
+  }
+
+  // Lookahead point in the robot frame.
+  const Eigen::Vector2d target = PointAt(progress_m_ + options_.lookahead_m);
+  const Eigen::Vector2d local = base_from_map * target;
+  const double dist2 = std::max(local.squaredNorm(), 1e-9);
+  if (local.x() < 0.0 && std::abs(local.y()) < -local.x()) {
+    // Target behind: turn on the spot towards it.
+    return {0.0, std::copysign(0.5 * options_.max_yaw_rate_rad_s, local.y())};
+  }
+  const double curvature = 2.0 * local.y() / dist2;
+  double v = options_.speed_m_s;
+  if (std::abs(curvature) > 1e-9)
+    v = std::min(v, options_.max_yaw_rate_rad_s / std::abs(curvature));
+  const double to_goal_m = std::max(remaining_m, (goal - position).norm());
+  v = std::min(v, std::sqrt(2.0 * options_.max_decel_m_s2 * to_goal_m));
+  return {v, v * curvature};
+}
+
+}  // namespace slamrig::sim

@@ -1,0 +1,22 @@
+#include "sim/messages.h"
+
+#include <charconv>
+
+namespace slamrig::sim {
+
+std::string FormatNumber(double value) {
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  return std::string(buffer, result.ptr);
+}
+
+std::vector<std::string> PrefixErrors(const std::string& prefix, std::vector<std::string> errors) {
+  for (auto& e : errors) e = prefix + "." + e;
+  return errors;
+}
+
+void AppendErrors(std::vector<std::string>* errors, const std::vector<std::string>& more) {
+  errors->insert(errors->end(), more.begin(), more.end());
+}
+
+}  // namespace slamrig::sim

@@ -1,0 +1,17 @@
+#pragma once
+
+#include "slam/types/pose2.h"
+
+namespace slamrig::sim {
+
+/// Where a sensor sits on the robot: base_from_sensor as plain fields (x forward, y left).
+struct MountPose {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double yaw_rad = 0.0;
+
+  /// The same mounting as an SE(2) transform base_from_sensor.
+  Pose2 ToPose2() const { return Pose2(x_m, y_m, yaw_rad); }
+};
+
+}  // namespace slamrig::sim

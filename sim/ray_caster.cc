@@ -1,0 +1,255 @@
+#include "sim/ray_caster.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "slam/types/check.h"
+
+namespace slamrig::sim {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+Eigen::Vector2d ToEigen(const b2Vec2& v) {
+  return {static_cast<double>(v.x), static_cast<double>(v.y)};
+}
+
+double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+
+struct Transform {
+  Eigen::Vector2d p;
+  double c = 1.0, s = 0.0;
+  Eigen::Vector2d Apply(const Eigen::Vector2d& v) const {
+    return {p.x() + c * v.x() - s * v.y(), p.y() + s * v.x() + c * v.y()};
+  }
+  Eigen::Vector2d Rotate(const Eigen::Vector2d& v) const {
+    return {c * v.x() - s * v.y(), s * v.x() + c * v.y()};
+  }
+};
+
+Transform FromB2(const b2Transform& xf) {
+  return {ToEigen(xf.p), static_cast<double>(xf.q.c), static_cast<double>(xf.q.s)};
+}
+
+// Distance from `p` to the segment a + [0, 1] e.
+double DistanceToSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                         const Eigen::Vector2d& e) {
+  const double ee = e.squaredNorm();
+  const double f = ee > 0.0 ? std::clamp((p - a).dot(e) / ee, 0.0, 1.0) : 0.0;
+  return (a + f * e - p).norm();
+}
+
+}  // namespace
+
+// Collects the cached shapes of the fixtures whose broad-phase boxes overlap the query box.
+class RayCaster::Query : public b2QueryCallback {
+ public:
+  Query(const std::vector<FixtureShapes>& fixtures, std::vector<const FixtureShapes*>* out)
+      : fixtures_(fixtures), out_(out) {}
+  bool ReportFixture(b2Fixture* fixture) override {
+    const std::uintptr_t id = fixture->GetUserData().pointer;
+    if (id > 0 && id <= fixtures_.size()) out_->push_back(&fixtures_[id - 1]);
+    return true;
+  }
+
+ private:
+  const std::vector<FixtureShapes>& fixtures_;
+  std::vector<const FixtureShapes*>* out_;
+};
+
+RayCaster::RayCaster(b2World* world, const b2Body* ignore) : world_(world), ignore_(ignore) {
+  for (b2Body* body = world_->GetBodyList(); body != nullptr; body = body->GetNext()) {
+    if (body == ignore_) continue;
+    const bool is_static = body->GetType() == b2_staticBody;
+    const Transform xf = is_static ? FromB2(body->GetTransform()) : Transform{};
+    for (b2Fixture* fixture = body->GetFixtureList(); fixture != nullptr;
+         fixture = fixture->GetNext()) {
+      if (fixture->IsSensor()) continue;
+      FixtureShapes shapes;
+      shapes.body = body;
+      shapes.is_static = is_static;
+      const b2Shape* shape = fixture->GetShape();
+      switch (shape->GetType()) {
+        case b2Shape::e_polygon: {
+          const auto* polygon = static_cast<const b2PolygonShape*>(shape);
+          for (int32 i = 0; i < polygon->m_count; ++i) {
+            const Eigen::Vector2d a = xf.Apply(ToEigen(polygon->m_vertices[i]));
+            const Eigen::Vector2d b =
+                xf.Apply(ToEigen(polygon->m_vertices[(i + 1) % polygon->m_count]));
+            shapes.segments.push_back({a, b - a, xf.Rotate(ToEigen(polygon->m_normals[i])), true});
+          }
+          break;
+        }
+        case b2Shape::e_edge: {
+          const auto* edge = static_cast<const b2EdgeShape*>(shape);
+          const Eigen::Vector2d a = xf.Apply(ToEigen(edge->m_vertex1));
+          const Eigen::Vector2d b = xf.Apply(ToEigen(edge->m_vertex2));
+          const Eigen::Vector2d e = b - a;
+          // Box2D's one-sided edges are solid on the right of vertex1 -> vertex2.
+          shapes.segments.push_back(
+              {a, e, Eigen::Vector2d(e.y(), -e.x()).normalized(), edge->m_oneSided});
+          break;
+        }
+        case b2Shape::e_circle: {
+          const auto* circle = static_cast<const b2CircleShape*>(shape);
+          shapes.circles.push_back(
+              {xf.Apply(ToEigen(circle->m_p)), static_cast<double>(circle->m_radius)});
+          break;
+        }
+        default:
+          SLAMRIG_CHECK(false, "RayCaster supports polygon, edge and circle fixtures only");
+      }
+      fixtures_.push_back(std::move(shapes));
+      fixture->GetUserData().pointer = fixtures_.size();
+    }
+  }
+}
+
+void RayCaster::ForEachRayInInterval(double lo, double hi, std::size_t num_rays,
+                                     auto&& visit) const {
+  if (hi - lo >= kTwoPi) {
+    visit(std::size_t{0}, num_rays);
+    return;
+  }
+  double rel_lo = std::fmod(lo - first_angle_rad_, kTwoPi);
+  if (rel_lo < 0.0) rel_lo += kTwoPi;
+  const double rel_hi = rel_lo + (hi - lo);
+  const auto begin = relative_angles_.begin(), end = relative_angles_.end();
+  const auto first = std::lower_bound(begin, end, rel_lo);
+  const auto last = std::upper_bound(first, end, rel_hi);
+  if (first < last)
+    visit(static_cast<std::size_t>(first - begin), static_cast<std::size_t>(last - begin));
+  // The part of the interval past one turn wraps round to the first rays.
+  if (rel_hi >= kTwoPi) {
+    const auto wrapped_last = std::upper_bound(begin, end, rel_hi - kTwoPi);
+    if (wrapped_last > begin) visit(std::size_t{0}, static_cast<std::size_t>(wrapped_last - begin));
+  }
+}
+
+void RayCaster::CastSegment(const Segment& s, double max_range_m, std::span<const Ray> rays,
+                            std::span<double> ranges_m) {
+  const double d = DistanceToSegment(center_, s.a, s.e);
+  if (d > max_range_m + spread_m_) return;
+  // Every origin behind a solid polygon's side: no ray can enter through it.
+  if (s.one_sided && (center_ - s.a).dot(s.normal) < -spread_m_) return;
+  auto test = [&](std::size_t first, std::size_t last) {
+    num_tests_ += static_cast<long long>(last - first);
+    for (std::size_t k = first; k < last; ++k) {
+      const Ray& ray = rays[k];
+      const double denom = Cross(ray.direction, s.e);
+      if (denom == 0.0) continue;
+      if (s.one_sided && ray.direction.dot(s.normal) >= 0.0) continue;
+      const Eigen::Vector2d w = s.a - ray.origin;
+      const double t = Cross(w, s.e) / denom;
+      if (t < 0.0 || t >= ranges_m[k]) continue;
+      const double u = Cross(w, ray.direction) / denom;
+      if (u < 0.0 || u > 1.0) continue;
+      ranges_m[k] = t;
+    }
+  };
+  const double x = spread_m_ / d;
+  if (x > 0.99) {
+    test(0, rays.size());
+    return;
+  }
+  // The angles under which the segment is seen from the centre, widened by the most the view can
+  // turn from another origin within the spread: asin(spread / d) <= tan(asin(spread / d)).
+  const Eigen::Vector2d pa = s.a - center_, pb = pa + s.e;
+  const double phi_a = std::atan2(pa.y(), pa.x());
+  const double delta = std::atan2(Cross(pa, pb), pa.dot(pb));
+  const double lo = phi_a + std::min(0.0, delta);
+  const double widen = x / std::sqrt(1.0 - x * x) + 1e-9;
+  ForEachRayInInterval(lo - widen, lo + std::abs(delta) + widen, rays.size(), test);
+}
+
+void RayCaster::CastCircle(const Circle& c, double max_range_m, std::span<const Ray> rays,
+                           std::span<double> ranges_m) {
+  const Eigen::Vector2d pc = c.center - center_;
+  const double d = pc.norm();
+  if (d - c.radius > max_range_m + spread_m_) return;
+  const double r2 = c.radius * c.radius;
+  auto test = [&](std::size_t first, std::size_t last) {
+    num_tests_ += static_cast<long long>(last - first);
+    for (std::size_t k = first; k < last; ++k) {
+      const Ray& ray = rays[k];
+      const Eigen::Vector2d w = ray.origin - c.center;
+      const double b = w.dot(ray.direction);
+      const double disc = b * b - (w.squaredNorm() - r2);
+      if (disc < 0.0) continue;
+      // The entry point; negative when the ray starts inside (no hit, as in Box2D).
+      const double t = -b - std::sqrt(disc);
+      if (t < 0.0 || t >= ranges_m[k]) continue;
+      ranges_m[k] = t;
+    }
+  };
+  if (d <= (c.radius + spread_m_) * 1.01) {
+    test(0, rays.size());
+    return;
+  }
+  // Half-angle of the disc seen from the nearest origin, plus the turn of the centre's bearing.
+  const double x1 = c.radius / (d - spread_m_), x2 = spread_m_ / d;
+  const double half = x1 / std::sqrt(1.0 - x1 * x1) + x2 / std::sqrt(1.0 - x2 * x2) + 1e-9;
+  const double phi = std::atan2(pc.y(), pc.x());
+  ForEachRayInInterval(phi - half, phi + half, rays.size(), test);
+}
+
+void RayCaster::Cast(std::span<const Ray> rays, double max_range_m, std::span<double> ranges_m) {
+  SLAMRIG_CHECK(rays.size() == ranges_m.size(), "one range per ray");
+  std::fill(ranges_m.begin(), ranges_m.end(), kInfinity);
+  num_tests_ = 0;
+  if (rays.empty()) return;
+
+  // The origins' bounding circle.
+  Eigen::Vector2d lo = rays.front().origin, hi = rays.front().origin;
+  for (const Ray& ray : rays) {
+    lo = lo.cwiseMin(ray.origin);
+    hi = hi.cwiseMax(ray.origin);
+  }
+  center_ = 0.5 * (lo + hi);
+  spread_m_ = 0.5 * (hi - lo).norm() + 1e-9;
+
+  first_angle_rad_ = rays.front().angle_rad;
+  relative_angles_.resize(rays.size());
+  for (std::size_t k = 0; k < rays.size(); ++k) {
+    relative_angles_[k] = rays[k].angle_rad - rays.front().angle_rad;
+  }
+  SLAMRIG_CHECK(relative_angles_.back() < kTwoPi, "a fan spans less than one turn");
+
+  // Gather the fixtures in range through the broad phase.
+  gathered_.clear();
+  Query query(fixtures_, &gathered_);
+  const double reach = max_range_m + spread_m_;
+  b2AABB box;
+  box.lowerBound =
+      b2Vec2(static_cast<float>(center_.x() - reach), static_cast<float>(center_.y() - reach));
+  box.upperBound =
+      b2Vec2(static_cast<float>(center_.x() + reach), static_cast<float>(center_.y() + reach));
+  world_->QueryAABB(&query, box);
+
+  for (const FixtureShapes* shapes : gathered_) {
+    if (shapes->body == ignore_) continue;
+    if (shapes->is_static) {
+      for (const Segment& s : shapes->segments) CastSegment(s, max_range_m, rays, ranges_m);
+      for (const Circle& c : shapes->circles) CastCircle(c, max_range_m, rays, ranges_m);
+    } else {
+      const Transform xf = FromB2(shapes->body->GetTransform());
+      for (const Segment& s : shapes->segments) {
+        CastSegment({xf.Apply(s.a), xf.Rotate(s.e), xf.Rotate(s.normal), s.one_sided}, max_range_m,
+                    rays, ranges_m);
+      }
+      for (const Circle& c : shapes->circles) {
+        CastCircle({xf.Apply(c.center), c.radius}, max_range_m, rays, ranges_m);
+      }
+    }
+  }
+  for (double& range : ranges_m) {
+    if (range > max_range_m) range = kInfinity;
+  }
+}
+
+}  // namespace slamrig::sim

@@ -1,0 +1,94 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "sim/encoder_model.h"
+#include "sim/imu_model.h"
+#include "sim/lidar_model.h"
+
+namespace slamrig::sim {
+
+/// The rigid body of the robot: a box footprint centred on base_link, centre of mass there.
+struct ChassisOptions {
+  double mass_kg = 8.0;            ///< total mass, wheels included
+  double length_m = 0.55;          ///< footprint along x
+  double width_m = 0.50;           ///< footprint along y
+  double yaw_inertia_kg_m2 = 0.0;  ///< about the centre of mass; 0: a uniform box's
+  double wall_friction = 0.3;      ///< Coulomb friction of the bumper against walls
+
+  /// One message per broken rule.
+  std::vector<std::string> Validate() const;
+};
+
+/// Wheel layout and tyre. The radius and track are the nominal values the robot's own software
+/// believes; the physical ones differ by CalibrationErrors.
+struct WheelOptions {
+  double radius_m = 0.127;            ///< nominal wheel radius
+  double track_width_m = 0.3937;      ///< nominal distance between left and right contacts
+  int per_side = 2;                   ///< driven wheels on each side, each with its own motor
+  double wheelbase_m = 0.3302;        ///< front to rear wheel distance (per_side > 1)
+  double spin_inertia_kg_m2 = 0.02;   ///< wheel plus motor and gearbox reflected to the axle
+  double caster_load_fraction = 0.0;  ///< share of the weight on passive casters
+  double longitudinal_stiffness_s_m = 30.0;  ///< traction / load per m/s of slip before saturation
+  double lateral_stiffness_s_m = 30.0;       ///< side force / load per m/s of skid
+
+  /// One message per broken rule.
+  std::vector<std::string> Validate() const;
+};
+
+/// A DC motor per wheel with a PI speed loop on the wheel's spin rate.
+struct MotorOptions {
+  double max_torque_n_m = 4.0;          ///< at the wheel axle, both directions
+  double kp_n_m_s_rad = 1.5;            ///< proportional gain, N m per rad/s of speed error
+  double ki_n_m_rad = 10.0;             ///< integral gain, N m per rad of accumulated error
+  double max_wheel_speed_rad_s = 20.0;  ///< the speed loop never asks for more
+
+  /// One message per broken rule.
+  std::vector<std::string> Validate() const;
+};
+
+/// How the physical robot differs from its nominal parameters: true = nominal * (1 + error).
+struct CalibrationErrors {
+  double left_radius_error = 0.003;
+  double right_radius_error = -0.002;
+  double track_width_error = 0.0;
+
+  /// One message per broken rule.
+  std::vector<std::string> Validate() const;
+};
+
+/// Velocity ramps the robot's base controller applies to incoming (v, omega) commands.
+struct MotionLimits {
+  double max_speed_m_s = 1.0;
+  double max_accel_m_s2 = 1.0;
+  double max_yaw_rate_rad_s = 2.0;
+  double max_yaw_accel_rad_s2 = 4.0;
+
+  /// One message per broken rule.
+  std::vector<std::string> Validate() const;
+};
+
+/// A complete robot preset (robots/*.yaml): body, wheels, motors, calibration and sensors.
+/// The default is the ECE276A robot.
+struct RobotSpec {
+  std::string name = "ece276a";
+  ChassisOptions chassis;
+  WheelOptions wheels;
+  MotorOptions motor;
+  CalibrationErrors calibration;
+  MotionLimits limits;
+  EncoderOptions encoders;
+  ImuOptions imu;
+  LidarOptions lidar;
+
+  /// One message per broken rule, field names as in the robot file ("motor.kp_n_m_s_rad = ...").
+  std::vector<std::string> Validate() const;
+};
+
+/// `spec` with every noise source and calibration error switched off: no IMU noise, bias or
+/// scale error, no lidar noise or mixture outliers, no range rounding, nominal = physical geometry.
+/// Tick quantization and the physics (slip, skid) remain.
+RobotSpec WithoutNoise(RobotSpec spec);
+
+}  // namespace slamrig::sim

@@ -1,0 +1,131 @@
+#include "sim/robot_yaml.h"
+
+#include "sim/yaml_fields.h"
+
+namespace slamrig::sim {
+
+// The robot file's schema: one field list per struct, shared by reader and writer.
+
+template <typename V>
+void VisitFields(V& v, ChassisOptions& c) {
+  v("mass_kg", c.mass_kg);
+  v("length_m", c.length_m);
+  v("width_m", c.width_m);
+  v("yaw_inertia_kg_m2", c.yaw_inertia_kg_m2);
+  v("wall_friction", c.wall_friction);
+}
+
+template <typename V>
+void VisitFields(V& v, WheelOptions& w) {
+  v("radius_m", w.radius_m);
+  v("track_width_m", w.track_width_m);
+  v("per_side", w.per_side);
+  v("wheelbase_m", w.wheelbase_m);
+  v("spin_inertia_kg_m2", w.spin_inertia_kg_m2);
+  v("caster_load_fraction", w.caster_load_fraction);
+  v("longitudinal_stiffness_s_m", w.longitudinal_stiffness_s_m);
+  v("lateral_stiffness_s_m", w.lateral_stiffness_s_m);
+}
+
+template <typename V>
+void VisitFields(V& v, MotorOptions& m) {
+  v("max_torque_n_m", m.max_torque_n_m);
+  v("kp_n_m_s_rad", m.kp_n_m_s_rad);
+  v("ki_n_m_rad", m.ki_n_m_rad);
+  v("max_wheel_speed_rad_s", m.max_wheel_speed_rad_s);
+}
+
+template <typename V>
+void VisitFields(V& v, CalibrationErrors& c) {
+  v("left_radius_error", c.left_radius_error);
+  v("right_radius_error", c.right_radius_error);
+  v("track_width_error", c.track_width_error);
+}
+
+template <typename V>
+void VisitFields(V& v, MotionLimits& l) {
+  v("max_speed_m_s", l.max_speed_m_s);
+  v("max_accel_m_s2", l.max_accel_m_s2);
+  v("max_yaw_rate_rad_s", l.max_yaw_rate_rad_s);
+  v("max_yaw_accel_rad_s2", l.max_yaw_accel_rad_s2);
+}
+
+template <typename V>
+void VisitFields(V& v, EncoderOptions& e) {
+  v("enabled", e.enabled);
+  v("rate_hz", e.rate_hz);
+  v("ticks_per_revolution", e.ticks_per_revolution);
+}
+
+template <typename V>
+void VisitFields(V& v, ImuNoise& n) {
+  v("noise_density", n.noise_density);
+  v("random_walk", n.random_walk);
+  v("bias", n.bias);
+  v("turn_on_bias_stddev", n.turn_on_bias_stddev);
+  v("scale_error", n.scale_error);
+  v("saturation", n.saturation);
+}
+
+template <typename V>
+void VisitFields(V& v, ImuOptions& i) {
+  v("enabled", i.enabled);
+  v("rate_hz", i.rate_hz);
+  v.Struct("mount", i.mount);
+  v("gravity_m_s2", i.gravity_m_s2);
+  v.Struct("gyro", i.gyro);
+  v.Struct("accel", i.accel);
+}
+
+template <typename V>
+void VisitFields(V& v, LidarOptions& l) {
+  v("enabled", l.enabled);
+  v("rate_hz", l.rate_hz);
+  v("num_beams", l.num_beams);
+  v("fov_deg", l.fov_deg);
+  v("beams_per_revolution", l.beams_per_revolution);
+  v("range_min_m", l.range_min_m);
+  v("range_max_m", l.range_max_m);
+  v("range_noise_stddev_m", l.range_noise_stddev_m);
+  v("range_resolution_m", l.range_resolution_m);
+  v("p_short", l.p_short);
+  v("short_decay_per_m", l.short_decay_per_m);
+  v("p_max", l.p_max);
+  v("p_random", l.p_random);
+  v.Struct("mount", l.mount);
+}
+
+template <typename V>
+void VisitFields(V& v, RobotSpec& r) {
+  v("name", r.name);
+  v.Struct("chassis", r.chassis);
+  v.Struct("wheels", r.wheels);
+  v.Struct("motor", r.motor);
+  v.Struct("calibration", r.calibration);
+  v.Struct("limits", r.limits);
+  v.Struct("encoders", r.encoders);
+  v.Struct("imu", r.imu);
+  v.Struct("lidar", r.lidar);
+}
+
+RobotSpec ParseRobotSpec(const YamlNode& node) {
+  RobotSpec spec;
+  FieldReader reader(node);
+  VisitFields(reader, spec);
+  node.ThrowIfInvalid(spec.Validate());
+  return spec;
+}
+
+RobotSpec LoadRobotSpec(const std::string& path) {
+  const YamlNode root = YamlNode::LoadFile(path);
+  if (!root.IsMap()) root.Fail("a robot file is a map (name, chassis, wheels, ...)");
+  RobotSpec spec = ParseRobotSpec(root);
+  root.CheckAllKeysUsed();
+  return spec;
+}
+
+std::string RobotSpecToYaml(const RobotSpec& spec) {
+  return ToYaml(spec, "slamrig robot (resolved: every field, defaults included)");
+}
+
+}  // namespace slamrig::sim

@@ -1,0 +1,192 @@
+#pragma once
+
+// Field visitors shared by the world and robot file readers and writers: each options struct
+// lists its fields once, in a VisitFields(visitor, struct) overload, and the same list reads
+// the file (FieldReader, strict, through YamlNode) and writes the resolved config (FieldWriter).
+
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sim/messages.h"
+#include "sim/mount_pose.h"
+#include "slam/config/yaml_node.h"
+
+namespace slamrig::sim {
+
+/// Reads fields from a YAML map, keeping defaults for absent keys. A nested struct or list
+/// element is validated where it is read, so its errors point at its own line.
+class FieldReader {
+ public:
+  explicit FieldReader(const YamlNode& node) : node_(node) {}
+
+  /// A scalar (double, int, bool, string, uint64).
+  template <typename T>
+  void operator()(const char* key, T& value) {
+    node_.Read(key, &value);
+  }
+  /// `[x, y]`.
+  void operator()(const char* key, Eigen::Vector2d& value) {
+    if (auto child = node_.Optional(key)) value = ReadPoint(*child);
+  }
+  /// `[[x, y], ...]`.
+  void operator()(const char* key, std::vector<Eigen::Vector2d>& values) {
+    auto child = node_.Optional(key);
+    if (!child) return;
+    values.clear();
+    for (const YamlNode& element : child->Elements()) values.push_back(ReadPoint(element));
+  }
+  /// One of `names` (pairs of enum value and name); required.
+  template <typename E>
+  void Enum(const char* key, E& value, const std::vector<std::pair<E, const char*>>& names) {
+    const YamlNode child = node_.Required(key);
+    const std::string text = child.As<std::string>();
+    std::string choices;
+    for (const auto& [option, name] : names) {
+      if (text == name) {
+        value = option;
+        return;
+      }
+      choices += (choices.empty() ? "" : ", ") + std::string(name);
+    }
+    child.Fail("'" + text + "' is not one of: " + choices);
+  }
+  /// A nested map.
+  template <typename T>
+  void Struct(const char* key, T& value) {
+    if (auto child = node_.Optional(key)) ReadStruct(*child, value);
+  }
+  /// A nested map that may be absent.
+  template <typename T>
+  void OptionalStruct(const char* key, std::optional<T>& value) {
+    auto child = node_.Optional(key);
+    if (!child) return;
+    value.emplace();
+    ReadStruct(*child, *value);
+  }
+  /// A list of maps.
+  template <typename T>
+  void List(const char* key, std::vector<T>& values) {
+    auto child = node_.Optional(key);
+    if (!child) return;
+    values.clear();
+    for (const YamlNode& element : child->Elements()) {
+      values.emplace_back();
+      ReadStruct(element, values.back());
+    }
+  }
+
+  const YamlNode& node() const { return node_; }
+
+ private:
+  static Eigen::Vector2d ReadPoint(const YamlNode& node) {
+    const auto elements = node.Elements();
+    if (elements.size() != 2)
+      node.Fail("expected a point [x, y], got " + std::to_string(elements.size()) + " numbers");
+    return {elements[0].As<double>(), elements[1].As<double>()};
+  }
+  template <typename T>
+  static void ReadStruct(const YamlNode& node, T& value) {
+    if (!node.IsMap()) node.Fail("expected a map");
+    FieldReader reader(node);
+    VisitFields(reader, value);
+    if constexpr (requires { value.Validate(); }) {
+      node.ThrowIfInvalid(PrefixErrors(node.path(), value.Validate()));
+    }
+  }
+
+  YamlNode node_;
+};
+
+/// Writes the same fields as block YAML with shortest round-trip numbers.
+class FieldWriter {
+ public:
+  explicit FieldWriter(YAML::Emitter* out) : out_(*out) {}
+
+  void operator()(const char* key, const double& value) {
+    out_ << YAML::Key << key << YAML::Value << FormatNumber(value);
+  }
+  void operator()(const char* key, const int& value) {
+    out_ << YAML::Key << key << YAML::Value << value;
+  }
+  void operator()(const char* key, const std::uint64_t& value) {
+    out_ << YAML::Key << key << YAML::Value << value;
+  }
+  void operator()(const char* key, const bool& value) {
+    out_ << YAML::Key << key << YAML::Value << value;
+  }
+  void operator()(const char* key, const std::string& value) {
+    out_ << YAML::Key << key << YAML::Value << value;
+  }
+  void operator()(const char* key, const Eigen::Vector2d& value) {
+    out_ << YAML::Key << key << YAML::Value;
+    WritePoint(value);
+  }
+  void operator()(const char* key, const std::vector<Eigen::Vector2d>& values) {
+    out_ << YAML::Key << key << YAML::Value << YAML::BeginSeq;
+    for (const auto& v : values) WritePoint(v);
+    out_ << YAML::EndSeq;
+  }
+  template <typename E>
+  void Enum(const char* key, E& value, const std::vector<std::pair<E, const char*>>& names) {
+    for (const auto& [option, name] : names) {
+      if (option == value) out_ << YAML::Key << key << YAML::Value << name;
+    }
+  }
+  template <typename T>
+  void Struct(const char* key, T& value) {
+    out_ << YAML::Key << key << YAML::Value;
+    WriteStruct(value);
+  }
+  template <typename T>
+  void OptionalStruct(const char* key, std::optional<T>& value) {
+    if (value) Struct(key, *value);
+  }
+  template <typename T>
+  void List(const char* key, std::vector<T>& values) {
+    out_ << YAML::Key << key << YAML::Value << YAML::BeginSeq;
+    for (auto& value : values) WriteStruct(value);
+    out_ << YAML::EndSeq;
+  }
+
+ private:
+  void WritePoint(const Eigen::Vector2d& v) {
+    out_ << YAML::Flow << YAML::BeginSeq << FormatNumber(v.x()) << FormatNumber(v.y())
+         << YAML::EndSeq;
+  }
+  template <typename T>
+  void WriteStruct(T& value) {
+    out_ << YAML::BeginMap;
+    VisitFields(*this, value);
+    out_ << YAML::EndMap;
+  }
+
+  YAML::Emitter& out_;
+};
+
+/// Fields of a mounting pose (also used for the spawn pose).
+template <typename V>
+void VisitFields(V& v, MountPose& m) {
+  v("x_m", m.x_m);
+  v("y_m", m.y_m);
+  v("yaw_rad", m.yaw_rad);
+}
+
+/// Emits `value` (a struct with a VisitFields overload) as a YAML document.
+template <typename T>
+std::string ToYaml(T value, const std::string& header_comment) {
+  YAML::Emitter out;
+  if (!header_comment.empty()) out << YAML::Comment(header_comment);
+  out << YAML::BeginMap;
+  FieldWriter writer(&out);
+  VisitFields(writer, value);
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace slamrig::sim
