@@ -162,7 +162,7 @@ VelocityCommand Driver::FollowPath(const Pose2& map_from_base) {
   const Eigen::Vector2d target = PointAt(progress_m_ + options_.lookahead_m);
   const Eigen::Vector2d local = base_from_map * target;
   const double dist2 = std::max(local.squaredNorm(), 1e-9);
-  if (local.x() < 0.0 && std::abs(local.y()) < -local.x()) {
+  if (local.x() < 0.0) {
     // Target behind: turn on the spot towards it.
     return {0.0, std::copysign(0.5 * options_.max_yaw_rate_rad_s, local.y())};
   }

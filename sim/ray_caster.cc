@@ -118,16 +118,18 @@ void RayCaster::ForEachRayInInterval(double lo, double hi, std::size_t num_rays,
   }
   double rel_lo = std::fmod(lo - first_angle_rad_, kTwoPi);
   if (rel_lo < 0.0) rel_lo += kTwoPi;
-  const double rel_hi = rel_lo + (hi - lo);
+  const double width = hi - lo;
   const auto begin = relative_angles_.begin(), end = relative_angles_.end();
-  const auto first = std::lower_bound(begin, end, rel_lo);
-  const auto last = std::upper_bound(first, end, rel_hi);
-  if (first < last)
-    visit(static_cast<std::size_t>(first - begin), static_cast<std::size_t>(last - begin));
-  // The part of the interval past one turn wraps round to the first rays.
-  if (rel_hi >= kTwoPi) {
-    const auto wrapped_last = std::upper_bound(begin, end, rel_hi - kTwoPi);
-    if (wrapped_last > begin) visit(std::size_t{0}, static_cast<std::size_t>(wrapped_last - begin));
+  // The fan may sweep a little more than a turn (a 360-degree scanner on a turning robot): look
+  // for the interval one turn before and after, too. The shifted intervals never overlap.
+  for (const double shift : {-kTwoPi, 0.0, kTwoPi}) {
+    const double from = rel_lo + shift, to = rel_lo + shift + width;
+    if (to < 0.0 || from > relative_angles_.back()) continue;
+    const auto first = std::lower_bound(begin, end, from);
+    const auto last = std::upper_bound(first, end, to);
+    if (first < last) {
+      visit(static_cast<std::size_t>(first - begin), static_cast<std::size_t>(last - begin));
+    }
   }
 }
 
@@ -218,7 +220,7 @@ void RayCaster::Cast(std::span<const Ray> rays, double max_range_m, std::span<do
   for (std::size_t k = 0; k < rays.size(); ++k) {
     relative_angles_[k] = rays[k].angle_rad - rays.front().angle_rad;
   }
-  SLAMRIG_CHECK(relative_angles_.back() < kTwoPi, "a fan spans less than one turn");
+  SLAMRIG_CHECK(relative_angles_.back() < 2.0 * kTwoPi, "a fan spans less than two turns");
 
   // Gather the fixtures in range through the broad phase.
   gathered_.clear();

@@ -33,7 +33,7 @@ class RayCaster {
 
   /// Writes the distance along each ray to the first surface, or +infinity when there is none
   /// within `max_range_m`, into `ranges_m` (same size as `rays`). The rays' `angle_rad` must be
-  /// non-decreasing and span less than 2 pi: one sweep of a scanner.
+  /// non-decreasing and span less than 4 pi: one sweep of a scanner (which may overlap itself).
   void Cast(std::span<const Ray> rays, double max_range_m, std::span<double> ranges_m);
 
   /// Ray-versus-shape intersection tests done by the last Cast (for benchmarks and tests).
