@@ -1,6 +1,6 @@
 // Sensor synchronisation on lidar time stamps (Wang, "Simultaneous Localization and Mapping with
-// Texture", ECE276A report, Sec. III-A): IMU samples within one lidar interval are averaged, encoder
-// counts summed, and v, omega integrated with the differential-drive model (Eq. 6).
+// Texture", ECE276A report, Sec. III-A): IMU samples within one lidar interval are averaged,
+// encoder counts summed, and v, omega integrated with the differential-drive model (Eq. 6).
 #include "slam/odometry/scan_sync.h"
 
 #include <cmath>
@@ -54,105 +54,6 @@ Pose2 Interpolate(const OdometryPose& a, const OdometryPose& b, Time t) {
   return a.odom_from_base * Pose2(chord.x(), chord.y(), s * theta);
 }
 
-// Odometry poses at each scan for a log that reports poses.
-void SyncPoses(const std::vector<Record>& records, ScanSyncResult& result) {
-  // For every record index, the index of the next OdometryPose at or after it (lookahead).
-  std::vector<std::size_t> next_odom(records.size() + 1, records.size());
-  for (std::size_t i = records.size(); i-- > 0;) {
-    next_odom[i] = std::holds_alternative<OdometryPose>(records[i]) ? i : next_odom[i + 1];
-  }
-  std::optional<OdometryPose> last;
-  std::optional<Pose2> previous_scan_pose;
-  for (std::size_t i = 0; i < records.size(); ++i) {
-    if (const auto* odom = std::get_if<OdometryPose>(&records[i])) {
-      last = *odom;
-      continue;
-    }
-    const auto* scan = std::get_if<LaserScan>(&records[i]);
-    if (scan == nullptr) continue;
-    const std::size_t n = next_odom[i];
-    const OdometryPose* next = n < records.size() ? &std::get<OdometryPose>(records[n]) : nullptr;
-    Pose2 pose;
-    if (last && next && last->time <= scan->time && scan->time <= next->time) {
-      pose = Interpolate(*last, *next, scan->time);
-    } else if (last) {
-      pose = last->odom_from_base;
-    } else if (next) {
-      pose = next->odom_from_base;
-    } else {
-      ++result.scans_without_odometry;
-    }
-    SyncedScan synced;
-    synced.scan = *scan;
-    synced.odom_from_base = pose;
-    if (previous_scan_pose) {
-      synced.increment = previous_scan_pose->Between(pose);
-      synced.dt_s = SecondsBetween(scan->time, result.scans.back().scan.time);
-      synced.distance_m = RotTransRot::FromIncrement(synced.increment).trans_m;
-      synced.yaw_change_rad = synced.increment.theta();
-    }
-    previous_scan_pose = pose;
-    result.scans.push_back(std::move(synced));
-  }
-}
-
-// Encoder counts summed and gyro rates averaged per scan interval.
-void SyncTicks(const std::vector<Record>& records, const ScanSyncOptions& options,
-               ScanSyncResult& result) {
-  const double metres_per_tick = options.robot.MetresPerTick();
-  double right_ticks = 0.0, left_ticks = 0.0, gyro_sum = 0.0;
-  int gyro_count = 0;
-  bool seen_ticks = false;
-  std::optional<double> held_rate;  // last interval's mean gyro rate, for dropouts
-  Pose2 pose;
-  for (const Record& record : records) {
-    if (const auto* ticks = std::get_if<WheelTicks>(&record)) {
-      right_ticks += SideMean(ticks->right_ticks);
-      left_ticks += SideMean(ticks->left_ticks);
-      seen_ticks = true;
-      continue;
-    }
-    if (const auto* imu = std::get_if<ImuSample>(&record)) {
-      gyro_sum += imu->angular_velocity_rad_s.z();
-      ++gyro_count;
-      continue;
-    }
-    const auto* scan = std::get_if<LaserScan>(&record);
-    if (scan == nullptr) continue;
-    SyncedScan synced;
-    synced.scan = *scan;
-    if (!result.scans.empty()) {
-      const double dt = SecondsBetween(scan->time, result.scans.back().scan.time);
-      const double right_m = right_ticks * metres_per_tick;
-      const double left_m = left_ticks * metres_per_tick;
-      double yaw = (right_m - left_m) / options.robot.track_width_m;
-      if (options.use_gyro) {
-        if (gyro_count > 0) {
-          held_rate = gyro_sum / gyro_count;
-          yaw = *held_rate * dt;
-        } else {
-          ++result.gyro_fallbacks;
-          if (held_rate) yaw = *held_rate * dt;
-        }
-      }
-      synced.dt_s = dt;
-      synced.distance_m = 0.5 * (right_m + left_m);
-      synced.yaw_change_rad = yaw;
-      synced.imu_samples = gyro_count;
-      synced.increment = DiffDriveIncrement(synced.distance_m, yaw, options.integration);
-      pose = pose * synced.increment;
-      if (!seen_ticks) ++result.scans_without_odometry;
-    } else if (!seen_ticks) {
-      ++result.scans_without_odometry;
-    }
-    synced.odom_from_base = pose;
-    // Counts before the first scan belong to no interval; start every interval empty.
-    right_ticks = left_ticks = gyro_sum = 0.0;
-    gyro_count = 0;
-    result.scans.push_back(std::move(synced));
-  }
-}
-
 }  // namespace
 
 std::vector<std::string> ScanSyncOptions::Validate() const {
@@ -161,32 +62,136 @@ std::vector<std::string> ScanSyncOptions::Validate() const {
   return errors;
 }
 
+ScanSynchronizer::ScanSynchronizer(const ScanSyncOptions& options, OdometrySource source)
+    : options_(options), source_(source) {
+  SLAMRIG_CHECK(options_.Validate().empty(), "invalid ScanSyncOptions");
+  SLAMRIG_CHECK(source != OdometrySource::kAuto, "ScanSynchronizer needs a resolved source");
+}
+
+std::vector<SyncedScan> ScanSynchronizer::Add(const Record& record) {
+  std::vector<SyncedScan> out;
+  switch (source_) {
+    case OdometrySource::kWheelTicks:
+      if (const auto* ticks = std::get_if<WheelTicks>(&record)) {
+        right_ticks_ += SideMean(ticks->right_ticks);
+        left_ticks_ += SideMean(ticks->left_ticks);
+        seen_ticks_ = true;
+      } else if (const auto* imu = std::get_if<ImuSample>(&record)) {
+        gyro_sum_ += imu->angular_velocity_rad_s.z();
+        ++gyro_count_;
+      } else if (const auto* scan = std::get_if<LaserScan>(&record)) {
+        out.push_back(CompleteTicks(*scan));
+      }
+      break;
+    case OdometrySource::kOdometryPoses:
+      if (const auto* odom = std::get_if<OdometryPose>(&record)) {
+        CompletePending(odom, &out);
+        last_odometry_ = *odom;
+      } else if (const auto* scan = std::get_if<LaserScan>(&record)) {
+        pending_.push_back(*scan);
+      }
+      break;
+    case OdometrySource::kAuto:
+    case OdometrySource::kNone:
+      if (const auto* scan = std::get_if<LaserScan>(&record)) {
+        ++scans_without_odometry_;
+        out.push_back(CompleteWithPose(*scan, Pose2()));
+      }
+      break;
+  }
+  return out;
+}
+
+std::vector<SyncedScan> ScanSynchronizer::Flush() {
+  std::vector<SyncedScan> out;
+  CompletePending(nullptr, &out);
+  return out;
+}
+
+// Encoder counts summed and gyro rates averaged over the interval since the previous scan.
+SyncedScan ScanSynchronizer::CompleteTicks(const LaserScan& scan) {
+  SyncedScan synced;
+  synced.scan = scan;
+  if (last_scan_time_) {
+    const double dt = SecondsBetween(scan.time, *last_scan_time_);
+    const double metres_per_tick = options_.robot.MetresPerTick();
+    const double right_m = right_ticks_ * metres_per_tick;
+    const double left_m = left_ticks_ * metres_per_tick;
+    double yaw = (right_m - left_m) / options_.robot.track_width_m;
+    if (options_.use_gyro) {
+      if (gyro_count_ > 0) {
+        held_rate_ = gyro_sum_ / gyro_count_;
+        yaw = *held_rate_ * dt;
+      } else {
+        ++gyro_fallbacks_;
+        if (held_rate_) yaw = *held_rate_ * dt;
+      }
+    }
+    synced.dt_s = dt;
+    synced.distance_m = 0.5 * (right_m + left_m);
+    synced.yaw_change_rad = yaw;
+    synced.imu_samples = gyro_count_;
+    synced.increment = DiffDriveIncrement(synced.distance_m, yaw, options_.integration);
+    pose_ = pose_ * synced.increment;
+    if (!seen_ticks_) ++scans_without_odometry_;
+  } else if (!seen_ticks_) {
+    ++scans_without_odometry_;
+  }
+  synced.odom_from_base = pose_;
+  last_scan_time_ = scan.time;
+  // Counts before the first scan belong to no interval; start every interval empty.
+  right_ticks_ = left_ticks_ = gyro_sum_ = 0.0;
+  gyro_count_ = 0;
+  return synced;
+}
+
+SyncedScan ScanSynchronizer::CompleteWithPose(const LaserScan& scan, const Pose2& pose) {
+  SyncedScan synced;
+  synced.scan = scan;
+  synced.odom_from_base = pose;
+  if (last_scan_time_) synced.dt_s = SecondsBetween(scan.time, *last_scan_time_);
+  if (previous_scan_pose_) {
+    synced.increment = previous_scan_pose_->Between(pose);
+    synced.distance_m = RotTransRot::FromIncrement(synced.increment).trans_m;
+    synced.yaw_change_rad = synced.increment.theta();
+  }
+  previous_scan_pose_ = pose;
+  last_scan_time_ = scan.time;
+  return synced;
+}
+
+// Pending scans get the odometry pose at their time: interpolated between the last pose before
+// and `next` after them, else the nearest one there is.
+void ScanSynchronizer::CompletePending(const OdometryPose* next, std::vector<SyncedScan>* out) {
+  for (const LaserScan& scan : pending_) {
+    Pose2 pose;
+    const OdometryPose* last = last_odometry_ ? &*last_odometry_ : nullptr;
+    if (last && next && last->time <= scan.time && scan.time <= next->time) {
+      pose = Interpolate(*last, *next, scan.time);
+    } else if (last) {
+      pose = last->odom_from_base;
+    } else if (next) {
+      pose = next->odom_from_base;
+    } else {
+      ++scans_without_odometry_;
+    }
+    out->push_back(CompleteWithPose(scan, pose));
+  }
+  pending_.clear();
+}
+
 ScanSyncResult SyncToScans(const std::vector<Record>& records, const ScanSyncOptions& options) {
   SLAMRIG_CHECK(options.Validate().empty(), "invalid ScanSyncOptions");
   ScanSyncResult result;
   result.source_used = Resolve(records, options.source);
-  switch (result.source_used) {
-    case OdometrySource::kWheelTicks:
-      SyncTicks(records, options, result);
-      break;
-    case OdometrySource::kOdometryPoses:
-      SyncPoses(records, result);
-      break;
-    case OdometrySource::kAuto:
-    case OdometrySource::kNone:
-      for (const Record& record : records) {
-        if (const auto* scan = std::get_if<LaserScan>(&record)) {
-          SyncedScan synced;
-          synced.scan = *scan;
-          if (!result.scans.empty()) {
-            synced.dt_s = SecondsBetween(scan->time, result.scans.back().scan.time);
-          }
-          result.scans.push_back(std::move(synced));
-        }
-      }
-      result.scans_without_odometry = static_cast<int>(result.scans.size());
-      break;
+  ScanSynchronizer sync(options, result.source_used == OdometrySource::kAuto ? OdometrySource::kNone
+                                                                             : result.source_used);
+  for (const Record& record : records) {
+    for (SyncedScan& s : sync.Add(record)) result.scans.push_back(std::move(s));
   }
+  for (SyncedScan& s : sync.Flush()) result.scans.push_back(std::move(s));
+  result.gyro_fallbacks = sync.gyro_fallbacks();
+  result.scans_without_odometry = sync.scans_without_odometry();
   return result;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,8 +47,48 @@ struct SyncedScan {
 struct ScanSyncResult {
   std::vector<SyncedScan> scans;
   OdometrySource source_used = OdometrySource::kNone;
-  int gyro_fallbacks = 0;       ///< intervals with no IMU sample although use_gyro: yaw held/encoders
+  int gyro_fallbacks = 0;  ///< intervals with no IMU sample although use_gyro: yaw held/encoders
   int scans_without_odometry = 0;  ///< scans before any odometry was seen (identity motion)
+};
+
+/// The incremental form of SyncToScans, for records that arrive one at a time (a simulator
+/// stepping on the same clock as SLAM). Feeding a record list through Add() then Flush() gives
+/// exactly SyncToScans' scans.
+class ScanSynchronizer {
+ public:
+  /// `source` must be resolved: kWheelTicks, kOdometryPoses or kNone (checked).
+  ScanSynchronizer(const ScanSyncOptions& options, OdometrySource source);
+
+  /// Takes the next record and returns the scans it completes: with wheel ticks a scan is
+  /// complete when it arrives; with odometry poses when the next pose after it arrives.
+  std::vector<SyncedScan> Add(const Record& record);
+  /// Completes the scans still waiting for odometry (end of the data).
+  std::vector<SyncedScan> Flush();
+
+  OdometrySource source() const { return source_; }
+  int gyro_fallbacks() const { return gyro_fallbacks_; }
+  int scans_without_odometry() const { return scans_without_odometry_; }
+
+ private:
+  SyncedScan CompleteTicks(const LaserScan& scan);
+  SyncedScan CompleteWithPose(const LaserScan& scan, const Pose2& pose);
+  void CompletePending(const OdometryPose* next, std::vector<SyncedScan>* out);
+
+  ScanSyncOptions options_;
+  OdometrySource source_;
+  int gyro_fallbacks_ = 0;
+  int scans_without_odometry_ = 0;
+  std::optional<Time> last_scan_time_;
+  // Wheel ticks: sums since the previous scan.
+  double right_ticks_ = 0.0, left_ticks_ = 0.0, gyro_sum_ = 0.0;
+  int gyro_count_ = 0;
+  bool seen_ticks_ = false;
+  std::optional<double> held_rate_;  // last interval's mean gyro rate, for dropouts
+  Pose2 pose_;
+  // Odometry poses: the last one seen, and scans waiting for the next one.
+  std::optional<OdometryPose> last_odometry_;
+  std::optional<Pose2> previous_scan_pose_;
+  std::vector<LaserScan> pending_;
 };
 
 /// Reduces time-ordered records to one input per scan, with the scan times as the reference
