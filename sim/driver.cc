@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "sim/messages.h"
 #include "slam/types/check.h"
@@ -34,6 +35,10 @@ std::vector<std::string> DriveOptions::Validate() const {
     positive("max_yaw_rate_rad_s", max_yaw_rate_rad_s);
     positive("max_decel_m_s2", max_decel_m_s2);
     positive("goal_tolerance_m", goal_tolerance_m);
+    if (!(turn_in_place_rad > 0.0 && turn_in_place_rad <= std::numbers::pi)) {
+      errors.push_back("turn_in_place_rad = " + FormatNumber(turn_in_place_rad) +
+                       "; must be in (0, pi]");
+    }
     if (waypoints_m.size() < 2) {
       errors.push_back("waypoints_m has " + std::to_string(waypoints_m.size()) +
                        " points; pure pursuit needs at least 2");
@@ -162,9 +167,11 @@ VelocityCommand Driver::FollowPath(const Pose2& map_from_base) {
   const Eigen::Vector2d target = PointAt(progress_m_ + options_.lookahead_m);
   const Eigen::Vector2d local = base_from_map * target;
   const double dist2 = std::max(local.squaredNorm(), 1e-9);
-  if (local.x() < 0.0) {
-    // Target behind: turn on the spot towards it.
-    return {0.0, std::copysign(0.5 * options_.max_yaw_rate_rad_s, local.y())};
+  const double bearing = std::atan2(local.y(), local.x());
+  if (std::abs(bearing) > options_.turn_in_place_rad) {
+    // Far off the heading: turn on the spot towards it (a skid-steer robot cannot follow a
+    // tight arc, and cutting a corner through a door catches the frame).
+    return {0.0, std::copysign(0.5 * options_.max_yaw_rate_rad_s, bearing)};
   }
   const double curvature = 2.0 * local.y() / dist2;
   double v = options_.speed_m_s;

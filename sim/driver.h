@@ -44,6 +44,8 @@ struct DriveOptions {
   double max_yaw_rate_rad_s = 1.0;           ///< the follower slows down to keep within this
   double max_decel_m_s2 = 0.5;               ///< braking before the end of the path
   double goal_tolerance_m = 0.05;            ///< done when this close to the end of the path
+  double turn_in_place_rad = 0.8;            ///< turn on the spot while the lookahead point is
+                                             ///< further off the heading than this
   std::vector<ScheduleSegment> schedule;     ///< schedule mode
 
   /// One message per broken rule, e.g. "laps = 0; must be >= 1".

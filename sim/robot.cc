@@ -71,6 +71,9 @@ Robot::Robot(const RobotSpec& spec, World* world, const Pose2& map_from_base)
     }
   }
   integral_rad_.assign(wheels_.size(), 0.0);
+  deflection_m_.assign(wheels_.size(), Eigen::Vector2d::Zero());
+  impulse_.assign(wheels_.size(), Eigen::Vector2d::Zero());
+  contacts_.assign(wheels_.size(), Contact{});
 }
 
 Robot::~Robot() { world_->b2world()->DestroyBody(body_); }
@@ -139,33 +142,43 @@ void Robot::ApplyWheelForces(double dt_s, int iterations) {
   }
 
   // Tyre forces by sequential impulses. Per wheel the constraint velocity is the slip
-  // (R * spin - u, -lateral); the soft-constraint impulse P satisfies slip_end = P / (k * load *
-  // dt), with P clamped to the friction circle |P| <= mu * load * dt.
-  std::vector<Eigen::Vector2d> impulse(wheels_.size(), Eigen::Vector2d::Zero());
+  // s = (R * spin - u, -lateral). Implicit Euler on the brush model gives
+  //   z' = (z + dt s') / (1 + a),  a = dt |v_roll| / L,  f = k z' + c s',
+  // i.e. s' = (f - k z / (1 + a)) / d with d = k dt / (1 + a) + c: a soft constraint with
+  // compliance gamma = 1 / (dt d) and a bias from the stored deflection. The impulse P = f dt is
+  // clamped to the friction circle |P| <= mu * load * dt.
   const double inv_m = 1.0 / mass_kg_, inv_i = 1.0 / inertia_kg_m2_;
+  for (std::size_t i = 0; i < wheels_.size(); ++i) {
+    const WheelState& wheel = wheels_[i];
+    const double k = w.contact_stiffness_per_m * wheel.load_n;
+    const double relax =
+        1.0 + dt_s * std::abs(wheel.radius_m * wheel.spin_rad_s) / w.relaxation_length_m;
+    const double d = k * dt_s / relax + w.contact_damping_s_m * wheel.load_n;
+    contacts_[i] = {1.0 / (dt_s * d), k * deflection_m_[i].x() / relax / d,
+                    k * deflection_m_[i].y() / relax / d, relax};
+    impulse_[i].setZero();
+  }
   for (int iteration = 0; iteration < iterations; ++iteration) {
     for (std::size_t i = 0; i < wheels_.size(); ++i) {
       WheelState& wheel = wheels_[i];
+      const Contact& contact = contacts_[i];
       const double x = wheel.position_m.x(), y = wheel.position_m.y(), r = wheel.radius_m;
-      const double u = vx - omega * y;
-      const double lateral = vy + omega * x;
-      const Eigen::Vector2d slip(r * wheel.spin_rad_s - u, -lateral);
-      const double gamma_x = 1.0 / (w.longitudinal_stiffness_s_m * wheel.load_n * dt_s);
-      const double gamma_y = 1.0 / (w.lateral_stiffness_s_m * wheel.load_n * dt_s);
-      // Solve (K + diag(gamma)) dP = slip - gamma * P for the 2x2 effective mass K.
-      const double k11 = r * r / spin_inertia + inv_m + y * y * inv_i + gamma_x;
+      const double slip_x = r * wheel.spin_rad_s - (vx - omega * y);
+      const double slip_y = -(vy + omega * x);
+      // Solve (K + gamma I) dP = s - gamma P + bias for the 2x2 effective mass K.
+      const double k11 = r * r / spin_inertia + inv_m + y * y * inv_i + contact.gamma;
       const double k12 = -x * y * inv_i;
-      const double k22 = inv_m + x * x * inv_i + gamma_y;
-      const double rhs1 = slip.x() - gamma_x * impulse[i].x();
-      const double rhs2 = slip.y() - gamma_y * impulse[i].y();
+      const double k22 = inv_m + x * x * inv_i + contact.gamma;
+      const double rhs1 = slip_x - contact.gamma * impulse_[i].x() + contact.bias_x;
+      const double rhs2 = slip_y - contact.gamma * impulse_[i].y() + contact.bias_y;
       const double det = k11 * k22 - k12 * k12;
       Eigen::Vector2d total =
-          impulse[i] + Eigen::Vector2d(k22 * rhs1 - k12 * rhs2, k11 * rhs2 - k12 * rhs1) / det;
+          impulse_[i] + Eigen::Vector2d(k22 * rhs1 - k12 * rhs2, k11 * rhs2 - k12 * rhs1) / det;
       const double limit = wheel.mu * wheel.load_n * dt_s;
       const double norm = total.norm();
       if (norm > limit) total *= norm > 0.0 ? limit / norm : 0.0;
-      const Eigen::Vector2d delta = total - impulse[i];
-      impulse[i] = total;
+      const Eigen::Vector2d delta = total - impulse_[i];
+      impulse_[i] = total;
       vx += delta.x() * inv_m;
       vy += delta.y() * inv_m;
       omega += (x * delta.y() - y * delta.x()) * inv_i;
@@ -173,18 +186,49 @@ void Robot::ApplyWheelForces(double dt_s, int iterations) {
     }
   }
 
-  // Ground truth of the contacts, then turn the wheels.
-  for (std::size_t i = 0; i < wheels_.size(); ++i) {
-    WheelState& wheel = wheels_[i];
-    wheel.slip_m_s = wheel.radius_m * wheel.spin_rad_s - (vx - omega * wheel.position_m.y());
-    wheel.skid_m_s = vy + omega * wheel.position_m.x();
-    const double limit = wheel.mu * wheel.load_n * dt_s;
-    wheel.friction_use = limit > 0.0 ? std::min(1.0, impulse[i].norm() / limit) : 1.0;
-    wheel.angle_rad += wheel.spin_rad_s * dt_s;
-  }
   body_->SetLinearVelocity(
       b2Vec2(static_cast<float>(c * vx - s * vy), static_cast<float>(s * vx + c * vy)));
   body_->SetAngularVelocity(static_cast<float>(omega));
+}
+
+void Robot::FinishStep(double dt_s) {
+  // The slip the tyres really saw: with the chassis velocity after Box2D resolved its contacts
+  // (a robot pushing a wall is stopped there, not in the tyre solve).
+  const double yaw = body_->GetAngle();
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  const b2Vec2 v_world = body_->GetLinearVelocity();
+  const double vx = c * v_world.x + s * v_world.y;
+  const double vy = -s * v_world.x + c * v_world.y;
+  const double omega = body_->GetAngularVelocity();
+  const double spin_inertia = spec_.wheels.spin_inertia_kg_m2;
+  for (std::size_t i = 0; i < wheels_.size(); ++i) {
+    WheelState& wheel = wheels_[i];
+    const double r = wheel.radius_m;
+    // Box2D's contacts may have changed the chassis velocity the tyres were solved against (a
+    // wall stops the chassis, not the wheels): one more longitudinal pass drags each wheel
+    // towards the chassis as it now moves, the chassis held fixed, so that a stalled wheel does
+    // not creep. Without contacts the tyre constraint already holds and this adds nothing.
+    const Contact& contact = contacts_[i];
+    const double slip = r * wheel.spin_rad_s - (vx - omega * wheel.position_m.y());
+    const double k = r * r / spin_inertia + contact.gamma;
+    double total = impulse_[i].x() + (slip - contact.gamma * impulse_[i].x() + contact.bias_x) / k;
+    const double limit_x = std::sqrt(std::max(
+        0.0, std::pow(wheel.mu * wheel.load_n * dt_s, 2) - impulse_[i].y() * impulse_[i].y()));
+    total = std::clamp(total, -limit_x, limit_x);
+    wheel.spin_rad_s -= r * (total - impulse_[i].x()) / spin_inertia;
+    impulse_[i].x() = total;
+
+    wheel.slip_m_s = r * wheel.spin_rad_s - (vx - omega * wheel.position_m.y());
+    wheel.skid_m_s = vy + omega * wheel.position_m.x();
+    // The tread deflection, capped where the tyre slides.
+    Eigen::Vector2d& z = deflection_m_[i];
+    z = (z + dt_s * Eigen::Vector2d(wheel.slip_m_s, -wheel.skid_m_s)) / contact.relax;
+    const double max_deflection = wheel.mu / spec_.wheels.contact_stiffness_per_m;
+    if (z.norm() > max_deflection) z *= max_deflection / z.norm();
+    const double limit = wheel.mu * wheel.load_n * dt_s;
+    wheel.friction_use = limit > 0.0 ? std::min(1.0, impulse_[i].norm() / limit) : 1.0;
+    wheel.angle_rad += wheel.spin_rad_s * dt_s;
+  }
 }
 
 }  // namespace slamrig::sim

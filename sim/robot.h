@@ -30,11 +30,13 @@ struct WheelState {
 /// A differential-drive (or skid-steer) robot as a Box2D body driven by its wheels. Each wheel
 /// has its own spin state and a motor with a torque limit and a PI speed loop towards the speed
 /// its side needs for the commanded (v, omega), computed with the nominal radius and track.
-/// Tyre forces follow a regularised Coulomb law: proportional to the slip velocity (the
-/// longitudinal and lateral stiffness) and capped at mu * load on the friction circle. They are
-/// solved implicitly together with the wheel spin and the chassis velocity by sequential impulses
-/// (Catto, "Iterative Dynamics with Temporal Coherence", GDC 2005; soft constraints as in Box2D),
-/// so stiff tyres stay stable at physics rates of 200 Hz. Rolling resistance brakes each wheel.
+/// Each tyre contact is a first-order brush model with a relaxation length (Pacejka, "Tire and
+/// Vehicle Dynamics", 3rd ed., Ch. 7): a tread deflection z with dz/dt = slip - |v_roll| / L * z,
+/// force k z + c slip, capped at mu * load on the friction circle (longitudinal and lateral
+/// together). Tyre forces, wheel spin and chassis velocity are solved implicitly by sequential
+/// impulses (Catto, "Iterative Dynamics with Temporal Coherence", GDC 2005, with the soft
+/// constraints of Box2D), so the stiff contact stays stable at physics rates of 200 Hz. Rolling
+/// resistance brakes each wheel.
 class Robot {
  public:
   /// Creates the body in `world` at `map_from_base`. `spec` must be valid (checked).
@@ -48,8 +50,11 @@ class Robot {
   void SetCommand(const VelocityCommand& command) { command_ = command; }
 
   /// Runs the motors and the tyre forces for a physics step of `dt_s`, changing the body's
-  /// velocity, and turns the wheels. Call before stepping the Box2D world.
+  /// velocity (`iterations` sequential-impulse passes). Call before stepping the Box2D world.
   void ApplyWheelForces(double dt_s, int iterations);
+  /// Completes the step after the Box2D world moved: tread deflections from the slip the tyres
+  /// really saw, contact state for the ground truth, wheel rotation for the encoders.
+  void FinishStep(double dt_s);
 
   /// Pose of base_link in the map frame.
   Pose2 pose() const;
@@ -77,7 +82,16 @@ class Robot {
   double mass_kg_ = 0.0;
   double inertia_kg_m2_ = 0.0;
   std::vector<WheelState> wheels_;
-  std::vector<double> integral_rad_;  // PI speed loop state per wheel
+  std::vector<double> integral_rad_;           // PI speed loop state per wheel
+  std::vector<Eigen::Vector2d> deflection_m_;  // tread deflection per wheel, base_link axes
+  std::vector<Eigen::Vector2d> impulse_;       // tyre impulse per wheel in the last step
+  struct Contact {
+    double gamma = 0.0;   // soft-constraint compliance
+    double bias_x = 0.0;  // stored-deflection bias, longitudinal
+    double bias_y = 0.0;  // and lateral
+    double relax = 1.0;   // deflection relaxation factor 1 + dt |v_roll| / L
+  };
+  std::vector<Contact> contacts_;  // per wheel, for the step under way
   VelocityCommand command_;
   VelocityCommand ramped_;
 };

@@ -45,8 +45,9 @@ std::vector<std::string> WheelOptions::Validate() const {
     errors.push_back("caster_load_fraction = " + FormatNumber(caster_load_fraction) +
                      "; must be in [0, 1)");
   }
-  RequirePositive(&errors, "longitudinal_stiffness_s_m", longitudinal_stiffness_s_m);
-  RequirePositive(&errors, "lateral_stiffness_s_m", lateral_stiffness_s_m);
+  RequirePositive(&errors, "contact_stiffness_per_m", contact_stiffness_per_m);
+  RequirePositive(&errors, "relaxation_length_m", relaxation_length_m);
+  RequirePositive(&errors, "contact_damping_s_m", contact_damping_s_m);
   return errors;
 }
 

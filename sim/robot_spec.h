@@ -30,8 +30,14 @@ struct WheelOptions {
   double wheelbase_m = 0.3302;        ///< front to rear wheel distance (per_side > 1)
   double spin_inertia_kg_m2 = 0.02;   ///< wheel plus motor and gearbox reflected to the axle
   double caster_load_fraction = 0.0;  ///< share of the weight on passive casters
-  double longitudinal_stiffness_s_m = 30.0;  ///< traction / load per m/s of slip before saturation
-  double lateral_stiffness_s_m = 30.0;       ///< side force / load per m/s of skid
+  /// Tyre contact: the tread deflects like a spring (force / load per metre of deflection), the
+  /// deflection relaxes as the tread rolls out of the contact patch (over the relaxation length),
+  /// and a damper acts on the slip velocity (force / load per m/s). Rolling under traction thus
+  /// slips in proportion to speed (a slip ratio), a stalled wheel holds without creeping, and the
+  /// force never exceeds mu * load.
+  double contact_stiffness_per_m = 500.0;
+  double relaxation_length_m = 0.03;
+  double contact_damping_s_m = 30.0;
 
   /// One message per broken rule.
   std::vector<std::string> Validate() const;

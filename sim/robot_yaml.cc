@@ -23,8 +23,9 @@ void VisitFields(V& v, WheelOptions& w) {
   v("wheelbase_m", w.wheelbase_m);
   v("spin_inertia_kg_m2", w.spin_inertia_kg_m2);
   v("caster_load_fraction", w.caster_load_fraction);
-  v("longitudinal_stiffness_s_m", w.longitudinal_stiffness_s_m);
-  v("lateral_stiffness_s_m", w.lateral_stiffness_s_m);
+  v("contact_stiffness_per_m", w.contact_stiffness_per_m);
+  v("relaxation_length_m", w.relaxation_length_m);
+  v("contact_damping_s_m", w.contact_damping_s_m);
 }
 
 template <typename V>

@@ -91,6 +91,7 @@ StepResult Simulator::Step() {
   robot_->ApplyWheelForces(step_s_, options_.traction_iterations);
   world_->b2world()->Step(static_cast<float>(step_s_), options_.velocity_iterations,
                           options_.position_iterations);
+  robot_->FinishStep(step_s_);
   time_.ns += step_ns_;
   history_.push_back(TakeSnapshot());
 

@@ -87,6 +87,7 @@ void VisitFields(V& v, DriveOptions& d) {
   v("max_yaw_rate_rad_s", d.max_yaw_rate_rad_s);
   v("max_decel_m_s2", d.max_decel_m_s2);
   v("goal_tolerance_m", d.goal_tolerance_m);
+  v("turn_in_place_rad", d.turn_in_place_rad);
   v.List("schedule", d.schedule);
 }
 

@@ -1,0 +1,47 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "sim/simulator.h"
+#include "slam/types/pose2.h"
+
+namespace slamrig::sim {
+
+/// How long a written run lasts.
+struct RunOptions {
+  /// Simulated seconds; 0 runs until the world's driver finishes (which an idle drive never does).
+  double duration_s = 0.0;
+  /// Safety stop for duration_s = 0, seconds.
+  double max_duration_s = 7200.0;
+
+  /// One message per broken rule.
+  std::vector<std::string> Validate() const;
+};
+
+/// What a written run contains.
+struct RunSummary {
+  double duration_s = 0.0;
+  bool drive_finished = false;
+  int num_scans = 0;
+  int num_odometry = 0;
+  int num_imu = 0;
+  Pose2 final_truth;     ///< map_from_base at the end
+  Pose2 final_odometry;  ///< odom_from_base at the end (the robot's own encoder + gyro estimate)
+  double path_length_m = 0.0;
+  std::vector<std::string> files;  ///< paths written
+};
+
+/// Runs a simulation and writes it into `out_dir` (created if missing), every file atomically:
+///  - run.log: a CARMEN log (PARAM, ODOM, ROBOTLASER1, TRUEPOS). ODOM is the robot's own
+///    odometry, slam::WheelOdometry on the encoder ticks and gyro with the nominal radius and
+///    track; each scan carries the odometry pose interpolated to its time, and a TRUEPOS line
+///    follows it with the ground truth.
+///  - truth.tum: ground truth at every scan time (TUM format).
+///  - world.yaml, robot.yaml: the resolved world and robot; sim.yaml: seed, rates, duration.
+/// Equal options give byte-identical files. Throws std::runtime_error when a file cannot be
+/// written.
+RunSummary WriteSimulationRun(const SimulatorOptions& options, const RunOptions& run,
+                              const std::string& out_dir);
+
+}  // namespace slamrig::sim
