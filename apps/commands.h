@@ -14,6 +14,7 @@ struct Command {
 };
 
 int RunMapCommand(const std::vector<std::string>& args);
+int RunSimulateCommand(const std::vector<std::string>& args);
 
 /// All subcommands, in the order `slamrig --help` lists them.
 const std::vector<Command>& Commands();

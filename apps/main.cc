@@ -14,6 +14,7 @@ namespace slamrig::app {
 const std::vector<Command>& Commands() {
   static const std::vector<Command> commands = {
       {"map", "build the occupancy map of a log from its logged poses", RunMapCommand},
+      {"simulate", "simulate a robot in a world: CARMEN log plus ground truth", RunSimulateCommand},
   };
   return commands;
 }
