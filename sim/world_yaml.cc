@@ -114,7 +114,7 @@ WorldSpec ParseWorldSpec(const YamlNode& node) {
     namespace fs = std::filesystem;
     fs::path map_path(spec.map->yaml_path);
     if (map_path.is_relative()) map_path = fs::path(node.file()).parent_path() / map_path;
-    spec.map->yaml_path = map_path.lexically_normal().string();
+    spec.map->yaml_path = std::filesystem::absolute(map_path).lexically_normal().string();
     if (!fs::exists(map_path)) {
       map_node.Required("yaml_path").Fail("no such map file '" + spec.map->yaml_path + "'");
     }

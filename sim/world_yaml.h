@@ -9,7 +9,8 @@ namespace slamrig::sim {
 
 /// Reads a world file (worlds/*.yaml) strictly: unknown keys, wrong types and broken rules are a
 /// ConfigError naming file, line, column and key path. A relative map path is resolved against
-/// the file's folder, and the map is read once to check it (its errors are reported too).
+/// the file's folder and stored absolute, and the map is read once to check it (its errors are
+/// reported too, after the world file's own location).
 WorldSpec LoadWorldSpec(const std::string& path);
 
 /// Reads a world from `node` (e.g. the `world:` section of a scenario). Unknown keys are left to
