@@ -22,7 +22,7 @@ double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
 }
 
 struct Transform {
-  Eigen::Vector2d p;
+  Eigen::Vector2d p = Eigen::Vector2d::Zero();
   double c = 1.0, s = 0.0;
   Eigen::Vector2d Apply(const Eigen::Vector2d& v) const {
     return {p.x() + c * v.x() - s * v.y(), p.y() + s * v.x() + c * v.y()};

@@ -10,9 +10,9 @@ namespace slamrig::sim {
 
 /// One ray of a fan, in the map frame.
 struct Ray {
-  Eigen::Vector2d origin;     ///< start point
-  Eigen::Vector2d direction;  ///< unit vector
-  double angle_rad = 0.0;     ///< atan2 of `direction` plus any multiple of 2 pi (see Cast)
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();      ///< start point
+  Eigen::Vector2d direction = Eigen::Vector2d::UnitX();  ///< unit vector
+  double angle_rad = 0.0;  ///< atan2 of `direction` plus any multiple of 2 pi (see Cast)
 };
 
 /// Casts fans of rays against the fixtures of a Box2D world, analytically and fast, with the hit
@@ -41,13 +41,13 @@ class RayCaster {
 
  private:
   struct Segment {
-    Eigen::Vector2d a;       // start
-    Eigen::Vector2d e;       // end - start
-    Eigen::Vector2d normal;  // outward unit normal of a solid polygon's side
+    Eigen::Vector2d a = Eigen::Vector2d::Zero();       // start
+    Eigen::Vector2d e = Eigen::Vector2d::Zero();       // end - start
+    Eigen::Vector2d normal = Eigen::Vector2d::Zero();  // outward unit normal of a polygon side
     bool one_sided = false;  // hit only when entering through the normal's side
   };
   struct Circle {
-    Eigen::Vector2d center;
+    Eigen::Vector2d center = Eigen::Vector2d::Zero();
     double radius = 0.0;
   };
   struct FixtureShapes {
