@@ -34,6 +34,7 @@ ParticleFilter::ParticleFilter(const ParticleFilterOptions& options)
       map_(options.map),
       correlator_(options.correlation),
       likelihood_field_(options.likelihood_field),
+      refiner_(options.refiner),
       rng_(options.seed) {
   SLAMRIG_CHECK(options_.Validate().empty(), "invalid ParticleFilterOptions");
   if (options_.num_threads > 1) pool_ = std::make_unique<ThreadPool>(options_.num_threads);
@@ -60,24 +61,32 @@ void ParticleFilter::Predict(const Pose2& odometry_increment) {
 std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& points,
                                          float* best_score) {
   const int n = options_.num_particles;
-  GridView view = GridView::Of(map_);
-  if (options_.observation == ObservationModel::kLikelihoodField) {
+  const bool use_field = options_.observation == ObservationModel::kLikelihoodField;
+  GridView field_view;
+  if (use_field || options_.refine) {
     // The field only needs to cover where this scan can land for some particle and shift.
     Eigen::AlignedBox2d particles_box;
     for (const Particle& p : particles_) particles_box.extend(p.pose.translation());
     double reach = 0.0;
     for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
-    const double margin = reach + (options_.correlation.xy_half_width_cells + 1) * map_.resolution() +
+    const double margin = reach + (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
                           options_.likelihood_field.cutoff_sigmas * options_.likelihood_field.sigma_m;
     const Eigen::Vector2d m = Eigen::Vector2d::Constant(margin);
     likelihood_field_.Update(map_, Eigen::AlignedBox2d(particles_box.min() - m, particles_box.max() + m));
-    view = likelihood_field_.view();
+    field_view = likelihood_field_.view();
   }
+  const GridView view = use_field ? field_view : GridView::Of(map_);
+  const float field_max = static_cast<float>(likelihood_field_.Score(0.0));
   std::vector<CorrelationResult> results(static_cast<std::size_t>(n));
   auto score_block = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
-      results[static_cast<std::size_t>(i)] =
-          correlator_.Correlate(view, points, particles_[static_cast<std::size_t>(i)].pose);
+      CorrelationResult& r = results[static_cast<std::size_t>(i)];
+      r = correlator_.Correlate(view, points, particles_[static_cast<std::size_t>(i)].pose);
+      if (options_.refine) {
+        const RefineResult refined = refiner_.Refine(field_view, field_max, points, r.pose);
+        r.pose = refined.pose;
+        if (use_field) r.score = static_cast<float>(refined.score);
+      }
     }
   };
   if (pool_) {

@@ -6,6 +6,7 @@
 #include "slam/grid/occupancy_grid.h"
 #include "slam/matching/likelihood_field.h"
 #include "slam/matching/map_correlator.h"
+#include "slam/matching/scan_refiner.h"
 #include "slam/pf/particle_filter_options.h"
 #include "slam/pf/thread_pool.h"
 #include "slam/types/pose2.h"
@@ -57,6 +58,7 @@ class ParticleFilter {
   OccupancyGrid map_;
   MapCorrelator correlator_;
   LikelihoodField likelihood_field_;
+  ScanRefiner refiner_;
   RandomEngine rng_;
   std::unique_ptr<ThreadPool> pool_;
   std::vector<Particle> particles_;

@@ -28,6 +28,7 @@ ParticleFilterOptions ParticleFilterOptions::ReportsPreset() {
   o.correlation = MapCorrelatorOptions{4, 0, 0.01, CorrelationValue::kOccupiedIndicator, 0.0f};
   o.observation_scale = 1.0;
   o.move_to_best_shift = false;
+  o.refine = false;
   o.resampling = ResamplingScheme::kStratified;
   o.resample_neff_ratio = 0.5;
   // 80 % trust: +log 4 on hits, -log 4 on free cells, every beam counts.
@@ -58,6 +59,14 @@ std::vector<std::string> ParticleFilterOptions::Validate() const {
   Prefixed(points.Validate(), errors);
   Prefixed(correlation.Validate(), errors);
   Prefixed(likelihood_field.Validate(), errors);
+  Prefixed(refiner.Validate(), errors);
+  if (observation == ObservationModel::kLikelihoodField &&
+      correlation.value != CorrelationValue::kRawValue) {
+    errors.push_back("pf.correlation.value = indicator; must be raw with the likelihood field");
+  }
+  if (refine && !move_to_best_shift) {
+    errors.push_back("pf.refine = true; needs pf.move_to_best_shift = true");
+  }
   for (const std::string& e : map.Validate()) errors.push_back("pf.map." + e);
   return errors;
 }

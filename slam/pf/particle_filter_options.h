@@ -8,6 +8,7 @@
 #include "slam/matching/likelihood_field.h"
 #include "slam/matching/map_correlator.h"
 #include "slam/matching/scan_points.h"
+#include "slam/matching/scan_refiner.h"
 #include "slam/odometry/rot_trans_rot_model.h"
 #include "slam/pf/resampling.h"
 
@@ -29,7 +30,9 @@ enum class ObservationModel {
   kLikelihoodField,  ///< sum of likelihood-field log-likelihoods (Probabilistic Robotics, 6.4)
 };
 
-/// Everything the particle filter can be told. Defaults are the improved filter;
+/// Everything the particle filter can be told. Defaults are the improved filter (likelihood
+/// field, x/y/yaw search, best-shift moves, Gauss-Newton refinement, rot-trans-rot noise,
+/// systematic resampling; tuned on intel-corrected over 16 seeds, ATE 0.07-0.12 m);
 /// `ReportsPreset()` reproduces the ECE276A reports.
 struct ParticleFilterOptions {
   int num_particles = 100;
@@ -38,16 +41,22 @@ struct ParticleFilterOptions {
   MotionNoiseModel motion_noise = MotionNoiseModel::kRotTransRot;
   double sigma_xy_m = 0.01;      ///< kGaussianPerStep: per step, x and y (world frame)
   double sigma_yaw_rad = 0.005;  ///< kGaussianPerStep: per step, yaw
-  RotTransRotNoise rot_trans_rot{0.02, 0.002, 0.01, 0.0005, 0.005, 0.003};  ///< kRotTransRot
+  RotTransRotNoise rot_trans_rot{0.02, 0.01, 0.01, 0.0005, 0.005, 0.003};  ///< kRotTransRot
 
-  ObservationModel observation = ObservationModel::kMapCorrelation;
+  ObservationModel observation = ObservationModel::kLikelihoodField;
   ScanPointsOptions points{0.1, 30.0, 1, 0.05};  ///< beams used for weighting (voxel-filtered)
-  MapCorrelatorOptions correlation{4, 2, 0.01, CorrelationValue::kOccupiedIndicator, 0.0f};
-  LikelihoodFieldOptions likelihood_field;
+  /// The shift search: 9x9 cells and 9 yaws 0.0075 rad apart. With kLikelihoodField its `value`
+  /// must be kRawValue.
+  MapCorrelatorOptions correlation{4, 4, 0.0075, CorrelationValue::kRawValue, 0.0f};
+  LikelihoodFieldOptions likelihood_field{0.08, 0.9, 0.1, 0.0f, 3.0};
   /// log-weight += observation_scale * score (the softmax temperature; 1 in the reports).
-  double observation_scale = 1.0;
+  double observation_scale = 0.5;
   /// Move each particle to its best shift (the reports' "future work"); false: only weight it.
   bool move_to_best_shift = true;
+  /// Then refine each particle to sub-cell accuracy by Gauss-Newton on the likelihood field
+  /// (needs move_to_best_shift); with the likelihood-field model the weight uses the refined score.
+  bool refine = true;
+  ScanRefinerOptions refiner;
 
   ResamplingScheme resampling = ResamplingScheme::kSystematic;
   /// Resample when Neff = 1 / sum(w^2) < resample_neff_ratio * num_particles (reports: 0.5).

@@ -1,0 +1,52 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "slam/matching/grid_view.h"
+#include "slam/types/pose2.h"
+
+namespace slamrig::slam {
+
+/// Gauss-Newton refinement of a scan pose on a smooth raster.
+struct ScanRefinerOptions {
+  int max_iterations = 6;
+  double max_step_m = 0.05;        ///< a larger translation step is scaled down to this
+  double max_step_rad = 0.02;      ///< a larger rotation step is scaled down to this
+  double converged_step_m = 1e-4;  ///< stop when the step is smaller (and its rotation < 1e-4 rad)
+
+  /// One message per broken rule (prefixed "refine.").
+  std::vector<std::string> Validate() const;
+};
+
+/// A refined pose and its score.
+struct RefineResult {
+  Pose2 pose;
+  double score = 0.0;  ///< sum over points of the bilinearly interpolated raster value
+  int iterations = 0;
+};
+
+/// Sub-cell scan alignment: maximises the bilinearly interpolated raster values at the scan points
+/// by Gauss-Newton on the residuals 1 - M(S(xi) p) with M the raster scaled to [0, 1]
+/// (Kohlbrecher et al., "A Flexible and Scalable SLAM System with Full 3D Motion Estimation"
+/// (Hector SLAM), SSRR 2011, Sec. IV-A, Eqs. 6-13), run on the likelihood field instead of the
+/// occupancy probabilities. A step that lowers the score is not taken. Thread-safe.
+class ScanRefiner {
+ public:
+  explicit ScanRefiner(const ScanRefinerOptions& options);
+
+  /// Refines `initial`; `max_value` is the raster's largest possible value (scales M to [0, 1]).
+  RefineResult Refine(const GridView& raster, float max_value,
+                      std::span<const Eigen::Vector2d> points_base, const Pose2& initial) const;
+
+  /// Sum over points of the interpolated raster value at `pose`.
+  static double Score(const GridView& raster, std::span<const Eigen::Vector2d> points_base,
+                      const Pose2& pose);
+
+ private:
+  ScanRefinerOptions options_;
+};
+
+}  // namespace slamrig::slam
