@@ -1,7 +1,10 @@
 // `slamrig simulate WORLD --out DIR`: a simulated run written as a CARMEN log plus ground truth.
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
 
 #include "apps/cli_args.h"
@@ -67,7 +70,7 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
       options.world.name.c_str(), options.robot.name.c_str(), static_cast<unsigned long long>(seed),
       summary.duration_s, summary.drive_finished ? " (drive done)" : "", summary.path_length_m,
       summary.num_scans, summary.num_odometry, summary.num_imu, error.translation().norm(),
-      std::abs(error.theta()) * 180.0 / 3.141592653589793, seconds,
+      std::abs(error.theta()) * 180.0 / std::numbers::pi, seconds,
       summary.duration_s / std::max(seconds, 1e-9), out_dir.c_str());
   return 0;
 }

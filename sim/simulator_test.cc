@@ -200,5 +200,44 @@ TEST(SimulatorTest, EachBeamIsCastFromThePoseAtItsOwnTime) {
   EXPECT_GT(skew_effect, 0.03);
 }
 
+TEST(SimulatorTest, TheLidarSeesAMovingObstacleWhereItIs) {
+  // A standing robot looks along +x; a 1 m wide trolley crosses 4 m ahead, and beyond it a wall.
+  SimulatorOptions o;
+  o.robot = WithoutNoise(RobotSpec{});
+  ShapeSpec wall;
+  wall.center_m = {8.0, 0.0};
+  wall.size_m = {0.2, 20.0};
+  o.world.walls.push_back(wall);
+  ObstacleSpec trolley;
+  trolley.shape.size_m = {0.6, 1.0};
+  trolley.path_m = {{4.3, -3.0}, {4.3, 3.0}};
+  trolley.speed_m_s = 1.0;
+  trolley.loop = false;
+  o.world.obstacles.push_back(trolley);
+  Simulator sim(o);
+  const double laser_x = o.robot.lidar.mount.x_m;
+  int blocked = 0, clear = 0;
+  while (sim.time().seconds() < 6.0) {
+    const StepResult step = sim.Step();
+    for (const Record& r : step.records) {
+      const auto* scan = std::get_if<LaserScan>(&r);
+      if (scan == nullptr) continue;
+      const std::size_t ahead = scan->ranges_m.size() / 2;  // beam 540 points along +x
+      // The trolley's centre when this beam was taken; it moves 2 cm during one scan.
+      const Time t = AddSeconds(scan->time, static_cast<double>(ahead) * scan->time_increment_s);
+      const double y = sim.world().ObstaclePositionAt(0, t).y();
+      if (std::abs(y) < 0.45) {
+        EXPECT_NEAR(scan->ranges_m[ahead], 4.0 - laser_x, 1e-3) << "t = " << t.seconds();
+        ++blocked;
+      } else if (std::abs(y) > 0.55) {
+        EXPECT_NEAR(scan->ranges_m[ahead], 7.9 - laser_x, 1e-3) << "t = " << t.seconds();
+        ++clear;
+      }
+    }
+  }
+  EXPECT_GT(blocked, 20);
+  EXPECT_GT(clear, 100);
+}
+
 }  // namespace
 }  // namespace slamrig::sim
