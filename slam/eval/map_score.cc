@@ -38,8 +38,8 @@ std::vector<std::string> MapScoreOptions::Validate() const {
   return errors;
 }
 
-MapScore ScoreMap(const OccupancyGrid& estimate, const OccupancyGrid& truth,
-                  const Pose2& truth_from_estimate, const MapScoreOptions& options) {
+MapScore ScoreMap(const OccupancyGrid& estimate, const Pose2& truth_from_estimate,
+                  const OccupancyGrid& truth, const MapScoreOptions& options) {
   SLAMRIG_CHECK(options.Validate().empty(), "invalid MapScoreOptions");
   // Occupied cells of both maps on the truth lattice (cell indices may fall outside the truth grid).
   const double occupied_log_odds =

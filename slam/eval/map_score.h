@@ -33,7 +33,7 @@ struct MapScore {
 
 /// Scores `estimate` against `truth`. `truth_from_estimate` maps the estimate's frame into the
 /// truth's (the ATE alignment); each estimate cell centre is moved by it to a truth cell.
-MapScore ScoreMap(const OccupancyGrid& estimate, const OccupancyGrid& truth,
-                  const Pose2& truth_from_estimate, const MapScoreOptions& options = {});
+MapScore ScoreMap(const OccupancyGrid& estimate, const Pose2& truth_from_estimate,
+                  const OccupancyGrid& truth, const MapScoreOptions& options = {});
 
 }  // namespace slamrig::slam
