@@ -23,15 +23,15 @@ OccupancyGrid Wall(int shift_cells, const Pose2& world_from_wall = Pose2()) {
 
 TEST(MapScoreTest, ToleranceOfOneCell) {
   const OccupancyGrid truth = Wall(0);
-  const MapScore same = ScoreMap(Wall(0), Pose2(, truth));
+  const MapScore same = ScoreMap(Wall(0), Pose2(), truth);
   EXPECT_EQ(same.estimate_occupied, 79);
   EXPECT_DOUBLE_EQ(same.f1, 1.0);
   EXPECT_DOUBLE_EQ(same.iou, 1.0);
-  EXPECT_DOUBLE_EQ(ScoreMap(Wall(1), Pose2(, truth)).f1, 1.0);
+  EXPECT_DOUBLE_EQ(ScoreMap(Wall(1), Pose2(), truth).f1, 1.0);
   MapScoreOptions exact;
   exact.tolerance_cells = 0;
   // Shifted up by a cell: only the vertical wall's cells still coincide.
-  const MapScore shifted = ScoreMap(Wall(1), Pose2(, truth), exact);
+  const MapScore shifted = ScoreMap(Wall(1), Pose2(), truth, exact);
   EXPECT_EQ(shifted.estimate_matched, 39);
   EXPECT_NEAR(shifted.precision, 39.0 / 79.0, 1e-12);
   EXPECT_NEAR(shifted.iou, shifted.f1 / (2 - shifted.f1), 1e-12);
@@ -41,8 +41,8 @@ TEST(MapScoreTest, AlignmentMovesTheEstimateIntoTheTruthFrame) {
   const Pose2 motion(1.0, 2.0, 0.5);
   const OccupancyGrid moved = Wall(0, motion);
   const OccupancyGrid truth = Wall(0);
-  EXPECT_LT(ScoreMap(moved, Pose2(, truth)).f1, 0.1);
-  EXPECT_GT(ScoreMap(moved, motion.Inverse(, truth)).f1, 0.95);
+  EXPECT_LT(ScoreMap(moved, Pose2(), truth).f1, 0.1);
+  EXPECT_GT(ScoreMap(moved, motion.Inverse(), truth).f1, 0.95);
 }
 
 }  // namespace
