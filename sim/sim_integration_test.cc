@@ -108,6 +108,26 @@ TEST(SimIntegrationTest, WithoutNoiseOnAGrippyFloorEncoderDistanceMatchesWithinH
   EXPECT_NEAR(r.encoder_distance_m / r.true_distance_m, 1.0, 0.005);
 }
 
+TEST(SimIntegrationTest, TheOfficeIcePatchMakesTheEncodersOverstateTheDistance) {
+  // The robot speeds up out of the south-east corner on the ice patch: the wheels spin.
+  SimulatorOptions icy = OfficeThreeLaps();
+  icy.robot = WithoutNoise(icy.robot);
+  icy.robot.lidar.enabled = false;
+  icy.world.drive.laps = 1;
+  SimulatorOptions dry = icy;
+  for (ZoneSpec& zone : dry.world.zones) {
+    if (zone.name == "ice") zone.surface = dry.world.floor;
+  }
+  const LoopResult on_ice = DriveOffice(icy), without_ice = DriveOffice(dry);
+  const double excess_icy = on_ice.encoder_distance_m - on_ice.true_distance_m;
+  const double excess_dry = without_ice.encoder_distance_m - without_ice.true_distance_m;
+  std::printf(
+      "office, 1 lap, no noise: encoders exceed the true distance by %.3f m with the ice "
+      "patch, %.3f m without\n",
+      excess_icy, excess_dry);
+  EXPECT_GT(excess_icy, excess_dry + 0.05);
+}
+
 TEST(SimIntegrationTest, EveryWorldIsDrivenToTheEndByEveryRobot) {
   for (const char* world : {"office", "corridor", "two_rooms", "hall", "lab_map"}) {
     for (const char* robot : {"ece276a", "small_diff"}) {
