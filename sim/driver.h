@@ -11,15 +11,15 @@ namespace slamrig::sim {
 
 /// A body-frame velocity command: forward speed and yaw rate (REP-103: x forward, CCW positive).
 struct VelocityCommand {
-  double v_m_s = 0.0;
-  double omega_rad_s = 0.0;
+  double v_m_s = 0.0;        ///< forward speed, m/s
+  double omega_rad_s = 0.0;  ///< yaw rate, rad/s, CCW positive
 };
 
 /// One piece of a scripted drive: hold (v, omega) for `duration_s`.
 struct ScheduleSegment {
-  double duration_s = 1.0;
-  double v_m_s = 0.0;
-  double omega_rad_s = 0.0;
+  double duration_s = 1.0;   ///< how long to hold the command, s
+  double v_m_s = 0.0;        ///< forward speed, m/s
+  double omega_rad_s = 0.0;  ///< yaw rate, rad/s
 };
 
 /// How the robot is driven.
@@ -35,7 +35,7 @@ const char* DriveModeName(DriveMode mode);
 /// The autopilot of a simulated run. Pure pursuit steers on the true pose: the driver is part of
 /// the scenario, not of the robot under test.
 struct DriveOptions {
-  DriveMode mode = DriveMode::kIdle;
+  DriveMode mode = DriveMode::kIdle;         ///< which of the two drivers, or none
   std::vector<Eigen::Vector2d> waypoints_m;  ///< path in the map frame (waypoints mode)
   bool closed = true;                        ///< the path returns to its first waypoint
   int laps = 1;                              ///< times around a closed path / schedule repeats

@@ -12,9 +12,9 @@ namespace slamrig::sim {
 /// Incremental wheel encoders, sampled together. Defaults are the ECE276A robot's (360 ticks per
 /// wheel revolution, 40 Hz).
 struct EncoderOptions {
-  bool enabled = true;
-  double rate_hz = 40.0;
-  int ticks_per_revolution = 360;
+  bool enabled = true;             ///< false: the robot has no encoders
+  double rate_hz = 40.0;           ///< samples per second
+  int ticks_per_revolution = 360;  ///< ticks per wheel revolution
 
   /// One message per broken rule, e.g. "ticks_per_revolution = 0; must be > 0".
   std::vector<std::string> Validate() const;
@@ -32,6 +32,7 @@ class EncoderModel {
   /// front to back, then left wheels front to back). The first call reports increments since 0.
   WheelTicks Measure(Time time, std::span<const double> wheel_angles_rad);
 
+  /// The options it was built with.
   const EncoderOptions& options() const { return options_; }
 
  private:

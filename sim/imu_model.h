@@ -29,12 +29,12 @@ struct ImuNoise {
 /// rest the accelerometer reads +g on z). Defaults are the ADIS16448 figures of the EuRoC dataset
 /// with a consumer-grade turn-on bias and scale error.
 struct ImuOptions {
-  bool enabled = true;
-  double rate_hz = 100.0;
+  bool enabled = true;            ///< false: the robot has no IMU
+  double rate_hz = 100.0;         ///< samples per second
   MountPose mount;                ///< position on the robot (yaw must be 0: axes as base_link)
   double gravity_m_s2 = 9.80665;  ///< what the accelerometer z reads at rest
-  ImuNoise gyro{1.6968e-4, 1.9393e-5, 0.0, 0.002, 0.003, 8.7266};
-  ImuNoise accel{2.0e-3, 3.0e-3, 0.0, 0.05, 0.005, 39.2266};
+  ImuNoise gyro{1.6968e-4, 1.9393e-5, 0.0, 0.002, 0.003, 8.7266};  ///< rad/s; 500 deg/s range
+  ImuNoise accel{2.0e-3, 3.0e-3, 0.0, 0.05, 0.005, 39.2266};       ///< m/s^2; 4 g range
 
   /// One message per broken rule, e.g. "gyro.noise_density = -1; must be >= 0".
   std::vector<std::string> Validate() const;
@@ -54,6 +54,7 @@ class ImuModel {
   ImuSample Measure(Time time, const Eigen::Vector3d& true_rate_rad_s,
                     const Eigen::Vector3d& true_specific_force_m_s2);
 
+  /// The options it was built with.
   const ImuOptions& options() const { return options_; }
 
  private:

@@ -14,7 +14,7 @@ namespace slamrig::sim {
 /// A scanning 2D lidar. Defaults are a Hokuyo UTM-30LX: 1081 beams over 270 degrees (0.25 degree
 /// steps, 1440 steps per turn), 40 Hz, 0.1-30 m, about 1 cm range noise, 1 mm resolution.
 struct LidarOptions {
-  bool enabled = true;
+  bool enabled = true;                 ///< false: the robot has no lidar
   double rate_hz = 40.0;               ///< scans per second (one mirror turn per scan)
   int num_beams = 1081;                ///< beams per scan, first at -fov/2, last at +fov/2
   double fov_deg = 270.0;              ///< angle from the first to the last beam
@@ -52,6 +52,7 @@ class LidarModel {
   /// `true_ranges_m` has num_beams entries.
   LaserScan MakeScan(Time time, std::span<const double> true_ranges_m);
 
+  /// The options it was built with.
   const LidarOptions& options() const { return options_; }
 
  private:

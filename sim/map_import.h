@@ -10,11 +10,12 @@ namespace slamrig::sim {
 
 /// A rectangle of grid cells: columns [x0, x1) and rows [y0, y1).
 struct CellRect {
-  int x0 = 0;
-  int y0 = 0;
-  int x1 = 0;
-  int y1 = 0;
+  int x0 = 0;  ///< first column
+  int y0 = 0;  ///< first row (row 0 = lowest y)
+  int x1 = 0;  ///< one past the last column
+  int y1 = 0;  ///< one past the last row
 
+  /// Field-wise equality.
   friend bool operator==(const CellRect&, const CellRect&) = default;
 };
 

@@ -6,9 +6,9 @@ namespace slamrig::sim {
 
 /// Where a sensor sits on the robot: base_from_sensor as plain fields (x forward, y left).
 struct MountPose {
-  double x_m = 0.0;
-  double y_m = 0.0;
-  double yaw_rad = 0.0;
+  double x_m = 0.0;      ///< forward of base_link
+  double y_m = 0.0;      ///< left of base_link
+  double yaw_rad = 0.0;  ///< CCW from base_link's x axis
 
   /// The same mounting as an SE(2) transform base_from_sensor.
   Pose2 ToPose2() const { return Pose2(x_m, y_m, yaw_rad); }

@@ -66,11 +66,15 @@ class Robot {
   double yaw_rate_rad_s() const;
   /// The wheels: right side front to back, then left side front to back.
   const std::vector<WheelState>& wheels() const { return wheels_; }
+  /// Driven wheels on the right side (the first entries of wheels()).
   int num_right_wheels() const { return spec_.wheels.per_side; }
+  /// Driven wheels on the left side (the last entries of wheels()).
   int num_left_wheels() const { return spec_.wheels.per_side; }
   /// The velocity the base controller currently drives at (after ramps).
   const VelocityCommand& ramped_command() const { return ramped_; }
+  /// The preset it was built from.
   const RobotSpec& spec() const { return spec_; }
+  /// Its Box2D body (the lidar caster ignores its fixtures).
   const b2Body* body() const { return body_; }
 
  private:

@@ -21,14 +21,14 @@ struct RunOptions {
 
 /// What a written run contains.
 struct RunSummary {
-  double duration_s = 0.0;
-  bool drive_finished = false;
-  int num_scans = 0;
-  int num_odometry = 0;
-  int num_imu = 0;
-  Pose2 final_truth;     ///< map_from_base at the end
+  double duration_s = 0.0;      ///< simulated seconds
+  bool drive_finished = false;  ///< the world's driver completed its path or schedule
+  int num_scans = 0;            ///< ROBOTLASER1 lines
+  int num_odometry = 0;         ///< ODOM lines
+  int num_imu = 0;              ///< IMU samples fed to the odometry
+  Pose2 final_truth;            ///< map_from_base at the end
   Pose2 final_odometry;  ///< odom_from_base at the end (the robot's own encoder + gyro estimate)
-  double path_length_m = 0.0;
+  double path_length_m = 0.0;      ///< true distance driven
   std::vector<std::string> files;  ///< paths written
 };
 

@@ -20,7 +20,7 @@ const char* ShapeTypeName(ShapeType type);
 /// One piece of planar geometry in metres, in the frame of whatever owns it (the map frame for
 /// walls and zones, the obstacle frame for moving obstacles). Only the fields of `type` are used.
 struct ShapeSpec {
-  ShapeType type = ShapeType::kBox;
+  ShapeType type = ShapeType::kBox;                    ///< which fields below apply
   Eigen::Vector2d center_m = Eigen::Vector2d::Zero();  ///< box and circle centre
   Eigen::Vector2d size_m = Eigen::Vector2d(1.0, 1.0);  ///< box full extent along its own x, y
   double angle_rad = 0.0;                              ///< box rotation, CCW

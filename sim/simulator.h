@@ -24,8 +24,8 @@ namespace slamrig::sim {
 
 /// Everything a simulated run needs.
 struct SimulatorOptions {
-  WorldSpec world;
-  RobotSpec robot;
+  WorldSpec world;                 ///< geometry, zones, obstacles, spawn, default drive
+  RobotSpec robot;                 ///< body, wheels, motors and sensors
   std::uint64_t seed = 1;          ///< every noise stream derives from it
   double physics_rate_hz = 200.0;  ///< Box2D and tyre steps per second
   int traction_iterations = 10;    ///< sequential-impulse passes over the wheels per step
@@ -41,9 +41,9 @@ struct SimulatorOptions {
 /// run; a lidar scan is stamped with its first beam's time (REP-117), so records after that time
 /// are held back until the scan is complete.
 struct StepResult {
-  Time time;  ///< simulation time after the step
-  std::vector<Record> records;
-  std::vector<TruthSample> truth;
+  Time time;                       ///< simulation time after the step
+  std::vector<Record> records;     ///< time-ordered sensor records
+  std::vector<TruthSample> truth;  ///< the ground truth at each record's time
 };
 
 /// A headless simulated run on its own clock (no wall time): Box2D world, robot, driver and
@@ -77,9 +77,13 @@ class Simulator {
   /// True once the world's driver has completed its path or schedule.
   bool drive_finished() const { return driver_.finished(); }
 
+  /// The options it was built with.
   const SimulatorOptions& options() const { return options_; }
+  /// The Box2D world (walls, obstacles, zones).
   const World& world() const { return *world_; }
+  /// The robot (body and wheel state).
   const Robot& robot() const { return *robot_; }
+  /// The world's driver (progress, laps).
   const Driver& driver() const { return driver_; }
 
  private:

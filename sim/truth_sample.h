@@ -13,10 +13,10 @@ namespace slamrig::sim {
 /// The simulator's ground truth at one instant. It travels on its own channel beside the sensor
 /// records; only evaluation may read it.
 struct TruthSample {
-  Time time;
+  Time time;                                               ///< the record's time
   Pose2 map_from_base;                                     ///< interpolated between physics steps
   Eigen::Vector2d velocity_m_s = Eigen::Vector2d::Zero();  ///< base_link velocity, map frame
-  double yaw_rate_rad_s = 0.0;
+  double yaw_rate_rad_s = 0.0;                             ///< CCW positive
   std::vector<WheelState> wheels;  ///< wheel and contact state of the physics step holding `time`
 
   /// The pose as the ground-truth record the evaluation reads.

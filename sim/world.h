@@ -35,8 +35,11 @@ class World {
   /// Where obstacle `index` should be at `time` (map frame).
   Eigen::Vector2d ObstaclePositionAt(std::size_t index, Time time) const;
 
+  /// The Box2D world, for stepping and ray casts.
   b2World* b2world() { return world_.get(); }
+  /// The Box2D world, read-only.
   const b2World* b2world() const { return world_.get(); }
+  /// The spec it was built from.
   const WorldSpec& spec() const { return spec_; }
   /// Boxes the imported map was merged into (0 without a map).
   int num_map_boxes() const { return num_map_boxes_; }

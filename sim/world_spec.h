@@ -22,9 +22,9 @@ struct SurfaceSpec {
 
 /// A floor region with its own surface (ice, carpet). Sensors never see zones.
 struct ZoneSpec {
-  std::string name;
-  ShapeSpec shape;  ///< box, polygon or circle in the map frame
-  SurfaceSpec surface;
+  std::string name;     ///< for people reading the file ("ice", "carpet")
+  ShapeSpec shape;      ///< box, polygon or circle in the map frame
+  SurfaceSpec surface;  ///< the floor inside
 
   /// One message per broken rule, relative to the zone ("mu = ...", "shape.radius_m = ...");
   /// the surface fields sit directly in the zone.
@@ -34,7 +34,7 @@ struct ZoneSpec {
 /// A moving obstacle (a trolley, a person): a kinematic body carried along a path at constant
 /// speed, seen by the lidar and pushing the robot when they meet.
 struct ObstacleSpec {
-  std::string name;
+  std::string name;                     ///< for people reading the file
   ShapeSpec shape;                      ///< box or circle in the obstacle's own frame
   std::vector<Eigen::Vector2d> path_m;  ///< map-frame path of the obstacle frame's origin
   double speed_m_s = 0.8;               ///< constant speed along the path
@@ -57,7 +57,7 @@ struct MapImportSpec {
 
 /// Everything a simulated world is made of. Plain data: World builds it; world_yaml reads it.
 struct WorldSpec {
-  std::string name;
+  std::string name;                     ///< written into logs and reports
   Pose2 spawn;                          ///< initial map_from_base of the robot
   SurfaceSpec floor;                    ///< surface everywhere outside zones
   std::vector<ShapeSpec> walls;         ///< static geometry

@@ -23,6 +23,7 @@ namespace slamrig::sim {
 /// element is validated where it is read, so its errors point at its own line.
 class FieldReader {
  public:
+  /// Reads the keys of the map `node`.
   explicit FieldReader(const YamlNode& node) : node_(node) {}
 
   /// A scalar (double, int, bool, string, uint64).
@@ -81,6 +82,7 @@ class FieldReader {
     }
   }
 
+  /// The map being read.
   const YamlNode& node() const { return node_; }
 
  private:
@@ -106,8 +108,10 @@ class FieldReader {
 /// Writes the same fields as block YAML with shortest round-trip numbers.
 class FieldWriter {
  public:
+  /// Writes into `out`, which must be inside a map.
   explicit FieldWriter(YAML::Emitter* out) : out_(*out) {}
 
+  /// Scalars, points and point lists, written as `key: value`.
   void operator()(const char* key, const double& value) {
     out_ << YAML::Key << key << YAML::Value << FormatNumber(value);
   }
@@ -132,21 +136,25 @@ class FieldWriter {
     for (const auto& v : values) WritePoint(v);
     out_ << YAML::EndSeq;
   }
+  /// An enum by its name in `names`.
   template <typename E>
   void Enum(const char* key, E& value, const std::vector<std::pair<E, const char*>>& names) {
     for (const auto& [option, name] : names) {
       if (option == value) out_ << YAML::Key << key << YAML::Value << name;
     }
   }
+  /// A nested map.
   template <typename T>
   void Struct(const char* key, T& value) {
     out_ << YAML::Key << key << YAML::Value;
     WriteStruct(value);
   }
+  /// A nested map, only when present.
   template <typename T>
   void OptionalStruct(const char* key, std::optional<T>& value) {
     if (value) Struct(key, *value);
   }
+  /// A list of maps.
   template <typename T>
   void List(const char* key, std::vector<T>& values) {
     out_ << YAML::Key << key << YAML::Value << YAML::BeginSeq;
