@@ -1,0 +1,269 @@
+// Reader for the UCSD ECE276A project 2 robot logs (Encoders/Imu/Hokuyo .npz, and the csv.gz
+// conversions in shared/datasets/ece276a_pr2_partial, whose SOURCE.md gives the layouts).
+#include "slam/io/ece276a_reader.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "slam/io/line_reader.h"
+#include "slam/io/npz_reader.h"
+#include "slam/types/error.h"
+
+namespace slamrig::slam {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Columns of a csv.gz file (header lines starting with '#' skipped), all rows the same width.
+std::vector<std::vector<double>> ReadCsv(const std::string& path, std::size_t columns) {
+  LineReader reader(path);
+  std::vector<std::vector<double>> rows;
+  std::string_view line;
+  while (reader.Next(&line)) {
+    if (line.empty() || line.front() == '#') continue;
+    std::vector<double> row;
+    std::size_t start = 0;
+    while (start <= line.size()) {
+      const std::size_t comma = std::min(line.find(',', start), line.size());
+      const std::string field(line.substr(start, comma - start));
+      char* end = nullptr;
+      const double v = std::strtod(field.c_str(), &end);
+      if (field.empty() || end != field.c_str() + field.size() || !std::isfinite(v)) {
+        throw ParseError(path + ":" + std::to_string(reader.line_number()) + ": column " +
+                         std::to_string(row.size() + 1) + ": expected a finite number, got '" + field + "'");
+      }
+      row.push_back(v);
+      start = comma + 1;
+    }
+    if (row.size() != columns) {
+      throw ParseError(path + ":" + std::to_string(reader.line_number()) + ": expected " +
+                       std::to_string(columns) + " columns, got " + std::to_string(row.size()));
+    }
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+const NpyArray& Array(const std::map<std::string, NpyArray>& arrays, const std::string& key,
+                      const std::string& path) {
+  const auto it = arrays.find(key);
+  if (it == arrays.end()) throw ParseError(path + ": no array '" + key + "'");
+  return it->second;
+}
+
+// A (rows x n) array, checked; element (r, i) at values[r * n + i].
+const NpyArray& Matrix(const std::map<std::string, NpyArray>& arrays, const std::string& key,
+                       std::size_t rows, std::size_t n, const std::string& path) {
+  const NpyArray& a = Array(arrays, key, path);
+  if (a.shape.size() != 2 || a.shape[0] != rows || a.shape[1] != n) {
+    std::ostringstream s;
+    s << path << ": " << key << ": expected shape (" << rows << ", " << n << ")";
+    throw ParseError(s.str());
+  }
+  return a;
+}
+
+double Scalar(const std::map<std::string, NpyArray>& arrays, const std::string& key,
+              const std::string& path) {
+  const NpyArray& a = Array(arrays, key, path);
+  if (a.size() != 1 || !std::isfinite(a.values[0])) {
+    throw ParseError(path + ": " + key + ": expected one finite number");
+  }
+  return a.values[0];
+}
+
+std::vector<double> Stamps(const std::map<std::string, NpyArray>& arrays, const std::string& key,
+                           const std::string& path) {
+  const NpyArray& a = Array(arrays, key, path);
+  if (a.shape.size() != 1) throw ParseError(path + ": " + key + ": expected a 1-D array");
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!std::isfinite(a.values[i])) {
+      throw ParseError(path + ": " + key + "[" + std::to_string(i) + "]: not a finite time");
+    }
+  }
+  return a.values;
+}
+
+void CheckFinite(double v, const std::string& path, const std::string& what, std::size_t index) {
+  if (!std::isfinite(v)) {
+    throw ParseError(path + ": " + what + " column " + std::to_string(index) + ": not finite");
+  }
+}
+
+bool IsNpz(const std::string& path) { return fs::path(path).extension() == ".npz"; }
+
+// The dataset number and folder of a path, e.g. ("DIR", "20") for DIR/Encoders20.npz or DIR/20.
+bool SplitDataset(const std::string& path, std::string* dir, std::string* number) {
+  const fs::path p(path);
+  std::string name = p.filename().string();
+  for (const char* suffix : {".csv.gz", ".npz"}) {
+    const std::string s = suffix;
+    if (name.size() > s.size() && name.compare(name.size() - s.size(), s.size(), s) == 0) {
+      name.resize(name.size() - s.size());
+    }
+  }
+  std::size_t digits = name.size();
+  while (digits > 0 && std::isdigit(static_cast<unsigned char>(name[digits - 1]))) --digits;
+  if (digits == name.size()) return false;
+  std::string prefix = name.substr(0, digits);
+  std::transform(prefix.begin(), prefix.end(), prefix.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (!prefix.empty() && prefix != "encoders" && prefix != "imu" && prefix != "hokuyo") return false;
+  *dir = p.has_parent_path() ? p.parent_path().string() : ".";
+  *number = name.substr(digits);
+  return true;
+}
+
+std::string FindOne(const std::string& dir, const std::string& npz, const std::string& csv) {
+  for (const std::string& name : {npz, csv}) {
+    if (name.empty()) continue;
+    const fs::path candidate = fs::path(dir) / name;
+    if (fs::exists(candidate)) return candidate.string();
+  }
+  return "";
+}
+
+}  // namespace
+
+bool LooksLikeEce276a(const std::string& path) {
+  std::string dir, number;
+  if (!SplitDataset(path, &dir, &number)) return false;
+  return !FindOne(dir, "Encoders" + number + ".npz", "encoders" + number + ".csv.gz").empty();
+}
+
+Ece276aFiles FindEce276aFiles(const std::string& path) {
+  std::string dir, number;
+  if (!SplitDataset(path, &dir, &number)) {
+    throw ParseError(path + ": not an ECE276A dataset (expected DIR/<number> or DIR/Encoders<number>.npz)");
+  }
+  Ece276aFiles files;
+  files.encoders = FindOne(dir, "Encoders" + number + ".npz", "encoders" + number + ".csv.gz");
+  if (files.encoders.empty()) {
+    throw ParseError(path + ": no Encoders" + number + ".npz or encoders" + number + ".csv.gz in " + dir);
+  }
+  files.imu = FindOne(dir, "Imu" + number + ".npz", "imu" + number + ".csv.gz");
+  files.hokuyo = FindOne(dir, "Hokuyo" + number + ".npz", "");
+  return files;
+}
+
+Dataset ReadEce276a(const Ece276aFiles& files, const Ece276aReadOptions& options) {
+  // Each record with a sort key: time, then encoders/IMU before a scan of the same stamp.
+  struct Keyed {
+    double time_s;
+    int order;
+    Record record;
+  };
+  std::vector<Keyed> keyed;
+  Dataset data;
+  data.source = files.encoders;
+
+  // Encoders: counts (4, N) [FR, FL, RR, RL] since the previous reading.
+  {
+    std::vector<double> t;
+    std::vector<std::array<double, 4>> counts;
+    if (IsNpz(files.encoders)) {
+      const auto arrays = ReadNpz(files.encoders);
+      t = Stamps(arrays, "time_stamps", files.encoders);
+      const NpyArray& c = Matrix(arrays, "counts", 4, t.size(), files.encoders);
+      for (std::size_t i = 0; i < t.size(); ++i) {
+        counts.push_back({c.values[i], c.values[t.size() + i], c.values[2 * t.size() + i], c.values[3 * t.size() + i]});
+      }
+    } else {
+      for (const auto& row : ReadCsv(files.encoders, 5)) {
+        t.push_back(row[0]);
+        counts.push_back({row[1], row[2], row[3], row[4]});
+      }
+    }
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      for (int k = 0; k < 4; ++k) {
+        CheckFinite(counts[i][static_cast<std::size_t>(k)], files.encoders, "counts", i);
+      }
+      const auto tick = [&](int k) { return static_cast<std::int32_t>(std::lround(counts[i][static_cast<std::size_t>(k)])); };
+      keyed.push_back({t[i], 0, WheelTicks{Time::FromSeconds(t[i]), {tick(0), tick(2)}, {tick(1), tick(3)}}});
+    }
+  }
+
+  // IMU: angular velocity (3, N) rad/s and linear acceleration (3, N) in g.
+  if (!files.imu.empty()) {
+    std::vector<double> t;
+    std::vector<std::array<double, 6>> rows;  // ax ay az wx wy wz
+    if (IsNpz(files.imu)) {
+      const auto arrays = ReadNpz(files.imu);
+      t = Stamps(arrays, "time_stamps", files.imu);
+      const NpyArray& w = Matrix(arrays, "angular_velocity", 3, t.size(), files.imu);
+      const NpyArray& a = Matrix(arrays, "linear_acceleration", 3, t.size(), files.imu);
+      const std::size_t n = t.size();
+      for (std::size_t i = 0; i < n; ++i) {
+        rows.push_back({a.values[i], a.values[n + i], a.values[2 * n + i], w.values[i], w.values[n + i], w.values[2 * n + i]});
+      }
+    } else {
+      for (const auto& row : ReadCsv(files.imu, 7)) {
+        t.push_back(row[0]);
+        rows.push_back({row[1], row[2], row[3], row[4], row[5], row[6]});
+      }
+    }
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      for (std::size_t k = 0; k < 6; ++k) CheckFinite(rows[i][k], files.imu, "imu", i);
+      ImuSample imu;
+      imu.time = Time::FromSeconds(t[i]);
+      imu.linear_acceleration_m_s2 = Eigen::Vector3d(rows[i][0], rows[i][1], rows[i][2]) * options.gravity_m_s2;
+      imu.angular_velocity_rad_s = Eigen::Vector3d(rows[i][3], rows[i][4], rows[i][5]);
+      keyed.push_back({t[i], 0, imu});
+    }
+  }
+
+  // Hokuyo: ranges (1081, N) float32 metres, scalar angle/range limits.
+  if (!files.hokuyo.empty()) {
+    const auto arrays = ReadNpz(files.hokuyo);
+    const std::string& path = files.hokuyo;
+    const std::vector<double> t = Stamps(arrays, "time_stamps", path);
+    const NpyArray& ranges = Array(arrays, "ranges", path);
+    if (ranges.shape.size() != 2 || ranges.shape[1] != t.size() || ranges.shape[0] < 2) {
+      throw ParseError(path + ": ranges: expected shape (beams, " + std::to_string(t.size()) + ")");
+    }
+    const std::size_t beams = ranges.shape[0];
+    LaserScan prototype;
+    prototype.angle_min_rad = Scalar(arrays, "angle_min", path);
+    const double angle_max = Scalar(arrays, "angle_max", path);
+    prototype.angle_increment_rad = arrays.count("angle_increment") > 0
+                                        ? Scalar(arrays, "angle_increment", path)
+                                        : (angle_max - prototype.angle_min_rad) / static_cast<double>(beams - 1);
+    prototype.range_min_m = Scalar(arrays, "range_min", path);
+    prototype.range_max_m = Scalar(arrays, "range_max", path);
+    prototype.base_from_laser = options.base_from_lidar;
+    int nan_beams = 0;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      LaserScan scan = prototype;
+      scan.time = Time::FromSeconds(t[i]);
+      scan.ranges_m.resize(beams);
+      for (std::size_t b = 0; b < beams; ++b) {
+        double r = ranges.values[b * t.size() + i];
+        // NaN/inf readings are no-returns: counted, never passed on.
+        if (!std::isfinite(r)) {
+          r = prototype.range_max_m;
+          ++nan_beams;
+        }
+        scan.ranges_m[b] = static_cast<float>(r);
+      }
+      keyed.push_back({t[i], 1, std::move(scan)});
+    }
+    if (nan_beams > 0) {
+      data.notes.push_back(std::to_string(nan_beams) + " non-finite Hokuyo ranges read as no return");
+    }
+  } else {
+    data.notes.push_back("no Hokuyo file: encoders and IMU only (dead reckoning, no map)");
+  }
+
+  std::stable_sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
+    return a.time_s != b.time_s ? a.time_s < b.time_s : a.order < b.order;
+  });
+  data.records.reserve(keyed.size());
+  for (Keyed& k : keyed) data.records.push_back(std::move(k.record));
+  return data;
+}
+
+}  // namespace slamrig::slam
