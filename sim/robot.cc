@@ -78,6 +78,20 @@ Robot::Robot(const RobotSpec& spec, World* world, const Pose2& map_from_base)
 
 Robot::~Robot() { world_->b2world()->DestroyBody(body_); }
 
+void Robot::Teleport(const Pose2& map_from_base) {
+  body_->SetTransform(
+      b2Vec2(static_cast<float>(map_from_base.x()), static_cast<float>(map_from_base.y())),
+      static_cast<float>(map_from_base.theta()));
+  body_->SetLinearVelocity(b2Vec2(0.0f, 0.0f));
+  body_->SetAngularVelocity(0.0f);
+  for (std::size_t i = 0; i < wheels_.size(); ++i) {
+    wheels_[i].spin_rad_s = 0.0;
+    integral_rad_[i] = 0.0;
+    deflection_m_[i].setZero();
+  }
+  ramped_ = VelocityCommand{};
+}
+
 Pose2 Robot::pose() const {
   const b2Vec2 p = body_->GetPosition();
   return Pose2(p.x, p.y, body_->GetAngle());

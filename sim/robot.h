@@ -56,6 +56,10 @@ class Robot {
   /// really saw, contact state for the ground truth, wheel rotation for the encoders.
   void FinishStep(double dt_s);
 
+  /// Puts the robot down at `map_from_base` at rest (a kidnapping): body and wheels stop, the
+  /// tyres and speed loops relax, the wheels keep their rotation (the encoders notice nothing).
+  void Teleport(const Pose2& map_from_base);
+
   /// Pose of base_link in the map frame.
   Pose2 pose() const;
   /// Heading without wrapping (continuous over turns), rad.

@@ -94,6 +94,8 @@ StepResult Simulator::Step() {
   robot_->FinishStep(step_s_);
   time_.ns += step_ns_;
   history_.push_back(TakeSnapshot());
+  history_.back().jump_before = teleported_;
+  teleported_ = false;
 
   MeasureEncoders();
   MeasureImu();
@@ -106,6 +108,11 @@ StepResult Simulator::Step() {
 }
 
 StepResult Simulator::Flush() { return Release(true); }
+
+void Simulator::Teleport(const Pose2& map_from_base) {
+  robot_->Teleport(map_from_base);
+  teleported_ = true;
+}
 
 std::pair<std::size_t, double> Simulator::Locate(Time time) const {
   SLAMRIG_CHECK(
@@ -130,8 +137,14 @@ TruthSample Simulator::TruthAt(Time time) const {
   const Snapshot& b = history_[j + 1];
   TruthSample truth;
   truth.time = time;
-  truth.map_from_base = Pose2(a.x_m + f * (b.x_m - a.x_m), a.y_m + f * (b.y_m - a.y_m),
-                              a.yaw_rad + f * (b.yaw_rad - a.yaw_rad));
+  if (b.jump_before) {
+    // No sweep across a teleport: before it the old pose, after it the new one.
+    const Snapshot& s = f > 0.0 ? b : a;
+    truth.map_from_base = Pose2(s.x_m, s.y_m, s.yaw_rad);
+  } else {
+    truth.map_from_base = Pose2(a.x_m + f * (b.x_m - a.x_m), a.y_m + f * (b.y_m - a.y_m),
+                                a.yaw_rad + f * (b.yaw_rad - a.yaw_rad));
+  }
   // Box2D moves with the velocity of the step's end over the whole step (semi-implicit Euler).
   const Snapshot& step = f > 0.0 ? b : a;
   truth.velocity_m_s = step.velocity_m_s;
@@ -174,10 +187,13 @@ void Simulator::MeasureImu() {
     const Snapshot& a = history_[j];
     const Snapshot& b = history_[j + 1];
     // True motion of the step holding t: constant acceleration, the end velocity's yaw rate.
-    const Eigen::Vector2d accel_world = (b.velocity_m_s - a.velocity_m_s) / step_s_;
-    const double yaw_accel = (b.yaw_rate_rad_s - a.yaw_rate_rad_s) / step_s_;
+    // (A teleport is not felt: the robot is put down at rest.)
+    const Eigen::Vector2d accel_world =
+        b.jump_before ? Eigen::Vector2d::Zero()
+                      : Eigen::Vector2d((b.velocity_m_s - a.velocity_m_s) / step_s_);
+    const double yaw_accel = b.jump_before ? 0.0 : (b.yaw_rate_rad_s - a.yaw_rate_rad_s) / step_s_;
     const double w = b.yaw_rate_rad_s;
-    const double yaw = a.yaw_rad + f * (b.yaw_rad - a.yaw_rad);
+    const double yaw = b.jump_before ? b.yaw_rad : a.yaw_rad + f * (b.yaw_rad - a.yaw_rad);
     const double c = std::cos(yaw), s = std::sin(yaw);
     Eigen::Vector2d accel(c * accel_world.x() + s * accel_world.y(),
                           -s * accel_world.x() + c * accel_world.y());
@@ -217,18 +233,25 @@ void Simulator::MeasureLidar() {
     const double base = static_cast<double>(j0) + f0;
     for (std::size_t i = 0; i < rays_.size(); ++i) {
       const double u = base + static_cast<double>(i) * steps_per_beam;
-      const std::size_t j = std::min(static_cast<std::size_t>(u), history_.size() - 2);
-      const double f = u - static_cast<double>(j);
+      std::size_t j = std::min(static_cast<std::size_t>(u), history_.size() - 2);
+      double f = u - static_cast<double>(j);
+      if (f == 0.0 && j > 0 && history_[j + 1].jump_before) {
+        // Exactly at a teleport: still the old pose, the end of the step before.
+        --j;
+        f = 1.0;
+      }
       if (j != step) {
         step = j;
         const Snapshot& a = history_[j];
         const Snapshot& b = history_[j + 1];
-        x0 = a.x_m;
-        y0 = a.y_m;
-        yaw0 = a.yaw_rad;
-        dx = b.x_m - a.x_m;
-        dy = b.y_m - a.y_m;
-        dyaw = b.yaw_rad - a.yaw_rad;
+        // Across a teleport the beams after it see the new pose, without a sweep.
+        const Snapshot& from = b.jump_before ? b : a;
+        x0 = from.x_m;
+        y0 = from.y_m;
+        yaw0 = from.yaw_rad;
+        dx = b.x_m - from.x_m;
+        dy = b.y_m - from.y_m;
+        dyaw = b.yaw_rad - from.yaw_rad;
         const double yaw = yaw0 + f * dyaw;
         const double angle = yaw + angle0 + static_cast<double>(i) * increment;
         c = std::cos(yaw);

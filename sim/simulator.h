@@ -65,6 +65,10 @@ class Simulator {
   /// Releases the records still held back at the end of a run (an unfinished scan is dropped).
   StepResult Flush();
 
+  /// Moves the robot to `map_from_base` at rest, now (a kidnapping, for relocalisation tests).
+  /// Records up to now keep the old pose; interpolation never sweeps across the jump.
+  void Teleport(const Pose2& map_from_base);
+
   /// Drive with this command instead of the world's driver (nullopt: back to the driver).
   void SetCommandOverride(std::optional<VelocityCommand> command) { override_ = command; }
 
@@ -93,6 +97,7 @@ class Simulator {
     Eigen::Vector2d velocity_m_s = Eigen::Vector2d::Zero();
     double yaw_rate_rad_s = 0.0;
     std::vector<WheelState> wheels;
+    bool jump_before = false;  // a teleport happened in the interval ending here
   };
   struct Pending {
     Record record;
@@ -128,6 +133,7 @@ class Simulator {
   std::int64_t encoder_period_ns_ = 0, imu_period_ns_ = 0, scan_period_ns_ = 0;
   std::int64_t next_encoder_ = 1, next_imu_ = 1, next_scan_ = 0;
   std::list<Pending> pending_;  // sorted by time
+  bool teleported_ = false;     // the next snapshot follows a jump
   std::vector<Ray> rays_;
   std::vector<double> true_ranges_;
 };

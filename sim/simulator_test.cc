@@ -200,6 +200,58 @@ TEST(SimulatorTest, EachBeamIsCastFromThePoseAtItsOwnTime) {
   EXPECT_GT(skew_effect, 0.03);
 }
 
+// Distance from `from` along beam `i` of `scan` to the inner faces of the 10 m square room
+// centred on the origin.
+double SquareRoomRange(const LaserScan& scan, std::size_t i, const Pose2& from) {
+  const double a = from.theta() + scan.BeamAngle(i);
+  const double dx = std::cos(a), dy = std::sin(a);
+  double best = 1e9;
+  if (dx > 1e-12) best = std::min(best, (5.0 - from.x()) / dx);
+  if (dx < -1e-12) best = std::min(best, (-5.0 - from.x()) / dx);
+  if (dy > 1e-12) best = std::min(best, (5.0 - from.y()) / dy);
+  if (dy < -1e-12) best = std::min(best, (-5.0 - from.y()) / dy);
+  return best;
+}
+
+TEST(SimulatorTest, TeleportMovesTheRobotWithoutSweepingAcrossTheJump) {
+  SimulatorOptions o;
+  o.robot = WithoutNoise(RobotSpec{});
+  for (const auto& [cx, cy, sx, sy] :
+       {std::array{0.0, 5.1, 10.4, 0.2}, std::array{0.0, -5.1, 10.4, 0.2},
+        std::array{5.1, 0.0, 0.2, 10.4}, std::array{-5.1, 0.0, 0.2, 10.4}}) {
+    ShapeSpec wall;
+    wall.center_m = {cx, cy};
+    wall.size_m = {sx, sy};
+    o.world.walls.push_back(wall);
+  }
+  Simulator sim(o);
+  const Pose2 target(2.0, 1.0, 0.5);
+  std::vector<LaserScan> scans;
+  std::vector<TruthSample> truths;
+  while (sim.time().seconds() < 1.5) {
+    // 1.01 s is in the middle of the scan that starts at 1.0 s.
+    if (sim.time() == Time::FromSeconds(1.01)) sim.Teleport(target);
+    const StepResult step = sim.Step();
+    for (std::size_t i = 0; i < step.records.size(); ++i) {
+      if (const auto* scan = std::get_if<LaserScan>(&step.records[i])) scans.push_back(*scan);
+      truths.push_back(step.truth[i]);
+    }
+  }
+  for (const TruthSample& t : truths) {
+    const Pose2 expected = t.time <= Time::FromSeconds(1.01) ? Pose2() : target;
+    EXPECT_NEAR(t.map_from_base.x(), expected.x(), 0.01) << t.time.seconds();
+    EXPECT_NEAR(t.map_from_base.theta(), expected.theta(), 0.01) << t.time.seconds();
+  }
+  const LaserScan& split = scans[40];  // the scan starting at 1.0 s
+  ASSERT_EQ(split.time, Time::FromSeconds(1.0));
+  for (std::size_t i = 0; i < split.ranges_m.size(); ++i) {
+    const Time t = AddSeconds(split.time, static_cast<double>(i) * split.time_increment_s);
+    const Pose2 base = t <= Time::FromSeconds(1.01) ? Pose2() : target;
+    EXPECT_NEAR(split.ranges_m[i], SquareRoomRange(split, i, base * split.base_from_laser), 2e-3)
+        << "beam " << i;
+  }
+}
+
 TEST(SimulatorTest, TheLidarSeesAMovingObstacleWhereItIs) {
   // A standing robot looks along +x; a 1 m wide trolley crosses 4 m ahead, and beyond it a wall.
   SimulatorOptions o;
