@@ -15,6 +15,8 @@ struct Command {
 
 int RunMapCommand(const std::vector<std::string>& args);
 int RunSimulateCommand(const std::vector<std::string>& args);
+int RunSlamCommand(const std::vector<std::string>& args);
+int RunEvalCommand(const std::vector<std::string>& args);
 
 /// All subcommands, in the order `slamrig --help` lists them.
 const std::vector<Command>& Commands();
