@@ -111,9 +111,26 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
     started_ = true;
     map_.InsertScan(scan, Pose2());
     step.neff = static_cast<double>(options_.num_particles);
+    step.updated = true;
+    last_step_ = step;
     return step;
   }
-  Predict(odometry_increment);
+  // Too little motion since the last update: no filtering, poses follow the odometry.
+  pending_motion_ = pending_motion_ * odometry_increment;
+  const bool moved_enough =
+      pending_motion_.translation().norm() >= options_.min_update_distance_m ||
+      std::abs(pending_motion_.theta()) >= options_.min_update_angle_rad;
+  if (!moved_enough) {
+    step = last_step_;
+    step.best_pose = last_step_.best_pose * pending_motion_;
+    step.mean_pose = last_step_.mean_pose * pending_motion_;
+    step.resampled = false;
+    step.updated = false;
+    return step;
+  }
+  Predict(pending_motion_);
+  pending_motion_ = Pose2();
+  step.updated = true;
 
   const std::vector<Eigen::Vector2d> points = ScanToBasePoints(scan, options_.points);
   step.points_used = static_cast<int>(points.size());
@@ -147,6 +164,7 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
     step.resampled = true;
     ++resample_count_;
   }
+  last_step_ = step;
   return step;
 }
 

@@ -37,6 +37,8 @@ ParticleFilterOptions ParticleFilterOptions::ReportsPreset() {
   o.map.min_log_odds = -10.0f;
   o.map.max_log_odds = 10.0f;
   o.map.update_once_per_scan = false;
+  o.min_update_distance_m = 0.0;
+  o.min_update_angle_rad = 0.0;
   return o;
 }
 
@@ -50,6 +52,12 @@ std::vector<std::string> ParticleFilterOptions::Validate() const {
   }
   if (!(resample_neff_ratio >= 0.0 && resample_neff_ratio <= 1.0)) {
     errors.push_back(Rule("resample_neff_ratio", resample_neff_ratio, "must be in [0, 1]"));
+  }
+  if (!(min_update_distance_m >= 0.0)) {
+    errors.push_back(Rule("min_update_distance_m", min_update_distance_m, "must be >= 0"));
+  }
+  if (!(min_update_angle_rad >= 0.0)) {
+    errors.push_back(Rule("min_update_angle_rad", min_update_angle_rad, "must be >= 0"));
   }
   if (num_threads < 1) errors.push_back(Rule("num_threads", num_threads, "must be >= 1"));
   if (cloud_every_n_scans < 0) {

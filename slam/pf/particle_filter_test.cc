@@ -112,6 +112,28 @@ TEST(ParticleFilterTest, SameSeedSameTrajectoryWhateverTheThreadCount) {
   EXPECT_NE(a.trajectory.poses().back().pose, d.trajectory.poses().back().pose);
 }
 
+// Between updates the particles stay put and the reported poses follow the odometry.
+TEST(ParticleFilterTest, FiltersOnlyAfterEnoughMotion) {
+  const ShortRun& run = GetShortRun();
+  ParticleFilterOptions options = FastOptions();
+  options.min_update_distance_m = 0.25;
+  options.min_update_angle_rad = 10.0;
+  ParticleFilter filter(options);
+  filter.AddScan(run.scans[0].scan, Pose2());
+  const std::vector<Particle> before = filter.particles();
+  const ParticleFilterStep a = filter.AddScan(run.scans[1].scan, Pose2(0.1, 0.0, 0.05));
+  const ParticleFilterStep b = filter.AddScan(run.scans[2].scan, Pose2(0.1, 0.0, 0.0));
+  EXPECT_FALSE(a.updated);
+  EXPECT_FALSE(b.updated);
+  EXPECT_EQ(filter.particles()[7].pose, before[7].pose);
+  const Pose2 expected = Pose2(0.1, 0.0, 0.05) * Pose2(0.1, 0.0, 0.0);
+  EXPECT_NEAR(b.best_pose.x(), expected.x(), 1e-12);
+  EXPECT_NEAR(b.best_pose.y(), expected.y(), 1e-12);
+  const ParticleFilterStep c = filter.AddScan(run.scans[3].scan, Pose2(0.1, 0.0, 0.0));
+  EXPECT_TRUE(c.updated);
+  EXPECT_NE(filter.particles()[7].pose, before[7].pose);
+}
+
 TEST(ParticleFilterTest, ValidateNamesFieldValueAndRule) {
   ParticleFilterOptions options;
   options.num_particles = 0;
