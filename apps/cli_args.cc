@@ -78,6 +78,12 @@ void ArgParser::AddOption(const std::string& name, const std::string& value_name
            });
 }
 
+void ArgParser::AddRepeated(const std::string& name, const std::string& value_name,
+                            const std::string& help, std::vector<std::string>* values) {
+  AddTyped(name, value_name, help + " (repeatable)", "",
+           [values](const std::string& v) { values->push_back(v); });
+}
+
 void ArgParser::AddPositional(const std::string& name, const std::string& help, std::string* value,
                               bool required) {
   positionals_.push_back({name, help, value, required});

@@ -24,6 +24,9 @@ class ArgParser {
                  int* value);
   void AddOption(const std::string& name, const std::string& value_name, const std::string& help,
                  std::uint64_t* value);
+  /// An option that may be given several times (`--set a=1 --set b=2`); values in order.
+  void AddRepeated(const std::string& name, const std::string& value_name, const std::string& help,
+                   std::vector<std::string>* values);
   /// A positional argument; required ones must be given.
   void AddPositional(const std::string& name, const std::string& help, std::string* value,
                      bool required = true);

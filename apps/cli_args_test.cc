@@ -57,6 +57,17 @@ TEST(ArgParserTest, ErrorsNameCommandAndFlag) {
   EXPECT_THAT(Parse({"a.log", "--resolution", "nan"}, &p), HasSubstr("expected a number"));
 }
 
+TEST(ArgParserTest, RepeatedOptionsKeepEveryValueInOrder) {
+  std::vector<std::string> sets;
+  std::string log;
+  ArgParser parser("slamrig test", "LOG", "A test command.");
+  parser.AddPositional("LOG", "the log", &log);
+  parser.AddRepeated("set", "KEY=VALUE", "override", &sets);
+  parser.Parse({"--set", "a=1", "x.log", "--set=b.c=2"});
+  EXPECT_EQ(sets, (std::vector<std::string>{"a=1", "b.c=2"}));
+  EXPECT_EQ(log, "x.log");
+}
+
 TEST(ArgParserTest, HelpListsEverythingWithDefaults) {
   Parsed p;
   ArgParser parser("slamrig test", "LOG [options]", "A test command.");

@@ -17,6 +17,8 @@ int RunMapCommand(const std::vector<std::string>& args);
 int RunSimulateCommand(const std::vector<std::string>& args);
 int RunSlamCommand(const std::vector<std::string>& args);
 int RunEvalCommand(const std::vector<std::string>& args);
+int RunRunCommand(const std::vector<std::string>& args);
+int RunSweepCommand(const std::vector<std::string>& args);
 
 /// All subcommands, in the order `slamrig --help` lists them.
 const std::vector<Command>& Commands();

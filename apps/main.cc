@@ -15,8 +15,12 @@ const std::vector<Command>& Commands() {
   static const std::vector<Command> commands = {
       {"map", "build the occupancy map of a log from its logged poses", RunMapCommand},
       {"simulate", "simulate a robot in a world: CARMEN log plus ground truth", RunSimulateCommand},
-      {"slam", "dead reckoning or particle-filter SLAM on a log, scored against its reference", RunSlamCommand},
-      {"eval", "score a trajectory against a reference: ATE, RPE, relations metric", RunEvalCommand},
+      {"slam", "dead reckoning or particle-filter SLAM on a log, scored against its reference",
+       RunSlamCommand},
+      {"eval", "score a trajectory against a reference: ATE, RPE, relations metric",
+       RunEvalCommand},
+      {"run", "run a scenario: simulation, SLAM, evaluation, report and verdict", RunRunCommand},
+      {"sweep", "run a scenario over a grid of parameters and seeds, all cores", RunSweepCommand},
   };
   return commands;
 }

@@ -155,12 +155,13 @@ TruthSample Simulator::TruthAt(Time time) const {
 
 TruthSample Simulator::Truth() const { return TruthAt(time_); }
 
-void Simulator::Emit(Record record) {
+void Simulator::Emit(Record record, std::vector<float> true_ranges_m) {
   // Keep the held records sorted by time; equal times stay in the order they were measured.
   const Time time = RecordTime(record);
   auto it = pending_.end();
   while (it != pending_.begin() && RecordTime(std::prev(it)->record) > time) --it;
-  pending_.insert(it, Pending{std::move(record), TruthAt(time)});
+  it = pending_.insert(it, Pending{std::move(record), TruthAt(time)});
+  it->truth.true_ranges_m = std::move(true_ranges_m);
 }
 
 void Simulator::MeasureEncoders() {
@@ -278,7 +279,8 @@ void Simulator::MeasureLidar() {
       ray.direction = Eigen::Vector2d(dc, ds);
     }
     caster_->Cast(rays_, o.range_max_m, true_ranges_);
-    Emit(lidar_->MakeScan(start, true_ranges_));
+    Emit(lidar_->MakeScan(start, true_ranges_),
+         std::vector<float>(true_ranges_.begin(), true_ranges_.end()));
     ++next_scan_;
   }
 }

@@ -108,7 +108,7 @@ class Simulator {
   // The history interval holding `time` and the fraction into it.
   std::pair<std::size_t, double> Locate(Time time) const;
   TruthSample TruthAt(Time time) const;
-  void Emit(Record record);
+  void Emit(Record record, std::vector<float> true_ranges_m = {});
   void MeasureEncoders();
   void MeasureImu();
   void MeasureLidar();

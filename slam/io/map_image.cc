@@ -44,7 +44,7 @@ std::string RenderMapPng(const OccupancyGrid& grid, const std::vector<Trajectory
   const int cells_x = static_cast<int>(std::ceil(region.sizes().x() / res));
   const int cells_y = static_cast<int>(std::ceil(region.sizes().y() / res));
   const int largest = std::max(cells_x, cells_y);
-  int scale = std::max(1, options.min_size_px / std::max(1, largest));
+  const int scale = std::max(1, (options.min_size_px + largest - 1) / std::max(1, largest));
   // Pixels per metre; large maps shrink below one pixel per cell.
   double px_per_m = scale / res;
   if (largest * scale > options.max_size_px) px_per_m = options.max_size_px / (largest * res);

@@ -1,0 +1,56 @@
+// `slamrig sweep SWEEP.yaml --out DIR`: a scenario over a parameter grid and seeds.
+
+#include <unistd.h>
+
+#include <climits>
+#include <cstdio>
+#include <filesystem>
+
+#include "apps/cli_args.h"
+#include "apps/commands.h"
+#include "scenarios/sweep_runner.h"
+#include "slam/types/error.h"
+
+namespace slamrig::app {
+namespace {
+
+// This program's own path, so that every run uses the same build.
+std::string SelfPath() {
+  char buffer[PATH_MAX];
+  const ssize_t n = ::readlink("/proc/self/exe", buffer, sizeof(buffer) - 1);
+  if (n <= 0) throw std::runtime_error("cannot find the slamrig binary (/proc/self/exe)");
+  return std::string(buffer, static_cast<std::size_t>(n));
+}
+
+}  // namespace
+
+int RunSweepCommand(const std::vector<std::string>& args) {
+  std::string sweep_path;
+  scenario::SweepRunnerOptions options;
+  bool quiet = false;
+  ArgParser parser("slamrig sweep", "SWEEP.yaml --out DIR [options]",
+                   "Runs the sweep's scenario for every combination of its parameter values and\n"
+                   "every seed, several runs at a time. Each finished run is appended to\n"
+                   "DIR/results.csv at once; run the same command again after an interruption\n"
+                   "and it runs only what is missing. At the end, DIR/summary.html shows each\n"
+                   "metric against each parameter with the spread over seeds.");
+  parser.AddPositional("SWEEP.yaml", "the sweep file (see scenarios/sweeps/)", &sweep_path);
+  parser.AddOption("out", "DIR", "output folder (created; reused to resume)", &options.out_dir);
+  parser.AddOption("jobs", "N", "runs at a time (0: one per core)", &options.jobs);
+  parser.AddFlag("quiet", "no progress bar", &quiet);
+  if (!parser.Parse(args)) return 0;
+  if (options.out_dir.empty()) throw ConfigError("slamrig sweep: --out DIR is required");
+  if (options.jobs < 0)
+    throw ConfigError("slamrig sweep: --jobs = " + std::to_string(options.jobs) + "; must be >= 0");
+  options.progress = !quiet;
+  options.slamrig_binary = SelfPath();
+
+  const scenario::SweepSpec spec = scenario::LoadSweepSpec(sweep_path);
+  const scenario::SweepSummary s = scenario::RunSweep(spec, options);
+  std::printf("%s: %d runs (%d from an earlier sweep, %d now), %d failed -> %s/results.csv\n",
+              sweep_path.c_str(), s.total, s.already_done, s.ran, s.failed,
+              options.out_dir.c_str());
+  return s.failed > 0 ? 3 : 0;
+}
+
+}  // namespace slamrig::app

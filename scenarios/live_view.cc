@@ -1,0 +1,97 @@
+#include "scenarios/live_view.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <opencv2/highgui.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "scenarios/plot.h"
+
+namespace slamrig::scenario {
+namespace {
+
+constexpr int kSizePx = 800;
+
+double WallSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+LiveView::LiveView(const std::string& title, double max_fps)
+    : title_(title), min_period_s_(1.0 / max_fps) {
+  const char* display = std::getenv("DISPLAY");
+  if (display == nullptr || *display == '\0') {
+    throw std::runtime_error("--view needs a display (DISPLAY is not set; try xvfb-run)");
+  }
+  cv::namedWindow(title_, cv::WINDOW_AUTOSIZE);
+}
+
+LiveView::~LiveView() { cv::destroyWindow(title_); }
+
+void LiveView::Update(double sim_time_s, const slam::OccupancyGrid& map, const Pose2& truth,
+                      const std::vector<LiveEstimate>& estimates) {
+  truth_path_.push_back(truth);
+  estimate_paths_.resize(estimates.size());
+  for (std::size_t i = 0; i < estimates.size(); ++i)
+    estimate_paths_[i].push_back(estimates[i].pose);
+  const double now = WallSeconds();
+  if (now - last_draw_s_ < min_period_s_) return;
+  last_draw_s_ = now;
+
+  // Fit the map (and the paths) into the window.
+  Eigen::AlignedBox2d box(
+      map.origin(), map.origin() + Eigen::Vector2d(map.width(), map.height()) * map.resolution());
+  for (const Pose2& p : truth_path_) box.extend(p.translation());
+  const double scale = kSizePx / std::max(box.sizes().maxCoeff(), 1.0);
+  cv::Mat image(kSizePx, kSizePx, CV_8UC3, cv::Scalar(205, 205, 205));
+  const auto px = [&](const Eigen::Vector2d& p) {
+    return cv::Point(static_cast<int>((p.x() - box.min().x()) * scale),
+                     static_cast<int>(kSizePx - (p.y() - box.min().y()) * scale));
+  };
+  for (int row = 0; row < kSizePx; ++row) {
+    auto* out = image.ptr<cv::Vec3b>(row);
+    for (int col = 0; col < kSizePx; ++col) {
+      const Eigen::Vector2d w(box.min().x() + (col + 0.5) / scale,
+                              box.min().y() + (kSizePx - row - 0.5) / scale);
+      const float l = map.LogOdds(map.WorldToCell(w));
+      if (l == 0.0f) continue;
+      const auto v =
+          static_cast<std::uint8_t>(std::lround(255.0 / (1.0 + std::exp(static_cast<double>(l)))));
+      out[col] = cv::Vec3b(v, v, v);
+    }
+  }
+  auto draw_path = [&](const std::vector<Pose2>& path, const cv::Scalar& colour) {
+    std::vector<cv::Point> points;
+    for (const Pose2& p : path) points.push_back(px(p.translation()));
+    if (points.size() >= 2) cv::polylines(image, points, false, colour, 1, cv::LINE_AA);
+  };
+  auto draw_pose = [&](const Pose2& p, const cv::Scalar& colour) {
+    const cv::Point c = px(p.translation());
+    const cv::Point tip = px(p * Eigen::Vector2d(0.5, 0.0));
+    cv::circle(image, c, 5, colour, 2, cv::LINE_AA);
+    cv::line(image, c, tip, colour, 2, cv::LINE_AA);
+  };
+  for (std::size_t i = 0; i < estimates.size(); ++i) {
+    const Colour c = PaletteColour(i == 2 ? 4 : i);
+    const cv::Scalar colour(c.b, c.g, c.r);
+    for (const Pose2& p : estimates[i].particles)
+      cv::circle(image, px(p.translation()), 1, colour, cv::FILLED);
+    draw_path(estimate_paths_[i], colour);
+    draw_pose(estimates[i].pose, colour);
+    cv::putText(image, estimates[i].name, {10, 44 + 20 * static_cast<int>(i)},
+                cv::FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv::LINE_AA);
+  }
+  draw_path(truth_path_, cv::Scalar(40, 160, 40));
+  draw_pose(truth, cv::Scalar(40, 160, 40));
+  char text[64];
+  std::snprintf(text, sizeof(text), "t = %.1f s   truth", sim_time_s);
+  cv::putText(image, text, {10, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(40, 160, 40), 1,
+              cv::LINE_AA);
+  cv::imshow(title_, image);
+  cv::waitKey(1);
+}
+
+}  // namespace slamrig::scenario

@@ -1,0 +1,295 @@
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "scenarios/plot.h"
+#include "scenarios/scenario_result.h"
+#include "slam/eval/json_writer.h"
+#include "slam/io/atomic_file.h"
+#include "slam/io/map_image.h"
+#include "slam/io/map_server.h"
+#include "slam/io/tum_io.h"
+
+namespace slamrig::scenario {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Number(double v, const char* format = "%.4g") {
+  if (!std::isfinite(v)) return "n/a";
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), format, v);
+  return buffer;
+}
+
+std::string Html(const std::string& s) {
+  std::string out;
+  for (const char c : s) {
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else
+      out += c;
+  }
+  return out;
+}
+
+// Position and heading error of `estimate` against `truth` at each estimate time.
+void ErrorsOverTime(const Trajectory& estimate, const Trajectory& truth, std::vector<double>* t,
+                    std::vector<double>* position, std::vector<double>* heading) {
+  const double t0 = truth.empty() ? 0.0 : truth[0].time.seconds();
+  for (const StampedPose& p : estimate.poses()) {
+    const auto ref = truth.Interpolate(p.time);
+    if (!ref) continue;
+    t->push_back(p.time.seconds() - t0);
+    position->push_back((ref->translation() - p.pose.translation()).norm());
+    heading->push_back(std::abs(NormalizeAngle(ref->theta() - p.pose.theta())));
+  }
+}
+
+std::string MetricsJson(const ScenarioResult& r) {
+  slam::JsonWriter j;
+  j.String("scenario", r.spec->name)
+      .Integer("seed", static_cast<long long>(r.spec->sim.seed))
+      .Bool("passed", r.passed)
+      .Number("sim_time_s", r.sim_time_s)
+      .Integer("scans", r.scans)
+      .Integer("scans_blacked_out", r.scans_blacked_out)
+      .Integer("kidnaps", r.kidnaps_done);
+  j.BeginObject("configs");
+  for (const ConfigResult& c : r.configs) {
+    j.BeginObject(c.name);
+    for (const auto& [name, value] : c.metrics) j.Number(name, value);
+    j.EndObject();
+  }
+  j.EndObject();
+  j.BeginObject("expectations");
+  for (const ExpectationOutcome& o : r.outcomes) {
+    j.BeginObject(o.expectation.config + "." + o.expectation.metric +
+                  (o.expectation.is_max ? "_max" : "_min"))
+        .Number("threshold", o.expectation.threshold)
+        .Number("value", o.value)
+        .Bool("passed", o.passed)
+        .EndObject();
+  }
+  j.EndObject();
+  return j.Finish();
+}
+
+}  // namespace
+
+std::string ExpectationOutcome::Describe() const {
+  const Expectation& e = expectation;
+  const std::string name = e.config + "." + e.metric;
+  if (!std::isfinite(value))
+    return name + " = n/a (not computed): fails " + (e.is_max ? "<= " : ">= ") +
+           Number(e.threshold);
+  const char* op = passed ? (e.is_max ? "<=" : ">=") : (e.is_max ? ">" : "<");
+  std::string text = name + " = " + Number(value) + " " + op + " " + Number(e.threshold);
+  if (!passed) {
+    const double by = std::abs(value - e.threshold);
+    const double percent = e.threshold != 0.0 ? 100.0 * by / std::abs(e.threshold) : NAN;
+    text += " (" + std::string(e.is_max ? "over" : "under") + " by " + Number(by) +
+            (std::isfinite(percent) ? ", " + Number(percent, "%.0f") + " %" : "") + ")";
+  }
+  return text;
+}
+
+void CheckExpectations(ScenarioResult* result) {
+  result->outcomes.clear();
+  result->passed = true;
+  for (const Expectation& e : result->spec->expectations) {
+    ExpectationOutcome o;
+    o.expectation = e;
+    o.value = NAN;
+    for (const ConfigResult& c : result->configs) {
+      if (c.name != e.config) continue;
+      const auto it = c.metrics.find(e.metric);
+      if (it != c.metrics.end()) o.value = it->second;
+    }
+    o.passed =
+        std::isfinite(o.value) && (e.is_max ? o.value <= e.threshold : o.value >= e.threshold);
+    result->passed = result->passed && o.passed;
+    result->outcomes.push_back(o);
+  }
+}
+
+std::string ExpectationTable(const ScenarioResult& r) {
+  std::string out;
+  if (r.outcomes.empty()) return "  (no expectations)\n";
+  std::size_t width = 0;
+  for (const auto& o : r.outcomes)
+    width = std::max(width, o.expectation.config.size() + o.expectation.metric.size() + 1);
+  char line[256];
+  std::snprintf(line, sizeof(line), "  %-6s %-*s %12s %12s\n", "", static_cast<int>(width),
+                "expectation", "value", "bound");
+  out += line;
+  for (const auto& o : r.outcomes) {
+    const std::string name = o.expectation.config + "." + o.expectation.metric;
+    const std::string bound =
+        std::string(o.expectation.is_max ? "<= " : ">= ") + Number(o.expectation.threshold);
+    std::snprintf(line, sizeof(line), "  %-6s %-*s %12s %12s%s\n", o.passed ? "PASS" : "FAIL",
+                  static_cast<int>(width), name.c_str(), Number(o.value).c_str(), bound.c_str(),
+                  o.passed ? "" : ("   <- " + o.Describe()).c_str());
+    out += line;
+  }
+  return out;
+}
+
+void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
+  fs::create_directories(out_dir);
+  const fs::path dir(out_dir);
+  auto file = [&](const std::string& name) { return (dir / name).string(); };
+  slam::WriteFileAtomically(file("config.yaml"), r.spec->resolved_yaml);
+  slam::WriteTum(file("truth.tum"), r.truth);
+
+  // Trajectories and maps.
+  std::vector<slam::TrajectoryOverlay> overlays = {{&r.truth, "ground truth", 40, 160, 40}};
+  for (std::size_t i = 0; i < r.configs.size(); ++i) {
+    const ConfigResult& c = r.configs[i];
+    slam::WriteTum(file(c.name + ".tum"), c.estimate);
+    const Colour colour = PaletteColour(i == 2 ? 4 : i);  // skip palette green (the truth's)
+    overlays.push_back({&c.estimate, c.name, colour.b, colour.g, colour.r});
+    if (c.map) slam::WriteMapServerMap(*c.map, file(c.name + "_map"));
+  }
+  // The map picture: the truth map (true poses, same scans) under every trajectory.
+  const slam::OccupancyGrid* background = r.truth_map ? &*r.truth_map : nullptr;
+  for (const ConfigResult& c : r.configs) {
+    if (!background && c.map) background = &*c.map;
+  }
+  std::string html_maps;
+  if (background) {
+    slam::MapImageOptions options;
+    options.title = r.spec->name + ": map from true poses, trajectories overlaid";
+    slam::WriteMapPng(file("map.png"), *background, overlays, options);
+    html_maps +=
+        "<figure><img src=\"map.png\"><figcaption>Ground-truth map with the true and estimated "
+        "trajectories.</figcaption></figure>";
+    for (std::size_t i = 0; i < r.configs.size(); ++i) {
+      const ConfigResult& c = r.configs[i];
+      if (!c.map) continue;
+      // The estimator's map is in its own frame: bring both trajectories there.
+      const Pose2 estimator_from_map = c.map_from_estimator.Inverse();
+      Trajectory truth_local, estimate_local;
+      for (const auto& p : r.truth.poses()) truth_local.Append(p.time, estimator_from_map * p.pose);
+      for (const auto& p : c.estimate.poses())
+        estimate_local.Append(p.time, estimator_from_map * p.pose);
+      slam::TrajectoryOverlay truth_overlay = overlays[0], estimate_overlay = overlays[i + 1];
+      truth_overlay.trajectory = &truth_local;
+      estimate_overlay.trajectory = &estimate_local;
+      slam::MapImageOptions own;
+      own.title = c.name + ": its own map and trajectory";
+      slam::WriteMapPng(file(c.name + "_map.png"), *c.map, {truth_overlay, estimate_overlay}, own);
+      html_maps += "<figure><img src=\"" + c.name + "_map.png\"><figcaption>" + Html(c.name) +
+                   "'s map with its trajectory (and the truth, in green).</figcaption></figure>";
+    }
+  }
+
+  // Errors over time, per configuration.
+  std::vector<PlotSeries> position, heading;
+  for (std::size_t i = 0; i < r.configs.size(); ++i) {
+    const ConfigResult& c = r.configs[i];
+    PlotSeries p{c.name, {}, {}, {}, {}, PaletteColour(i == 2 ? 4 : i)};
+    PlotSeries h = p;
+    ErrorsOverTime(c.estimate, r.truth, &p.x, &p.y, &h.y);
+    h.x = p.x;
+    for (double& v : h.y) v = v * 180.0 / M_PI;
+    position.push_back(std::move(p));
+    heading.push_back(std::move(h));
+  }
+  PlotOptions options;
+  options.title = "Position error (estimate vs truth, same start pose)";
+  options.x_label = "time [s]";
+  options.y_label = "error [m]";
+  slam::WriteFileAtomically(file("position_error.png"), RenderLinePlotPng(position, options));
+  options.title = "Heading error";
+  options.y_label = "error [deg]";
+  slam::WriteFileAtomically(file("heading_error.png"), RenderLinePlotPng(heading, options));
+  std::string html_plots =
+      "<figure><img src=\"position_error.png\"></figure><figure><img "
+      "src=\"heading_error.png\"></figure>";
+
+  std::vector<PlotSeries> neff;
+  for (std::size_t i = 0; i < r.configs.size(); ++i) {
+    const ConfigResult& c = r.configs[i];
+    if (c.neff.empty()) continue;
+    neff.push_back({c.name, c.neff_time_s, c.neff, {}, {}, PaletteColour(i == 2 ? 4 : i)});
+  }
+  if (!neff.empty()) {
+    options.title = "Effective sample size Neff = 1 / sum(w^2) after each scan";
+    options.y_label = "Neff";
+    slam::WriteFileAtomically(file("neff.png"), RenderLinePlotPng(neff, options));
+    html_plots += "<figure><img src=\"neff.png\"></figure>";
+  }
+
+  // Metrics side by side.
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> values;
+  for (const ConfigResult& c : r.configs) {
+    names.push_back(c.name);
+    auto get = [&](const char* m) {
+      const auto it = c.metrics.find(m);
+      return it == c.metrics.end() ? NAN : it->second;
+    };
+    values.push_back(
+        {get("ate_rmse_m"), get("ate_max_m"), get("rpe_m_per_10m"), get("final_error_m")});
+  }
+  options.title = "Trajectory errors per SLAM configuration";
+  options.y_label = "metres";
+  options.x_label = "";
+  slam::WriteFileAtomically(
+      file("errors_by_config.png"),
+      RenderBarChartPng(names, {"ATE RMSE", "ATE max", "RPE per 10 m", "final error"}, values,
+                        options));
+  html_plots += "<figure><img src=\"errors_by_config.png\"></figure>";
+
+  // report.html, written last: its presence means the folder is complete.
+  std::ostringstream h;
+  h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>" << Html(r.spec->name)
+    << "</title><style>body{font-family:sans-serif;margin:2em;max-width:1100px}"
+       "img{max-width:100%;border:1px solid #ddd}figure{margin:1em 0}"
+       "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:4px "
+       "10px;text-align:right}"
+       "th:first-child,td:first-child{text-align:left}.pass{color:#080;font-weight:bold}"
+       ".fail{color:#c00;font-weight:bold}</style></head><body>";
+  h << "<h1>" << Html(r.spec->name) << " <span class=\""
+    << (r.passed ? "pass\">PASS" : "fail\">FAIL") << "</span></h1><p>" << Html(r.spec->description)
+    << "</p><p>Seed " << r.spec->sim.seed << ", " << Number(r.sim_time_s, "%.1f")
+    << " s simulated, " << r.scans << " scans";
+  if (r.scans_blacked_out) h << " (" << r.scans_blacked_out << " blacked out)";
+  if (r.kidnaps_done) h << ", " << r.kidnaps_done << " kidnapping(s)";
+  h << ". Files: <a href=\"config.yaml\">config.yaml</a>, <a "
+       "href=\"metrics.json\">metrics.json</a>, "
+       "<a href=\"truth.tum\">truth.tum</a>";
+  for (const auto& c : r.configs)
+    h << ", <a href=\"" << c.name << ".tum\">" << c.name << ".tum</a>";
+  h << ".</p><h2>Expectations</h2><table><tr><th>expectation</th><th>value</th><th>bound</"
+       "th><th>result</th></tr>";
+  for (const auto& o : r.outcomes) {
+    h << "<tr><td>" << Html(o.expectation.config + "." + o.expectation.metric) << "</td><td>"
+      << Number(o.value) << "</td><td>" << (o.expectation.is_max ? "&le; " : "&ge; ")
+      << Number(o.expectation.threshold) << "</td><td class=\""
+      << (o.passed ? "pass\">pass" : "fail\">FAIL") << "</td></tr>";
+  }
+  h << "</table><h2>Metrics</h2><table><tr><th>metric</th>";
+  for (const auto& c : r.configs) h << "<th>" << Html(c.name) << "</th>";
+  h << "</tr>";
+  for (const std::string& m : KnownMetrics()) {
+    h << "<tr><td>" << m << "</td>";
+    for (const auto& c : r.configs) {
+      const auto it = c.metrics.find(m);
+      h << "<td>" << (it == c.metrics.end() ? "" : Number(it->second)) << "</td>";
+    }
+    h << "</tr>";
+  }
+  h << "</table><h2>Maps</h2>" << html_maps << "<h2>Errors</h2>" << html_plots
+    << "</body></html>\n";
+  slam::WriteFileAtomically(file("metrics.json"), MetricsJson(r));
+  slam::WriteFileAtomically(file("report.html"), h.str());
+}
+
+}  // namespace slamrig::scenario

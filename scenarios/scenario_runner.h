@@ -1,0 +1,27 @@
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "scenarios/scenario_result.h"
+#include "scenarios/scenario_spec.h"
+
+namespace slamrig::scenario {
+
+/// How a scenario run behaves around the run itself (never what it computes).
+struct RunnerOptions {
+  bool view = false;  ///< open a live window (needs a display)
+  /// Called about once per simulated second with (sim time, duration); for progress output.
+  std::function<void(double, double)> progress;
+};
+
+/// Runs a scenario: the simulator, every SLAM configuration and the evaluation advance together
+/// on the simulator's clock in this one process. Each physics step's records go through the fault
+/// injection (lidar blackouts drop scans; kidnaps move the robot), then to each configuration's
+/// scan synchroniser and estimator as soon as a scan's odometry is known, so nothing is dropped
+/// or reordered however fast it runs. The run ends when the drive is finished or at duration_s.
+/// Deterministic: equal specs give bit-identical trajectories and maps (wall-clock time only
+/// enters the realtime_factor metric).
+ScenarioResult RunScenario(const ScenarioSpec& spec, const RunnerOptions& options = {});
+
+}  // namespace slamrig::scenario
