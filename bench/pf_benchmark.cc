@@ -67,11 +67,11 @@ void RunWhole(benchmark::State& state, ParticleFilterOptions options) {
 
 // The reports' method: all 1081 beams, 9x9 x/y shifts, Gaussian noise, per-beam map updates.
 void BM_ReportsPreset(benchmark::State& state) { RunWhole(state, ParticleFilterOptions::ReportsPreset()); }
-BENCHMARK(BM_ReportsPreset)->Arg(1)->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(BM_ReportsPreset)->Arg(1)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
 // The improved defaults (likelihood field, 9x9x9 x/y/yaw search, refinement).
 void BM_ImprovedDefaults(benchmark::State& state) { RunWhole(state, ParticleFilterOptions{}); }
-BENCHMARK(BM_ImprovedDefaults)->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK(BM_ImprovedDefaults)->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
 // One 9x9 map correlation of a 1081-beam scan against a mapped office.
 void BM_Correlate9x9(benchmark::State& state) {
