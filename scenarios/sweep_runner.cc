@@ -20,6 +20,7 @@
 #include <stdexcept>
 
 #include "scenarios/plot.h"
+#include "scenarios/scenario_spec.h"
 #include "slam/io/atomic_file.h"
 #include "slam/types/error.h"
 
@@ -112,6 +113,21 @@ void AppendLine(int fd, const std::string& line, const std::string& path) {
   }
 }
 
+// Every known metric of every SLAM configuration of the scenario, except the wall-clock one,
+// which differs between identical runs. Read from the scenario as the first run sees it.
+std::vector<std::string> DefaultMetrics(const SweepSpec& spec) {
+  std::vector<std::string> overrides;
+  for (const auto& p : spec.parameters) overrides.push_back(p.key + "=" + p.values.front());
+  const ScenarioSpec scenario = LoadScenario(spec.scenario_path, overrides);
+  std::vector<std::string> metrics;
+  for (const SlamConfig& config : scenario.slam) {
+    for (const std::string& m : KnownMetrics()) {
+      if (m != "realtime_factor") metrics.push_back(config.name + "." + m);
+    }
+  }
+  return metrics;
+}
+
 struct Child {
   std::size_t run;
   Clock::time_point start;
@@ -138,9 +154,8 @@ SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) 
   fs::create_directories(fs::path(options.out_dir) / "runs");
   const std::string csv_path = (fs::path(options.out_dir) / "results.csv").string();
 
-  // Without a metrics list the header is fixed by the first run's metrics.json; a resumed sweep
-  // takes it from the file.
-  std::vector<std::string> metrics = spec.metrics;
+  // A resumed sweep must have been started with the same grid and metrics.
+  std::vector<std::string> metrics = spec.metrics.empty() ? DefaultMetrics(spec) : spec.metrics;
   std::set<std::string> done;
   std::vector<std::string> header;
   if (fs::exists(csv_path)) {
@@ -154,15 +169,10 @@ SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) 
     std::string line;
     if (std::getline(lines, line)) {
       header = SplitCsv(line);
-      const std::size_t fixed = spec.parameters.size() + 3;  // run, params, seed, status
-      const std::vector<std::string> expected_start = ResultsHeader(spec, {});
-      if (header.size() < fixed + 1 ||
-          !std::equal(expected_start.begin(), expected_start.begin() + static_cast<long>(fixed),
-                      header.begin())) {
+      if (header != ResultsHeader(spec, metrics)) {
         throw ConfigError(csv_path +
-                          ": written by a different sweep (header differs); use another --out");
+                          ": written by another sweep (its columns differ); use another --out");
       }
-      metrics.assign(header.begin() + static_cast<long>(fixed), header.end() - 1);
       while (std::getline(lines, line)) {
         if (!line.empty()) done.insert(SplitCsv(line)[0]);
       }
@@ -178,12 +188,7 @@ SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) 
   }
   const int fd = ::open(csv_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
   if (fd < 0) throw std::runtime_error(csv_path + ": cannot open: " + std::strerror(errno));
-  bool header_written = !header.empty();
-  if (header_written && header != ResultsHeader(spec, metrics)) {
-    ::close(fd);
-    throw ConfigError(csv_path +
-                      ": written by a different sweep (metrics differ); use another --out");
-  }
+  if (header.empty()) AppendLine(fd, JoinCsv(ResultsHeader(spec, metrics)), csv_path);
 
   const int jobs = options.jobs > 0
                        ? options.jobs
@@ -274,13 +279,6 @@ SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) 
       }
     }
     if (state != "pass") ++summary.failed;
-    if (!header_written) {
-      if (metrics.empty()) {
-        for (const auto& [key, value] : values) metrics.push_back(key);
-      }
-      AppendLine(fd, JoinCsv(ResultsHeader(spec, metrics)), csv_path);
-      header_written = true;
-    }
     std::vector<std::string> row = {run.id};
     for (std::size_t p = 0; p < spec.parameters.size(); ++p) {
       row.push_back(spec.parameters[p].values[run.value_index[p]]);

@@ -39,7 +39,8 @@ struct Fixture {
     dir.Write("scenario.yaml", "name: x\n");
     spec = LoadSweepSpec(dir.Write("sweep.yaml",
                                    "scenario: scenario.yaml\nseeds: 3\nparameters:\n"
-                                   "  a.noise: [1, 2]\n  b.count: [10, 20, 30]\n"));
+                                   "  a.noise: [1, 2]\n  b.count: [10, 20, 30]\n"
+                                   "metrics: [pf.ate_rmse_m]\n"));
     options.out_dir = dir.File("out");
     options.slamrig_binary = runner;
     options.jobs = 2;

@@ -27,7 +27,9 @@ struct SweepSpec {
   std::string scenario_path;  ///< resolved against the sweep file's folder
   std::vector<std::uint64_t> seeds;
   std::vector<SweepParameter> parameters;
-  std::vector<std::string> metrics;  ///< empty: every metric the runs report
+  /// Columns of results.csv. Empty: every metric the first finished run reports except the
+  /// wall-clock ones (realtime_factor), so that a re-run sweep gives identical rows.
+  std::vector<std::string> metrics;
 };
 
 /// One run of the grid.

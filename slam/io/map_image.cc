@@ -1,5 +1,6 @@
 #include "slam/io/map_image.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <opencv2/imgcodecs.hpp>
@@ -25,14 +26,36 @@ double NiceLength(double target_m) {
 std::string RenderMapPng(const OccupancyGrid& grid, const std::vector<TrajectoryOverlay>& overlays,
                          const MapImageOptions& options) {
   const double res = grid.resolution();
-  // World region: observed cells and trajectories, plus a margin.
+  // World region: where the walls are and the trajectories, plus a margin. Walls are cells hit
+  // at least twice more than passed through, between the 0.5 and 99.5 percentiles, so that stray
+  // returns far away (a lidar's random readings, each hit once) do not shrink the building to a
+  // dot.
   Eigen::AlignedBox2d region;
+  std::vector<double> xs, ys;
+  const float wall = std::min(2.0f * grid.options().hit_log_odds, grid.options().max_log_odds);
   for (int y = 0; y < grid.height(); ++y) {
     for (int x = 0; x < grid.width(); ++x) {
-      if (grid.LogOdds({x, y}) != 0.0f) {
+      const float l = grid.LogOdds({x, y});
+      if (l >= wall) {
+        const Eigen::Vector2d c = grid.CellCenter({x, y});
+        xs.push_back(c.x());
+        ys.push_back(c.y());
+      } else if (l != 0.0f && xs.size() < 100) {
         region.extend(grid.CellCenter({x, y}));
       }
     }
+  }
+  if (xs.size() >= 100) {
+    region.setEmpty();
+    auto quantile = [](std::vector<double>& v, double q) {
+      const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
+      std::nth_element(v.begin(), v.begin() + k, v.end());
+      return v[static_cast<std::size_t>(k)];
+    };
+    region.extend(Eigen::Vector2d(quantile(xs, 0.005), quantile(ys, 0.005)));
+    region.extend(Eigen::Vector2d(quantile(xs, 0.995), quantile(ys, 0.995)));
+  } else {
+    for (std::size_t i = 0; i < xs.size(); ++i) region.extend(Eigen::Vector2d(xs[i], ys[i]));
   }
   for (const auto& overlay : overlays) {
     for (const auto& p : overlay.trajectory->poses()) region.extend(p.pose.translation());
