@@ -77,6 +77,9 @@ RunSummary WriteSimulationRun(const SimulatorOptions& options, const RunOptions&
   slam::CarmenWriter log(dir + "run.log");
   log.WriteParam("robot_front_laser_max", FormatNumber(robot.lidar.range_max_m));
   log.WriteParam("robot_frontlaser_offset", FormatNumber(robot.lidar.mount.x_m));
+  // ROBOTLASER1 has no field for these; slamrig's reader applies them to every laser line.
+  log.WriteParam("laser_time_increment_s", FormatNumber(robot.lidar.time_increment_s()));
+  log.WriteParam("laser_range_min_m", FormatNumber(robot.lidar.range_min_m));
   log.WriteParam("slamrig_world", options.world.name.empty() ? "unnamed" : options.world.name);
   log.WriteParam("slamrig_robot", robot.name.empty() ? "unnamed" : robot.name);
   log.WriteParam("slamrig_seed", std::to_string(options.seed));

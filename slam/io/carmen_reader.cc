@@ -302,8 +302,13 @@ class CarmenParser {
     }
     const double range_max =
         std::min(max_range.value_or(options_.no_return_range_m), options_.no_return_range_m);
+    // Written by slamrig's simulator: what ROBOTLASER1 has no field for.
+    const auto time_increment = param("laser_time_increment_s");
+    const auto range_min = param("laser_range_min_m");
     for (std::size_t i = 0; i < log_.scans.size(); ++i) {
       LaserScan& scan = log_.scans[i].scan;
+      if (time_increment) scan.time_increment_s = *time_increment;
+      if (range_min) scan.range_min_m = *range_min;
       if (IsExplicit(i)) {
         scan.range_max_m = std::min(scan.range_max_m, options_.no_return_range_m);
         continue;

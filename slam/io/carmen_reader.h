@@ -70,6 +70,8 @@ struct CarmenLog {
 /// pi / n for even n (180, 360: -90 deg .. +89 deg, as GMapping's RangeSensor lays them out and
 /// as the corrected logs' poses were estimated with) and by pi / (n - 1) for odd n (181, 361:
 /// -90 .. +90 deg). A `laser_front_laser_resolution` PARAM (degrees) overrides the spacing.
+/// PARAMs `laser_time_increment_s` and `laser_range_min_m` (written by slamrig's simulator)
+/// set the per-beam time step and minimum range of every scan.
 CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options = {});
 
 }  // namespace slamrig::slam

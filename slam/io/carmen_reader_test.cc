@@ -136,6 +136,19 @@ TEST(CarmenReaderTest, ReadsRobotLaserWithItsOwnGeometry) {
   EXPECT_EQ(s.logged_pose, Pose2(1, 2, 0.1));
 }
 
+TEST(CarmenReaderTest, SlamrigParamsSetBeamTimingAndMinimumRange) {
+  TempDir dir;
+  const std::string text =
+      "PARAM laser_time_increment_s 1.736111111111111e-05 slamrig 0\n"
+      "PARAM laser_range_min_m 0.1 slamrig 0\n"
+      "ROBOTLASER1 0 -2.35 4.7 0.5 30 0.01 0 3 1.5 0.05 2.5 0 "
+      "0 0 0 0 0 0 0 0 0 0 0 7.25 host 7.25\n";
+  const CarmenLog log = ReadCarmenLog(dir.Write("p.log", text));
+  EXPECT_DOUBLE_EQ(log.scans[0].scan.time_increment_s, 1.736111111111111e-05);
+  EXPECT_DOUBLE_EQ(log.scans[0].scan.range_min_m, 0.1);
+  EXPECT_FALSE(log.scans[0].scan.IsHit(1));  // 0.05 m is under the minimum range
+}
+
 TEST(CarmenReaderTest, ReadsGzipTransparently) {
   TempDir dir;
   const std::string path = dir.File("g.log.gz");
