@@ -195,7 +195,12 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   sync.source = sources.at(odometry);
 
   // Read and run everything before creating any output, so bad input leaves nothing behind.
-  const std::string path = ResolveDataPath(log_path);
+  std::string path = ResolveDataPath(log_path);
+  // An ECE276A dataset named by folder and number ("ece276a_pr2_partial/20") is no file itself.
+  if (!std::filesystem::exists(path) && !slam::LooksLikeEce276a(path) &&
+      slam::LooksLikeEce276a((std::filesystem::path(DataDir()) / log_path).string())) {
+    path = (std::filesystem::path(DataDir()) / log_path).string();
+  }
   std::string kind;
   const slam::Dataset data = LoadLog(path, lenient, &kind);
   slam::ScanSyncResult synced = slam::SyncToScans(data.records, sync);
@@ -301,8 +306,11 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   json.StringArray("notes", data.notes);
   slam::WriteFileAtomically(dir + "metrics.json", json.Finish());
 
-  std::string line = log_name + ": " + algorithm + " on " + std::to_string(timing.scans) + " scans in " +
-                     Fixed(timing.wall_s, 2) + " s (" + Fixed(timing.RealTimeFactor(), 1) + "x real time)";
+  std::string line = log_name + ": " + algorithm + " on " +
+                     (encoder_only ? std::to_string(run.trajectory.size()) + " encoder records (no scans)"
+                                   : std::to_string(timing.scans) + " scans") +
+                     " in " + Fixed(timing.wall_s, 2) + " s";
+  if (!encoder_only) line += " (" + Fixed(timing.RealTimeFactor(), 1) + "x real time)";
   if (metrics) {
     line += "; ATE RMSE " + Fixed(metrics->ate.translation_m.rmse, 3) + " m";
     if (dr_metrics) line += " (dead reckoning " + Fixed(dr_metrics->ate.translation_m.rmse, 3) + " m)";
