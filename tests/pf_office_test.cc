@@ -1,0 +1,52 @@
+// Issue 4's simulated check, end to end through the log file: the office world, default noise,
+// three laps of the corridor loop (`slamrig simulate office`), then particle-filter SLAM with
+// 100 particles on the written run.log must reach ATE RMSE <= 0.10 m against the simulator's
+// truth and at most half of dead reckoning's on the same odometry.
+#include <gtest/gtest.h>
+
+#include "sim/presets.h"
+#include "sim/robot_yaml.h"
+#include "sim/run_writer.h"
+#include "sim/world_yaml.h"
+#include "slam/eval/trajectory_error.h"
+#include "slam/io/carmen_reader.h"
+#include "slam/io/dataset.h"
+#include "slam/odometry/scan_sync.h"
+#include "slam/pf/slam_run.h"
+#include "tests/util/temp_dir.h"
+
+namespace slamrig {
+namespace {
+
+TEST(PfOfficeTest, ThreeLapsWithinTenCentimetresAndHalfOfDeadReckoning) {
+  testing::TempDir dir;
+  sim::SimulatorOptions options;
+  options.world = sim::LoadWorldSpec(sim::FindPresetFile("office", "worlds"));
+  options.robot = sim::LoadRobotSpec(sim::FindPresetFile("ece276a", "robots"));
+  options.seed = 1;
+  ASSERT_EQ(options.world.drive.laps, 3);
+  sim::WriteSimulationRun(options, sim::RunOptions{}, dir.path().string());
+
+  const slam::Dataset data = slam::CarmenToDataset(slam::ReadCarmenLog(dir.File("run.log")));
+  const slam::ScanSyncResult synced = slam::SyncToScans(data.records, slam::ScanSyncOptions{});
+  ASSERT_GT(synced.scans.size(), 10000u);
+  Trajectory truth;
+  for (const GroundTruthPose& g : data.reference) truth.Append(g.time, g.map_from_base);
+
+  const double dr =
+      slam::ComputeAte(
+          slam::RunDeadReckoning(synced.scans, slam::OccupancyGridOptions{}).trajectory, truth)
+          .translation_m.rmse;
+  slam::ParticleFilterOptions pf_options;
+  pf_options.num_particles = 100;
+  const double pf =
+      slam::ComputeAte(slam::RunParticleFilter(synced.scans, pf_options).trajectory, truth)
+          .translation_m.rmse;
+  RecordProperty("dead_reckoning_ate_rmse_m", std::to_string(dr));
+  RecordProperty("pf_ate_rmse_m", std::to_string(pf));
+  EXPECT_LE(pf, 0.10) << "dead reckoning " << dr;
+  EXPECT_LE(pf, 0.5 * dr);
+}
+
+}  // namespace
+}  // namespace slamrig
