@@ -49,17 +49,22 @@ slam::Dataset LoadLog(const std::string& path, bool lenient, std::string* kind) 
 
 const char* SourceName(slam::OdometrySource s) {
   switch (s) {
-    case slam::OdometrySource::kWheelTicks: return "wheel_ticks";
-    case slam::OdometrySource::kOdometryPoses: return "poses";
-    case slam::OdometrySource::kNone: return "none";
-    case slam::OdometrySource::kAuto: break;
+    case slam::OdometrySource::kWheelTicks:
+      return "wheel_ticks";
+    case slam::OdometrySource::kOdometryPoses:
+      return "poses";
+    case slam::OdometrySource::kNone:
+      return "none";
+    case slam::OdometrySource::kAuto:
+      break;
   }
   return "auto";
 }
 
 // Dead reckoning straight from the encoders (and gyro), one pose per encoder record: for logs
 // without a lidar, such as the shared ECE276A data.
-Trajectory EncoderDeadReckoning(const std::vector<Record>& records, const slam::ScanSyncOptions& sync) {
+Trajectory EncoderDeadReckoning(const std::vector<Record>& records,
+                                const slam::ScanSyncOptions& sync) {
   slam::WheelOdometryOptions options;
   options.robot = sync.robot;
   options.use_gyro = sync.use_gyro;
@@ -69,7 +74,8 @@ Trajectory EncoderDeadReckoning(const std::vector<Record>& records, const slam::
     if (const auto* imu = std::get_if<ImuSample>(&r)) odometry.AddImu(*imu);
     if (const auto* ticks = std::get_if<WheelTicks>(&r)) {
       const OdometryPose p = odometry.AddTicks(*ticks);
-      if (trajectory.empty() || trajectory.poses().back().time <= p.time) trajectory.Append(p.time, p.odom_from_base);
+      if (trajectory.empty() || trajectory.poses().back().time <= p.time)
+        trajectory.Append(p.time, p.odom_from_base);
     }
   }
   return trajectory;
@@ -78,14 +84,18 @@ Trajectory EncoderDeadReckoning(const std::vector<Record>& records, const slam::
 // Progress on stderr, at most every two seconds, for logs that take a while.
 class Progress {
  public:
-  explicit Progress(bool enabled) : enabled_(enabled), start_(Clock::now()), next_(start_ + std::chrono::seconds(2)) {}
+  explicit Progress(bool enabled)
+      : enabled_(enabled), start_(Clock::now()), next_(start_ + std::chrono::seconds(2)) {}
   void operator()(std::size_t done, std::size_t total) {
     if (!enabled_) return;
     const auto now = Clock::now();
     if (now < next_ && done < total) return;
     next_ = now + std::chrono::seconds(2);
     const double s = std::chrono::duration<double>(now - start_).count();
-    std::fprintf(stderr, "\rslam: %zu/%zu scans (%.0f%%), %.1f s", done, total, 100.0 * static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(total, 1)), s);
+    std::fprintf(
+        stderr, "\rslam: %zu/%zu scans (%.0f%%), %.1f s", done, total,
+        100.0 * static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(total, 1)),
+        s);
     if (done == total) std::fputc('\n', stderr);
     std::fflush(stderr);
     printed_ = true;
@@ -103,8 +113,8 @@ std::string CloudsCsv(const std::vector<slam::ParticleCloud>& clouds) {
   for (const slam::ParticleCloud& c : clouds) {
     for (std::size_t i = 0; i < c.particles.size(); ++i) {
       const slam::Particle& p = c.particles[i];
-      std::snprintf(line, sizeof(line), "%.9f,%zu,%.6f,%.6f,%.6f,%.9g\n", c.time.seconds(), i, p.pose.x(),
-                    p.pose.y(), p.pose.theta(), p.weight);
+      std::snprintf(line, sizeof(line), "%.9f,%zu,%.6f,%.6f,%.6f,%.9g\n", c.time.seconds(), i,
+                    p.pose.x(), p.pose.y(), p.pose.theta(), p.weight);
       out += line;
     }
   }
@@ -115,14 +125,18 @@ void WritePfConfig(slam::JsonWriter& json, const slam::ParticleFilterOptions& pf
   json.BeginObject("pf")
       .Integer("num_particles", pf.num_particles)
       .Integer("seed", static_cast<long long>(pf.seed))
-      .String("motion_noise", pf.motion_noise == slam::MotionNoiseModel::kRotTransRot ? "rot_trans_rot" : "gaussian")
+      .String("motion_noise", pf.motion_noise == slam::MotionNoiseModel::kRotTransRot
+                                  ? "rot_trans_rot"
+                                  : "gaussian")
       .Number("sigma_xy_m", pf.sigma_xy_m)
       .Number("sigma_yaw_rad", pf.sigma_yaw_rad)
       .Number("alpha1", pf.rot_trans_rot.alpha1)
       .Number("alpha2", pf.rot_trans_rot.alpha2)
       .Number("alpha3", pf.rot_trans_rot.alpha3)
       .Number("alpha4", pf.rot_trans_rot.alpha4)
-      .String("observation", pf.observation == slam::ObservationModel::kLikelihoodField ? "likelihood_field" : "correlation")
+      .String("observation", pf.observation == slam::ObservationModel::kLikelihoodField
+                                 ? "likelihood_field"
+                                 : "correlation")
       .Integer("xy_half_width_cells", pf.correlation.xy_half_width_cells)
       .Integer("yaw_half_steps", pf.correlation.yaw_half_steps)
       .Number("yaw_step_rad", pf.correlation.yaw_step_rad)
@@ -132,7 +146,8 @@ void WritePfConfig(slam::JsonWriter& json, const slam::ParticleFilterOptions& pf
       .Number("voxel_size_m", pf.points.voxel_size_m)
       .Bool("move_to_best_shift", pf.move_to_best_shift)
       .Bool("refine", pf.refine)
-      .String("resampling", pf.resampling == slam::ResamplingScheme::kSystematic ? "systematic" : "stratified")
+      .String("resampling",
+              pf.resampling == slam::ResamplingScheme::kSystematic ? "systematic" : "stratified")
       .Number("resample_neff_ratio", pf.resample_neff_ratio)
       .Integer("threads", pf.num_threads)
       .EndObject();
@@ -146,38 +161,45 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   std::uint64_t seed = 1;
   double resolution = 0.05;
   bool no_gyro = false, lenient = false, quiet = false;
-  ArgParser parser("slamrig slam", "LOG --out DIR [options]",
-                   "Runs dead reckoning or particle-filter SLAM on a log and writes, into DIR:\n"
-                   "trajectory.tum (one pose per scan, stamped with the scan time), map.pgm +\n"
-                   "map.yaml (ROS map_server), map.png (with the reference trajectory when the log\n"
-                   "has one) and metrics.json (ATE/RPE against the reference, timing, settings).\n"
-                   "LOG is a CARMEN log (plain or .gz; real, or written by `slamrig simulate`) or an\n"
-                   "ECE276A dataset (DIR/20, or one of its Encoders/Imu/Hokuyo files).");
+  ArgParser parser(
+      "slamrig slam", "LOG --out DIR [options]",
+      "Runs dead reckoning or particle-filter SLAM on a log and writes, into DIR:\n"
+      "trajectory.tum (one pose per scan, stamped with the scan time), map.pgm +\n"
+      "map.yaml (ROS map_server), map.png (with the reference trajectory when the log\n"
+      "has one) and metrics.json (ATE/RPE against the reference, timing, settings).\n"
+      "LOG is a CARMEN log (plain or .gz; real, or written by `slamrig simulate`) or an\n"
+      "ECE276A dataset (DIR/20, or one of its Encoders/Imu/Hokuyo files).");
   parser.AddPositional("LOG", "log path; a path, or relative to SLAMRIG_DATA_DIR", &log_path);
   parser.AddOption("out", "DIR", "output folder (created)", &out_dir);
   parser.AddOption("algorithm", "NAME", "pf or dead-reckoning", &algorithm);
-  parser.AddOption("preset", "NAME", "pf settings: default (the improved filter) or reports (ECE276A)", &preset);
+  parser.AddOption("preset", "NAME",
+                   "pf settings: default (the improved filter) or reports (ECE276A)", &preset);
   parser.AddOption("particles", "N", "number of particles", &particles);
   parser.AddOption("seed", "N", "random seed (same seed, same result)", &seed);
   parser.AddOption("threads", "N", "worker threads for the particle scoring", &threads);
   parser.AddOption("resolution", "M", "map cell size in metres", &resolution);
   parser.AddOption("odometry", "SOURCE", "auto, wheel_ticks, poses or none", &odometry);
   parser.AddFlag("no-gyro", "yaw from the wheel encoders even when the log has a gyro", &no_gyro);
-  parser.AddOption("clouds", "N", "write the particle cloud every N scans to particles.csv (0: never)", &clouds);
+  parser.AddOption("clouds", "N",
+                   "write the particle cloud every N scans to particles.csv (0: never)", &clouds);
   parser.AddOption("max-scans", "N", "stop after N scans (0: all)", &max_scans);
   parser.AddFlag("lenient", "skip and count malformed CARMEN lines instead of failing", &lenient);
   parser.AddFlag("quiet", "no progress output", &quiet);
   if (!parser.Parse(args)) return 0;
   if (out_dir.empty()) throw ConfigError("slamrig slam: --out DIR is required");
   if (algorithm != "pf" && algorithm != "dead-reckoning") {
-    throw ConfigError("slamrig slam: --algorithm: expected pf or dead-reckoning, got '" + algorithm + "'");
+    throw ConfigError("slamrig slam: --algorithm: expected pf or dead-reckoning, got '" +
+                      algorithm + "'");
   }
   if (preset != "default" && preset != "reports") {
     throw ConfigError("slamrig slam: --preset: expected default or reports, got '" + preset + "'");
   }
-  if (max_scans < 0) throw ConfigError("slamrig slam: --max-scans = " + std::to_string(max_scans) + "; must be >= 0");
-  slam::ParticleFilterOptions pf = preset == "reports" ? slam::ParticleFilterOptions::ReportsPreset()
-                                                       : slam::ParticleFilterOptions{};
+  if (max_scans < 0)
+    throw ConfigError("slamrig slam: --max-scans = " + std::to_string(max_scans) +
+                      "; must be >= 0");
+  slam::ParticleFilterOptions pf = preset == "reports"
+                                       ? slam::ParticleFilterOptions::ReportsPreset()
+                                       : slam::ParticleFilterOptions{};
   pf.num_particles = particles;
   pf.seed = seed;
   pf.num_threads = threads;
@@ -187,10 +209,13 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   slam::ScanSyncOptions sync;
   sync.use_gyro = !no_gyro;
   const std::map<std::string, slam::OdometrySource> sources = {
-      {"auto", slam::OdometrySource::kAuto}, {"wheel_ticks", slam::OdometrySource::kWheelTicks},
-      {"poses", slam::OdometrySource::kOdometryPoses}, {"none", slam::OdometrySource::kNone}};
+      {"auto", slam::OdometrySource::kAuto},
+      {"wheel_ticks", slam::OdometrySource::kWheelTicks},
+      {"poses", slam::OdometrySource::kOdometryPoses},
+      {"none", slam::OdometrySource::kNone}};
   if (!sources.count(odometry)) {
-    throw ConfigError("slamrig slam: --odometry: expected auto, wheel_ticks, poses or none, got '" + odometry + "'");
+    throw ConfigError("slamrig slam: --odometry: expected auto, wheel_ticks, poses or none, got '" +
+                      odometry + "'");
   }
   sync.source = sources.at(odometry);
 
@@ -209,7 +234,8 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   }
   Trajectory reference;
   for (const GroundTruthPose& g : data.reference) {
-    if (reference.empty() || reference.poses().back().time <= g.time) reference.Append(g.time, g.map_from_base);
+    if (reference.empty() || reference.poses().back().time <= g.time)
+      reference.Append(g.time, g.map_from_base);
   }
   const std::string log_name = std::filesystem::path(path).filename().string();
 
@@ -219,20 +245,25 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   Progress progress(!quiet);
   bool encoder_only = false;
   if (synced.scans.empty()) {
-    if (algorithm == "pf") throw ParseError(path + ": no laser scans; the particle filter needs them");
+    if (algorithm == "pf")
+      throw ParseError(path + ": no laser scans; the particle filter needs them");
     run.trajectory = EncoderDeadReckoning(data.records, sync);
-    if (run.trajectory.empty()) throw ParseError(path + ": no laser scans and no wheel encoder records");
+    if (run.trajectory.empty())
+      throw ParseError(path + ": no laser scans and no wheel encoder records");
     run.mean_trajectory = run.trajectory;
     encoder_only = true;
   } else if (algorithm == "pf") {
-    run = slam::RunParticleFilter(synced.scans, pf, [&](std::size_t d, std::size_t t) { progress(d, t); });
+    run = slam::RunParticleFilter(synced.scans, pf,
+                                  [&](std::size_t d, std::size_t t) { progress(d, t); });
   } else {
-    run = slam::RunDeadReckoning(synced.scans, pf.map, [&](std::size_t d, std::size_t t) { progress(d, t); });
+    run = slam::RunDeadReckoning(synced.scans, pf.map,
+                                 [&](std::size_t d, std::size_t t) { progress(d, t); });
   }
   timing.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
   timing.scans = static_cast<int>(synced.scans.size());
   if (run.trajectory.size() >= 2) {
-    timing.data_s = SecondsBetween(run.trajectory.poses().back().time, run.trajectory.poses().front().time);
+    timing.data_s =
+        SecondsBetween(run.trajectory.poses().back().time, run.trajectory.poses().front().time);
   }
 
   // Scores against the reference, with dead reckoning alongside for comparison.
@@ -258,11 +289,17 @@ int RunSlamCommand(const std::vector<std::string>& args) {
     Trajectory reference_in_map;
     if (metrics) {
       const Pose2 map_from_reference = metrics->ate.reference_from_estimate.Inverse();
-      for (const StampedPose& p : reference.poses()) reference_in_map.Append(p.time, map_from_reference * p.pose);
+      for (const StampedPose& p : reference.poses())
+        reference_in_map.Append(p.time, map_from_reference * p.pose);
     }
     std::vector<slam::TrajectoryOverlay> overlays;
-    if (!reference_in_map.empty()) overlays.push_back({&reference_in_map, data.reference_kind.empty() ? "reference" : data.reference_kind, 40, 160, 40});
-    overlays.push_back({&run.trajectory, algorithm == "pf" ? "particle filter (best particle)" : "dead reckoning", 200, 60, 0});
+    if (!reference_in_map.empty())
+      overlays.push_back({&reference_in_map,
+                          data.reference_kind.empty() ? "reference" : data.reference_kind, 40, 160,
+                          40});
+    overlays.push_back({&run.trajectory,
+                        algorithm == "pf" ? "particle filter (best particle)" : "dead reckoning",
+                        200, 60, 0});
     slam::MapImageOptions image_options;
     image_options.title = log_name + ": " + algorithm;
     slam::WriteMapPng(dir + "map.png", run.map, overlays, image_options);
@@ -271,7 +308,8 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   slam::JsonWriter json;
   json.String("log", path).String("log_format", kind).String("algorithm", algorithm);
   if (algorithm == "pf") json.String("preset", preset);
-  json.String("odometry_source", encoder_only ? "wheel_ticks (encoder records, no scans)" : SourceName(synced.source_used))
+  json.String("odometry_source", encoder_only ? "wheel_ticks (encoder records, no scans)"
+                                              : SourceName(synced.source_used))
       .Integer("scans", timing.scans)
       .Integer("poses", static_cast<long long>(run.trajectory.size()))
       .Number("wall_time_s", timing.wall_s)
@@ -285,8 +323,11 @@ int RunSlamCommand(const std::vector<std::string>& args) {
     json.Integer("resamples", run.resamples).Number("mean_neff", run.mean_neff);
     WritePfConfig(json, pf);
   }
-  json.BeginObject("map").Number("resolution_m", run.map.resolution()).Integer("width", run.map.width())
-      .Integer("height", run.map.height()).EndObject();
+  json.BeginObject("map")
+      .Number("resolution_m", run.map.resolution())
+      .Integer("width", run.map.width())
+      .Integer("height", run.map.height())
+      .EndObject();
   if (metrics) {
     json.String("reference", data.reference_kind.empty() ? "reference" : data.reference_kind);
     json.BeginObject("trajectory");
@@ -306,14 +347,16 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   json.StringArray("notes", data.notes);
   slam::WriteFileAtomically(dir + "metrics.json", json.Finish());
 
-  std::string line = log_name + ": " + algorithm + " on " +
-                     (encoder_only ? std::to_string(run.trajectory.size()) + " encoder records (no scans)"
-                                   : std::to_string(timing.scans) + " scans") +
-                     " in " + Fixed(timing.wall_s, 2) + " s";
+  std::string line =
+      log_name + ": " + algorithm + " on " +
+      (encoder_only ? std::to_string(run.trajectory.size()) + " encoder records (no scans)"
+                    : std::to_string(timing.scans) + " scans") +
+      " in " + Fixed(timing.wall_s, 2) + " s";
   if (!encoder_only) line += " (" + Fixed(timing.RealTimeFactor(), 1) + "x real time)";
   if (metrics) {
     line += "; ATE RMSE " + Fixed(metrics->ate.translation_m.rmse, 3) + " m";
-    if (dr_metrics) line += " (dead reckoning " + Fixed(dr_metrics->ate.translation_m.rmse, 3) + " m)";
+    if (dr_metrics)
+      line += " (dead reckoning " + Fixed(dr_metrics->ate.translation_m.rmse, 3) + " m)";
   }
   line += " -> " + out_dir;
   std::puts(line.c_str());

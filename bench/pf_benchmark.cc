@@ -29,7 +29,8 @@ const Ece276aLikeRun& Run() {
     options.waypoints = testing::OfficeLoop();
     options.laps = 10;
     options.max_duration_s = 4999.5 / 40.0;
-    testing::SyntheticRun synthetic = testing::MakeSyntheticRun(testing::SegmentWorld::Office(), options);
+    testing::SyntheticRun synthetic =
+        testing::MakeSyntheticRun(testing::SegmentWorld::Office(), options);
     auto* r = new Ece276aLikeRun;
     r->scans = SyncToScans(synthetic.records, ScanSyncOptions{}).scans;
     r->truth = std::move(synthetic.truth);
@@ -42,7 +43,8 @@ double PositionRmse(const Trajectory& estimate, const std::vector<GroundTruthPos
   const Pose2 anchor = truth.front().map_from_base;
   double sum = 0.0;
   for (std::size_t i = 0; i < estimate.size(); ++i) {
-    sum += ((anchor * estimate[i].pose).translation() - truth[i].map_from_base.translation()).squaredNorm();
+    sum += ((anchor * estimate[i].pose).translation() - truth[i].map_from_base.translation())
+               .squaredNorm();
   }
   return std::sqrt(sum / static_cast<double>(estimate.size()));
 }
@@ -66,12 +68,19 @@ void RunWhole(benchmark::State& state, ParticleFilterOptions options) {
 }
 
 // The reports' method: all 1081 beams, 9x9 x/y shifts, Gaussian noise, per-beam map updates.
-void BM_ReportsPreset(benchmark::State& state) { RunWhole(state, ParticleFilterOptions::ReportsPreset()); }
+void BM_ReportsPreset(benchmark::State& state) {
+  RunWhole(state, ParticleFilterOptions::ReportsPreset());
+}
 BENCHMARK(BM_ReportsPreset)->Arg(1)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
 // The improved defaults (likelihood field, 9x9x9 x/y/yaw search, refinement).
 void BM_ImprovedDefaults(benchmark::State& state) { RunWhole(state, ParticleFilterOptions{}); }
-BENCHMARK(BM_ImprovedDefaults)->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+BENCHMARK(BM_ImprovedDefaults)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
 
 // One 9x9 map correlation of a 1081-beam scan against a mapped office.
 void BM_Correlate9x9(benchmark::State& state) {

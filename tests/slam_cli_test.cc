@@ -44,10 +44,11 @@ TEST(SlamCliTest, SlamWritesEverythingAndEvalAgreesWithIt) {
   SLAMRIG_REQUIRE_DATASET(log, "carmen_corrected/intel-corrected.log.gz");
   testing::TempDir dir;
   const std::string out = dir.File("slam");
-  const auto slam = RunCommand(kBinary + " slam " + log + " --max-scans 120 --particles 30 --quiet --out " + out);
+  const auto slam =
+      RunCommand(kBinary + " slam " + log + " --max-scans 120 --particles 30 --quiet --out " + out);
   ASSERT_EQ(slam.exit_code, 0) << slam.output;
-  for (const char* f : {"trajectory.tum", "trajectory_mean.tum", "reference.tum", "map.pgm", "map.yaml", "map.png",
-                        "metrics.json"}) {
+  for (const char* f : {"trajectory.tum", "trajectory_mean.tum", "reference.tum", "map.pgm",
+                        "map.yaml", "map.png", "metrics.json"}) {
     EXPECT_TRUE(std::filesystem::exists(out + "/" + f)) << f;
   }
   EXPECT_EQ(CountPoses(Slurp(out + "/trajectory.tum")), 120);
@@ -55,15 +56,16 @@ TEST(SlamCliTest, SlamWritesEverythingAndEvalAgreesWithIt) {
   EXPECT_GT(slam_rmse, 0.0);
   EXPECT_LT(slam_rmse, 0.5);
 
-  const auto eval = RunCommand(kBinary + " eval --estimate " + out + "/trajectory.tum --truth " + out +
-                               "/reference.tum --out " + dir.File("eval"));
+  const auto eval = RunCommand(kBinary + " eval --estimate " + out + "/trajectory.tum --truth " +
+                               out + "/reference.tum --out " + dir.File("eval"));
   ASSERT_EQ(eval.exit_code, 0) << eval.output;
   EXPECT_NEAR(AteRmse(Slurp(dir.File("eval") + "/metrics.json")), slam_rmse, 1e-6);
 
   // Relations generated from the reference, evaluated on the estimate.
-  const auto relations = RunCommand(kBinary + " eval --estimate " + out + "/trajectory.tum --truth " + out +
-                                    "/reference.tum --make-relations " + dir.File("r.relations") +
-                                    " --relations " + dir.File("r.relations"));
+  const auto relations =
+      RunCommand(kBinary + " eval --estimate " + out + "/trajectory.tum --truth " + out +
+                 "/reference.tum --make-relations " + dir.File("r.relations") + " --relations " +
+                 dir.File("r.relations"));
   ASSERT_EQ(relations.exit_code, 0) << relations.output;
   EXPECT_NE(relations.output.find("relations: "), std::string::npos) << relations.output;
 }
@@ -72,8 +74,9 @@ TEST(SlamCliTest, SameSeedSameTrajectoryFile) {
   SLAMRIG_REQUIRE_DATASET(log, "carmen_corrected/intel-corrected.log.gz");
   testing::TempDir dir;
   for (const char* run : {"a", "b"}) {
-    const auto r = RunCommand(kBinary + " slam " + log + " --max-scans 80 --particles 20 --seed 7 --quiet --out " +
-                              dir.File(run));
+    const auto r =
+        RunCommand(kBinary + " slam " + log +
+                   " --max-scans 80 --particles 20 --seed 7 --quiet --out " + dir.File(run));
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   EXPECT_EQ(Slurp(dir.File("a") + "/trajectory.tum"), Slurp(dir.File("b") + "/trajectory.tum"));
@@ -82,7 +85,8 @@ TEST(SlamCliTest, SameSeedSameTrajectoryFile) {
 TEST(SlamCliTest, DeadReckoningOnTheEce276aEncodersAndImu) {
   SLAMRIG_REQUIRE_DATASET(encoders, "ece276a_pr2_partial/Encoders20.npz");
   testing::TempDir dir;
-  const auto r = RunCommand(kBinary + " slam " + encoders + " --algorithm dead-reckoning --out " + dir.File("dr"));
+  const auto r = RunCommand(kBinary + " slam " + encoders + " --algorithm dead-reckoning --out " +
+                            dir.File("dr"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(CountPoses(Slurp(dir.File("dr") + "/trajectory.tum")), 4956);
   const auto pf = RunCommand(kBinary + " slam " + encoders + " --out " + dir.File("pf"));
@@ -93,16 +97,20 @@ TEST(SlamCliTest, DeadReckoningOnTheEce276aEncodersAndImu) {
 
 TEST(SlamCliTest, BadInputIsOneLineAndNoOutput) {
   testing::TempDir dir;
-  const auto missing = RunCommand(kBinary + " slam " + dir.File("nope.log") + " --out " + dir.File("o"));
+  const auto missing =
+      RunCommand(kBinary + " slam " + dir.File("nope.log") + " --out " + dir.File("o"));
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.output.find("nope.log"), std::string::npos) << missing.output;
   EXPECT_FALSE(std::filesystem::exists(dir.File("o")));
-  const auto bad_algorithm = RunCommand(kBinary + " slam x.log --algorithm foo --out " + dir.File("o"));
+  const auto bad_algorithm =
+      RunCommand(kBinary + " slam x.log --algorithm foo --out " + dir.File("o"));
   EXPECT_EQ(bad_algorithm.exit_code, 2);
   EXPECT_NE(bad_algorithm.output.find("--algorithm"), std::string::npos) << bad_algorithm.output;
-  const auto bad_particles = RunCommand(kBinary + " slam x.log --particles 0 --out " + dir.File("o"));
+  const auto bad_particles =
+      RunCommand(kBinary + " slam x.log --particles 0 --out " + dir.File("o"));
   EXPECT_EQ(bad_particles.exit_code, 2);
-  EXPECT_NE(bad_particles.output.find("pf.num_particles = 0; must be > 0"), std::string::npos) << bad_particles.output;
+  EXPECT_NE(bad_particles.output.find("pf.num_particles = 0; must be > 0"), std::string::npos)
+      << bad_particles.output;
   const auto eval = RunCommand(kBinary + " eval --truth " + dir.File("t.tum"));
   EXPECT_EQ(eval.exit_code, 2);
 }

@@ -23,7 +23,9 @@ ErrorStats ErrorStats::Of(std::vector<double> errors) {
   std::nth_element(errors.begin(), errors.begin() + static_cast<std::ptrdiff_t>(mid), errors.end());
   s.median = errors[mid];
   if (errors.size() % 2 == 0) {
-    s.median = 0.5 * (s.median + *std::max_element(errors.begin(), errors.begin() + static_cast<std::ptrdiff_t>(mid)));
+    s.median =
+        0.5 * (s.median + *std::max_element(errors.begin(),
+                                            errors.begin() + static_cast<std::ptrdiff_t>(mid)));
   }
   return s;
 }

@@ -67,7 +67,8 @@ JsonWriter& JsonWriter::Bool(const std::string& key, bool value) {
   return *this;
 }
 
-JsonWriter& JsonWriter::StringArray(const std::string& key, const std::vector<std::string>& values) {
+JsonWriter& JsonWriter::StringArray(const std::string& key,
+                                    const std::vector<std::string>& values) {
   Key(key);
   out_ += "[";
   for (std::size_t i = 0; i < values.size(); ++i) out_ += (i ? ", " : "") + JsonQuote(values[i]);

@@ -28,7 +28,8 @@ bool HasWithin(const std::unordered_set<std::int64_t>& cells, int x, int y, int 
 std::vector<std::string> MapScoreOptions::Validate() const {
   std::vector<std::string> errors;
   if (tolerance_cells < 0) {
-    errors.push_back("map_score.tolerance_cells = " + std::to_string(tolerance_cells) + "; must be >= 0");
+    errors.push_back("map_score.tolerance_cells = " + std::to_string(tolerance_cells) +
+                     "; must be >= 0");
   }
   if (!(occupied_probability > 0.5 && occupied_probability < 1.0)) {
     std::ostringstream s;
@@ -41,7 +42,8 @@ std::vector<std::string> MapScoreOptions::Validate() const {
 MapScore ScoreMap(const OccupancyGrid& estimate, const Pose2& truth_from_estimate,
                   const OccupancyGrid& truth, const MapScoreOptions& options) {
   SLAMRIG_CHECK(options.Validate().empty(), "invalid MapScoreOptions");
-  // Occupied cells of both maps on the truth lattice (cell indices may fall outside the truth grid).
+  // Occupied cells of both maps on the truth lattice (cell indices may fall outside the truth
+  // grid).
   const double occupied_log_odds =
       std::log(options.occupied_probability / (1.0 - options.occupied_probability));
   std::unordered_set<std::int64_t> truth_cells, estimate_cells;
@@ -53,7 +55,8 @@ MapScore ScoreMap(const OccupancyGrid& estimate, const Pose2& truth_from_estimat
   for (int y = 0; y < estimate.height(); ++y) {
     for (int x = 0; x < estimate.width(); ++x) {
       if (!(estimate.LogOdds({x, y}) > occupied_log_odds)) continue;
-      const Eigen::Array2i cell = truth.WorldToCell(truth_from_estimate * estimate.CellCenter({x, y}));
+      const Eigen::Array2i cell =
+          truth.WorldToCell(truth_from_estimate * estimate.CellCenter({x, y}));
       estimate_cells.insert(Key(cell.x(), cell.y()));
     }
   }
@@ -61,13 +64,19 @@ MapScore ScoreMap(const OccupancyGrid& estimate, const Pose2& truth_from_estimat
   score.estimate_occupied = static_cast<int>(estimate_cells.size());
   score.truth_occupied = static_cast<int>(truth_cells.size());
   for (const std::int64_t k : estimate_cells) {
-    score.estimate_matched += HasWithin(truth_cells, static_cast<int>(k >> 32), static_cast<std::int32_t>(k & 0xffffffff), options.tolerance_cells);
+    score.estimate_matched +=
+        HasWithin(truth_cells, static_cast<int>(k >> 32), static_cast<std::int32_t>(k & 0xffffffff),
+                  options.tolerance_cells);
   }
   for (const std::int64_t k : truth_cells) {
-    score.truth_matched += HasWithin(estimate_cells, static_cast<int>(k >> 32), static_cast<std::int32_t>(k & 0xffffffff), options.tolerance_cells);
+    score.truth_matched +=
+        HasWithin(estimate_cells, static_cast<int>(k >> 32),
+                  static_cast<std::int32_t>(k & 0xffffffff), options.tolerance_cells);
   }
-  if (score.estimate_occupied > 0) score.precision = static_cast<double>(score.estimate_matched) / score.estimate_occupied;
-  if (score.truth_occupied > 0) score.recall = static_cast<double>(score.truth_matched) / score.truth_occupied;
+  if (score.estimate_occupied > 0)
+    score.precision = static_cast<double>(score.estimate_matched) / score.estimate_occupied;
+  if (score.truth_occupied > 0)
+    score.recall = static_cast<double>(score.truth_matched) / score.truth_occupied;
   if (score.precision + score.recall > 0.0) {
     score.f1 = 2.0 * score.precision * score.recall / (score.precision + score.recall);
   }

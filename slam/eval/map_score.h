@@ -10,7 +10,7 @@ namespace slamrig::slam {
 
 /// How occupied cells are compared.
 struct MapScoreOptions {
-  int tolerance_cells = 1;             ///< a cell matches if the other map has one this close (Chebyshev)
+  int tolerance_cells = 1;  ///< a cell matches if the other map has one this close (Chebyshev)
   double occupied_probability = 0.65;  ///< a cell with a higher probability is occupied
 
   /// One message per broken rule (prefixed "map_score.").

@@ -2,8 +2,8 @@
 // point patterns", IEEE TPAMI 13(4), 1991, Eqs. 34-41 with c = 1, specialised to the plane.
 #include "slam/eval/pose_association.h"
 
-#include <algorithm>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 namespace slamrig::slam {
@@ -28,7 +28,8 @@ std::vector<PosePair> AssociatePoses(const Trajectory& estimate, const Trajector
     if (after == ref.end()) continue;
     if (after->time != e.time) {
       if (after == ref.begin()) continue;
-      if (SecondsBetween(after->time, (after - 1)->time) > options.max_interpolation_gap_s) continue;
+      if (SecondsBetween(after->time, (after - 1)->time) > options.max_interpolation_gap_s)
+        continue;
     }
     const std::optional<Pose2> r = reference.Interpolate(e.time);
     if (r) pairs.push_back({e.time, e.pose, *r});

@@ -17,7 +17,8 @@ namespace slamrig::slam {
 std::vector<std::string> RelationGeneratorOptions::Validate() const {
   std::vector<std::string> errors;
   if (consecutive_step < 0) {
-    errors.push_back("relations.consecutive_step = " + std::to_string(consecutive_step) + "; must be >= 0");
+    errors.push_back("relations.consecutive_step = " + std::to_string(consecutive_step) +
+                     "; must be >= 0");
   }
   for (const double d : path_distances_m) {
     if (!(d > 0.0)) {
@@ -27,7 +28,8 @@ std::vector<std::string> RelationGeneratorOptions::Validate() const {
     }
   }
   if (num_random_pairs < 0) {
-    errors.push_back("relations.num_random_pairs = " + std::to_string(num_random_pairs) + "; must be >= 0");
+    errors.push_back("relations.num_random_pairs = " + std::to_string(num_random_pairs) +
+                     "; must be >= 0");
   }
   return errors;
 }
@@ -42,7 +44,8 @@ std::vector<Relation> GenerateRelations(const Trajectory& reference,
     relations.push_back({p[i].time, p[j].time, p[i].pose.Between(p[j].pose)});
   };
   if (options.consecutive_step > 0) {
-    for (std::size_t i = 0; i < n; ++i) add(i, i + static_cast<std::size_t>(options.consecutive_step));
+    for (std::size_t i = 0; i < n; ++i)
+      add(i, i + static_cast<std::size_t>(options.consecutive_step));
   }
   std::vector<double> along(n, 0.0);
   for (std::size_t i = 1; i < n; ++i) {
@@ -100,12 +103,14 @@ std::vector<Relation> ParseRelations(const std::string& text, const std::string&
       throw ParseError(source_name + ":" + std::to_string(line_number) + ": unexpected field '" +
                        extra + "' after yaw");
     }
-    relations.push_back({Time::FromSeconds(v[0]), Time::FromSeconds(v[1]), Pose2(v[2], v[3], v[7])});
+    relations.push_back(
+        {Time::FromSeconds(v[0]), Time::FromSeconds(v[1]), Pose2(v[2], v[3], v[7])});
   }
   return relations;
 }
 
-RelationsResult EvaluateRelations(const Trajectory& estimate, const std::vector<Relation>& relations) {
+RelationsResult EvaluateRelations(const Trajectory& estimate,
+                                  const std::vector<Relation>& relations) {
   RelationsResult result;
   std::vector<double> trans, trans_sq, rot, rot_sq;
   for (const Relation& r : relations) {

@@ -20,9 +20,9 @@ struct Relation {
 
 /// Which pose pairs a generated relations file contains.
 struct RelationGeneratorOptions {
-  int consecutive_step = 1;               ///< (i, i + step) for every i; 0 = none
-  std::vector<double> path_distances_m;   ///< (i, first j with path length >= d) for each d
-  int num_random_pairs = 0;               ///< random (i, j) pairs over the whole run
+  int consecutive_step = 1;              ///< (i, i + step) for every i; 0 = none
+  std::vector<double> path_distances_m;  ///< (i, first j with path length >= d) for each d
+  int num_random_pairs = 0;              ///< random (i, j) pairs over the whole run
   std::uint64_t seed = 1;
 
   /// One message per broken rule (prefixed "relations.").
@@ -45,15 +45,16 @@ std::vector<Relation> ParseRelations(const std::string& text, const std::string&
 /// 27(4), 2009, Eqs. 1-2): for each relation, error = relative^-1 * (est(t1)^-1 est(t2)); mean and
 /// standard deviation of the absolute and squared translational and rotational errors.
 struct RelationsResult {
-  int used = 0;     ///< relations whose two times the estimate covers
-  int skipped = 0;  ///< relations outside the estimate
-  ErrorStats translation_m;       ///< |t| per relation
-  ErrorStats translation_sq_m2;   ///< |t|^2 per relation
-  ErrorStats rotation_rad;        ///< |theta| per relation
-  ErrorStats rotation_sq_rad2;    ///< theta^2 per relation
+  int used = 0;                  ///< relations whose two times the estimate covers
+  int skipped = 0;               ///< relations outside the estimate
+  ErrorStats translation_m;      ///< |t| per relation
+  ErrorStats translation_sq_m2;  ///< |t|^2 per relation
+  ErrorStats rotation_rad;       ///< |theta| per relation
+  ErrorStats rotation_sq_rad2;   ///< theta^2 per relation
 };
 
 /// Evaluates `estimate` on `relations`; poses are taken at exact stamps or interpolated.
-RelationsResult EvaluateRelations(const Trajectory& estimate, const std::vector<Relation>& relations);
+RelationsResult EvaluateRelations(const Trajectory& estimate,
+                                  const std::vector<Relation>& relations);
 
 }  // namespace slamrig::slam

@@ -54,8 +54,10 @@ TEST(RelationsTest, ErrorsAreMeanAndStdOfAbsoluteAndSquaredErrors) {
 }
 
 TEST(RelationsTest, FormatParseRoundTripAndErrors) {
-  const std::vector<Relation> relations = {{Time::FromSeconds(1.5), Time::FromSeconds(2.25), Pose2(0.5, -0.25, 0.125)}};
-  const std::vector<Relation> back = ParseRelations("# comment\n" + FormatRelations(relations), "r.txt");
+  const std::vector<Relation> relations = {
+      {Time::FromSeconds(1.5), Time::FromSeconds(2.25), Pose2(0.5, -0.25, 0.125)}};
+  const std::vector<Relation> back =
+      ParseRelations("# comment\n" + FormatRelations(relations), "r.txt");
   ASSERT_EQ(back.size(), 1u);
   EXPECT_EQ(back[0].t2, Time::FromSeconds(2.25));
   EXPECT_NEAR(back[0].relative.y(), -0.25, 1e-9);

@@ -30,7 +30,8 @@ RpeResult ComputeRpe(const Trajectory& estimate, const Trajectory& reference, do
   // Reference path length at each pair, for distance-based spacing.
   std::vector<double> along(pairs.size(), 0.0);
   for (std::size_t i = 1; i < pairs.size(); ++i) {
-    along[i] = along[i - 1] + (pairs[i].reference.translation() - pairs[i - 1].reference.translation()).norm();
+    along[i] = along[i - 1] +
+               (pairs[i].reference.translation() - pairs[i - 1].reference.translation()).norm();
   }
   RpeResult result;
   result.distance_m = distance_m;

@@ -35,7 +35,8 @@ std::vector<std::vector<double>> ReadCsv(const std::string& path, std::size_t co
       const double v = std::strtod(field.c_str(), &end);
       if (field.empty() || end != field.c_str() + field.size() || !std::isfinite(v)) {
         throw ParseError(path + ":" + std::to_string(reader.line_number()) + ": column " +
-                         std::to_string(row.size() + 1) + ": expected a finite number, got '" + field + "'");
+                         std::to_string(row.size() + 1) + ": expected a finite number, got '" +
+                         field + "'");
       }
       row.push_back(v);
       start = comma + 1;
@@ -111,8 +112,10 @@ bool SplitDataset(const std::string& path, std::string* dir, std::string* number
   while (digits > 0 && std::isdigit(static_cast<unsigned char>(name[digits - 1]))) --digits;
   if (digits == name.size()) return false;
   std::string prefix = name.substr(0, digits);
-  std::transform(prefix.begin(), prefix.end(), prefix.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (!prefix.empty() && prefix != "encoders" && prefix != "imu" && prefix != "hokuyo") return false;
+  std::transform(prefix.begin(), prefix.end(), prefix.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  if (!prefix.empty() && prefix != "encoders" && prefix != "imu" && prefix != "hokuyo")
+    return false;
   *dir = p.has_parent_path() ? p.parent_path().string() : ".";
   *number = name.substr(digits);
   return true;
@@ -138,12 +141,14 @@ bool LooksLikeEce276a(const std::string& path) {
 Ece276aFiles FindEce276aFiles(const std::string& path) {
   std::string dir, number;
   if (!SplitDataset(path, &dir, &number)) {
-    throw ParseError(path + ": not an ECE276A dataset (expected DIR/<number> or DIR/Encoders<number>.npz)");
+    throw ParseError(
+        path + ": not an ECE276A dataset (expected DIR/<number> or DIR/Encoders<number>.npz)");
   }
   Ece276aFiles files;
   files.encoders = FindOne(dir, "Encoders" + number + ".npz", "encoders" + number + ".csv.gz");
   if (files.encoders.empty()) {
-    throw ParseError(path + ": no Encoders" + number + ".npz or encoders" + number + ".csv.gz in " + dir);
+    throw ParseError(path + ": no Encoders" + number + ".npz or encoders" + number + ".csv.gz in " +
+                     dir);
   }
   files.imu = FindOne(dir, "Imu" + number + ".npz", "imu" + number + ".csv.gz");
   files.hokuyo = FindOne(dir, "Hokuyo" + number + ".npz", "");
@@ -170,7 +175,8 @@ Dataset ReadEce276a(const Ece276aFiles& files, const Ece276aReadOptions& options
       t = Stamps(arrays, "time_stamps", files.encoders);
       const NpyArray& c = Matrix(arrays, "counts", 4, t.size(), files.encoders);
       for (std::size_t i = 0; i < t.size(); ++i) {
-        counts.push_back({c.values[i], c.values[t.size() + i], c.values[2 * t.size() + i], c.values[3 * t.size() + i]});
+        counts.push_back({c.values[i], c.values[t.size() + i], c.values[2 * t.size() + i],
+                          c.values[3 * t.size() + i]});
       }
     } else {
       for (const auto& row : ReadCsv(files.encoders, 5)) {
@@ -182,8 +188,11 @@ Dataset ReadEce276a(const Ece276aFiles& files, const Ece276aReadOptions& options
       for (int k = 0; k < 4; ++k) {
         CheckFinite(counts[i][static_cast<std::size_t>(k)], files.encoders, "counts", i);
       }
-      const auto tick = [&](int k) { return static_cast<std::int32_t>(std::lround(counts[i][static_cast<std::size_t>(k)])); };
-      keyed.push_back({t[i], 0, WheelTicks{Time::FromSeconds(t[i]), {tick(0), tick(2)}, {tick(1), tick(3)}}});
+      const auto tick = [&](int k) {
+        return static_cast<std::int32_t>(std::lround(counts[i][static_cast<std::size_t>(k)]));
+      };
+      keyed.push_back(
+          {t[i], 0, WheelTicks{Time::FromSeconds(t[i]), {tick(0), tick(2)}, {tick(1), tick(3)}}});
     }
   }
 
@@ -198,7 +207,8 @@ Dataset ReadEce276a(const Ece276aFiles& files, const Ece276aReadOptions& options
       const NpyArray& a = Matrix(arrays, "linear_acceleration", 3, t.size(), files.imu);
       const std::size_t n = t.size();
       for (std::size_t i = 0; i < n; ++i) {
-        rows.push_back({a.values[i], a.values[n + i], a.values[2 * n + i], w.values[i], w.values[n + i], w.values[2 * n + i]});
+        rows.push_back({a.values[i], a.values[n + i], a.values[2 * n + i], w.values[i],
+                        w.values[n + i], w.values[2 * n + i]});
       }
     } else {
       for (const auto& row : ReadCsv(files.imu, 7)) {
@@ -210,7 +220,8 @@ Dataset ReadEce276a(const Ece276aFiles& files, const Ece276aReadOptions& options
       for (std::size_t k = 0; k < 6; ++k) CheckFinite(rows[i][k], files.imu, "imu", i);
       ImuSample imu;
       imu.time = Time::FromSeconds(t[i]);
-      imu.linear_acceleration_m_s2 = Eigen::Vector3d(rows[i][0], rows[i][1], rows[i][2]) * options.gravity_m_s2;
+      imu.linear_acceleration_m_s2 =
+          Eigen::Vector3d(rows[i][0], rows[i][1], rows[i][2]) * options.gravity_m_s2;
       imu.angular_velocity_rad_s = Eigen::Vector3d(rows[i][3], rows[i][4], rows[i][5]);
       keyed.push_back({t[i], 0, imu});
     }
@@ -229,9 +240,10 @@ Dataset ReadEce276a(const Ece276aFiles& files, const Ece276aReadOptions& options
     LaserScan prototype;
     prototype.angle_min_rad = Scalar(arrays, "angle_min", path);
     const double angle_max = Scalar(arrays, "angle_max", path);
-    prototype.angle_increment_rad = arrays.count("angle_increment") > 0
-                                        ? Scalar(arrays, "angle_increment", path)
-                                        : (angle_max - prototype.angle_min_rad) / static_cast<double>(beams - 1);
+    prototype.angle_increment_rad =
+        arrays.count("angle_increment") > 0
+            ? Scalar(arrays, "angle_increment", path)
+            : (angle_max - prototype.angle_min_rad) / static_cast<double>(beams - 1);
     prototype.range_min_m = Scalar(arrays, "range_min", path);
     prototype.range_max_m = Scalar(arrays, "range_max", path);
     prototype.base_from_laser = options.base_from_lidar;
@@ -252,7 +264,8 @@ Dataset ReadEce276a(const Ece276aFiles& files, const Ece276aReadOptions& options
       keyed.push_back({t[i], 1, std::move(scan)});
     }
     if (nan_beams > 0) {
-      data.notes.push_back(std::to_string(nan_beams) + " non-finite Hokuyo ranges read as no return");
+      data.notes.push_back(std::to_string(nan_beams) +
+                           " non-finite Hokuyo ranges read as no return");
     }
   } else {
     data.notes.push_back("no Hokuyo file: encoders and IMU only (dead reckoning, no map)");

@@ -19,7 +19,9 @@ namespace {
 
 // --- A minimal .npz writer (stored zip entries), independent of the reader under test. ---
 
-std::string U16(std::uint32_t v) { return std::string{static_cast<char>(v & 0xff), static_cast<char>((v >> 8) & 0xff)}; }
+std::string U16(std::uint32_t v) {
+  return std::string{static_cast<char>(v & 0xff), static_cast<char>((v >> 8) & 0xff)};
+}
 std::string U32(std::uint32_t v) { return U16(v & 0xffff) + U16(v >> 16); }
 
 struct NpyInput {
@@ -35,11 +37,13 @@ std::string Npy(const NpyInput& a) {
   for (const std::size_t s : a.shape) shape += std::to_string(s) + ", ";
   if (a.shape.size() > 1) shape.resize(shape.size() - 2);
   shape += ")";
-  std::string header = "{'descr': '" + a.descr + "', 'fortran_order': " + (a.fortran ? "True" : "False") +
+  std::string header = "{'descr': '" + a.descr +
+                       "', 'fortran_order': " + (a.fortran ? "True" : "False") +
                        ", 'shape': " + shape + ", }";
   while ((10 + header.size() + 1) % 64 != 0) header += ' ';
   header += '\n';
-  return std::string("\x93NUMPY\x01\x00", 8) + U16(static_cast<std::uint32_t>(header.size())) + header + a.data;
+  return std::string("\x93NUMPY\x01\x00", 8) + U16(static_cast<std::uint32_t>(header.size())) +
+         header + a.data;
 }
 
 void WriteNpz(const std::string& path, const std::vector<NpyInput>& arrays) {
@@ -47,19 +51,21 @@ void WriteNpz(const std::string& path, const std::vector<NpyInput>& arrays) {
   for (const NpyInput& a : arrays) {
     const std::string name = a.name + ".npy";
     const std::string body = Npy(a);
-    const auto crc = static_cast<std::uint32_t>(crc32(0L, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size())));
+    const auto crc = static_cast<std::uint32_t>(
+        crc32(0L, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size())));
     const auto offset = static_cast<std::uint32_t>(out.size());
     const auto size = static_cast<std::uint32_t>(body.size());
-    out += U32(0x04034b50) + U16(20) + U16(0) + U16(0) + U16(0) + U16(0) + U32(crc) + U32(size) + U32(size) +
-           U16(static_cast<std::uint32_t>(name.size())) + U16(0) + name + body;
-    central += U32(0x02014b50) + U16(20) + U16(20) + U16(0) + U16(0) + U16(0) + U16(0) + U32(crc) + U32(size) +
-               U32(size) + U16(static_cast<std::uint32_t>(name.size())) + U16(0) + U16(0) + U16(0) + U16(0) +
-               U32(0) + U32(offset) + name;
+    out += U32(0x04034b50) + U16(20) + U16(0) + U16(0) + U16(0) + U16(0) + U32(crc) + U32(size) +
+           U32(size) + U16(static_cast<std::uint32_t>(name.size())) + U16(0) + name + body;
+    central += U32(0x02014b50) + U16(20) + U16(20) + U16(0) + U16(0) + U16(0) + U16(0) + U32(crc) +
+               U32(size) + U32(size) + U16(static_cast<std::uint32_t>(name.size())) + U16(0) +
+               U16(0) + U16(0) + U16(0) + U32(0) + U32(offset) + name;
   }
   const auto central_at = static_cast<std::uint32_t>(out.size());
-  out += central + U32(0x06054b50) + U16(0) + U16(0) + U16(static_cast<std::uint32_t>(arrays.size())) +
-         U16(static_cast<std::uint32_t>(arrays.size())) + U32(static_cast<std::uint32_t>(central.size())) +
-         U32(central_at) + U16(0);
+  out += central + U32(0x06054b50) + U16(0) + U16(0) +
+         U16(static_cast<std::uint32_t>(arrays.size())) +
+         U16(static_cast<std::uint32_t>(arrays.size())) +
+         U32(static_cast<std::uint32_t>(central.size())) + U32(central_at) + U16(0);
   std::ofstream(path, std::ios::binary) << out;
 }
 
@@ -81,7 +87,8 @@ SmallLog WriteSmallLog(const testing::TempDir& dir, bool with_nan) {
   const double t0 = 1298445274.5;
   for (int i = 0; i < 120; ++i) {
     log.enc_t.push_back(t0 + 0.025 * i);
-    for (const std::int16_t c : {std::int16_t(i % 5), std::int16_t(i % 3), std::int16_t(i % 7), std::int16_t(1)}) {
+    for (const std::int16_t c :
+         {std::int16_t(i % 5), std::int16_t(i % 3), std::int16_t(i % 7), std::int16_t(1)}) {
       log.counts_fortran.push_back(c);
     }
   }
@@ -94,13 +101,16 @@ SmallLog WriteSmallLog(const testing::TempDir& dir, bool with_nan) {
   const int beams = 1081, scans = 120;
   std::vector<float> ranges(static_cast<std::size_t>(beams * scans));  // (1081, N) in C order
   for (int b = 0; b < beams; ++b) {
-    for (int s = 0; s < scans; ++s) ranges[static_cast<std::size_t>(b * scans + s)] = static_cast<float>(1.0 + 0.001 * b + 0.01 * s);
+    for (int s = 0; s < scans; ++s)
+      ranges[static_cast<std::size_t>(b * scans + s)] =
+          static_cast<float>(1.0 + 0.001 * b + 0.01 * s);
   }
   if (with_nan) ranges[5 * scans + 7] = std::nanf("");
   for (int s = 0; s < scans; ++s) log.lidar_t.push_back(t0 + 0.025 * s);  // same stamps as encoders
   const std::size_t n_enc = log.enc_t.size(), n_imu = log.imu_t.size();
-  WriteNpz(dir.File("Encoders99.npz"), {{"counts", "<i2", {4, n_enc}, true, Raw(log.counts_fortran)},
-                                        {"time_stamps", "<f8", {n_enc}, false, Raw(log.enc_t)}});
+  WriteNpz(dir.File("Encoders99.npz"),
+           {{"counts", "<i2", {4, n_enc}, true, Raw(log.counts_fortran)},
+            {"time_stamps", "<f8", {n_enc}, false, Raw(log.enc_t)}});
   WriteNpz(dir.File("Imu99.npz"), {{"angular_velocity", "<f8", {3, n_imu}, true, Raw(w)},
                                    {"linear_acceleration", "<f8", {3, n_imu}, true, Raw(a)},
                                    {"time_stamps", "<f8", {n_imu}, false, Raw(log.imu_t)}});
@@ -108,10 +118,18 @@ SmallLog WriteSmallLog(const testing::TempDir& dir, bool with_nan) {
   WriteNpz(dir.File("Hokuyo99.npz"),
            {{"angle_min", "<f8", {}, false, Raw(std::vector<double>{angle_min})},
             {"angle_max", "<f8", {}, false, Raw(std::vector<double>{angle_max})},
-            {"angle_increment", "<f8", {}, false, Raw(std::vector<double>{(angle_max - angle_min) / 1080})},
+            {"angle_increment",
+             "<f8",
+             {},
+             false,
+             Raw(std::vector<double>{(angle_max - angle_min) / 1080})},
             {"range_min", "<f8", {}, false, Raw(std::vector<double>{0.1})},
             {"range_max", "<f8", {}, false, Raw(std::vector<double>{30.0})},
-            {"ranges", "<f4", {static_cast<std::size_t>(beams), static_cast<std::size_t>(scans)}, false, Raw(ranges)},
+            {"ranges",
+             "<f4",
+             {static_cast<std::size_t>(beams), static_cast<std::size_t>(scans)},
+             false,
+             Raw(ranges)},
             {"time_stamps", "<f8", {static_cast<std::size_t>(scans)}, false, Raw(log.lidar_t)}});
   return log;
 }
@@ -138,8 +156,10 @@ TEST(Ece276aReaderTest, ReadsNpzEncodersImuAndHokuyoInTimeOrder) {
     if (const auto* t = std::get_if<WheelTicks>(&r)) {
       // [FR, FL, RR, RL] -> right {FR, RR}, left {FL, RL}.
       const std::size_t k = static_cast<std::size_t>(ticks);
-      EXPECT_EQ(t->right_ticks, (std::vector<std::int32_t>{log.counts_fortran[4 * k], log.counts_fortran[4 * k + 2]}));
-      EXPECT_EQ(t->left_ticks, (std::vector<std::int32_t>{log.counts_fortran[4 * k + 1], log.counts_fortran[4 * k + 3]}));
+      EXPECT_EQ(t->right_ticks, (std::vector<std::int32_t>{log.counts_fortran[4 * k],
+                                                           log.counts_fortran[4 * k + 2]}));
+      EXPECT_EQ(t->left_ticks, (std::vector<std::int32_t>{log.counts_fortran[4 * k + 1],
+                                                          log.counts_fortran[4 * k + 3]}));
       EXPECT_EQ(t->time, Time::FromSeconds(log.enc_t[k]));
       ++ticks;
     } else if (const auto* imu = std::get_if<ImuSample>(&r)) {
@@ -173,7 +193,8 @@ TEST(Ece276aReaderTest, CsvAndNpzGiveTheSameRecords) {
   for (std::size_t i = 0; i < log.enc_t.size(); ++i) {
     char line[128];
     std::snprintf(line, sizeof(line), "%.6f,%d,%d,%d,%d\n", log.enc_t[i], log.counts_fortran[4 * i],
-                  log.counts_fortran[4 * i + 1], log.counts_fortran[4 * i + 2], log.counts_fortran[4 * i + 3]);
+                  log.counts_fortran[4 * i + 1], log.counts_fortran[4 * i + 2],
+                  log.counts_fortran[4 * i + 3]);
     gzputs(f, line);
   }
   gzclose(f);
@@ -182,7 +203,8 @@ TEST(Ece276aReaderTest, CsvAndNpzGiveTheSameRecords) {
   ASSERT_EQ(csv.records.size(), 120u);
   ASSERT_EQ(npz.records.size(), 120u);
   for (std::size_t i = 0; i < 120; ++i) {
-    EXPECT_EQ(std::get<WheelTicks>(csv.records[i]).right_ticks, std::get<WheelTicks>(npz.records[i]).right_ticks);
+    EXPECT_EQ(std::get<WheelTicks>(csv.records[i]).right_ticks,
+              std::get<WheelTicks>(npz.records[i]).right_ticks);
     EXPECT_EQ(std::get<WheelTicks>(csv.records[i]).time, std::get<WheelTicks>(npz.records[i]).time);
   }
 }
@@ -196,10 +218,13 @@ TEST(Ece276aReaderTest, BadFilesAreParseErrorsNamingTheFileAndPlace) {
     ReadEce276a(FindEce276aFiles(dir.File("97")));
     FAIL();
   } catch (const ParseError& e) {
-    EXPECT_STREQ(e.what(), (dir.File("encoders97.csv.gz") + ":3: column 3: expected a finite number, got 'x'").c_str());
+    EXPECT_STREQ(e.what(),
+                 (dir.File("encoders97.csv.gz") + ":3: column 3: expected a finite number, got 'x'")
+                     .c_str());
   }
-  WriteNpz(dir.File("Encoders96.npz"), {{"counts", "<i2", {3, 1}, true, Raw(std::vector<std::int16_t>{1, 2, 3})},
-                                        {"time_stamps", "<f8", {1}, false, Raw(std::vector<double>{1.0})}});
+  WriteNpz(dir.File("Encoders96.npz"),
+           {{"counts", "<i2", {3, 1}, true, Raw(std::vector<std::int16_t>{1, 2, 3})},
+            {"time_stamps", "<f8", {1}, false, Raw(std::vector<double>{1.0})}});
   EXPECT_THROW(ReadEce276a(FindEce276aFiles(dir.File("96"))), ParseError);
   EXPECT_THROW(FindEce276aFiles(dir.File("95")), ParseError);
   dir.Write("Encoders94.npz", "not a zip");
@@ -211,8 +236,10 @@ TEST(Ece276aReaderTest, BadFilesAreParseErrorsNamingTheFileAndPlace) {
 TEST(Ece276aReaderTest, RealDataset20) {
   SLAMRIG_REQUIRE_DATASET(encoders, "ece276a_pr2_partial/Encoders20.npz");
   const Dataset npz = ReadEce276a(FindEce276aFiles(encoders));
-  const std::string csv_path = (std::filesystem::path(encoders).parent_path() / "encoders20.csv.gz").string();
-  const std::string imu_csv = (std::filesystem::path(encoders).parent_path() / "imu20.csv.gz").string();
+  const std::string csv_path =
+      (std::filesystem::path(encoders).parent_path() / "encoders20.csv.gz").string();
+  const std::string imu_csv =
+      (std::filesystem::path(encoders).parent_path() / "imu20.csv.gz").string();
   const Dataset csv = ReadEce276a(Ece276aFiles{csv_path, imu_csv, ""});
   ASSERT_EQ(npz.records.size(), 4956u + 12187u);
   ASSERT_EQ(csv.records.size(), npz.records.size());

@@ -20,7 +20,8 @@ namespace {
 std::uint64_t Le(const std::string& b, std::size_t at, int bytes, const std::string& where) {
   if (at + static_cast<std::size_t>(bytes) > b.size()) throw ParseError(where + ": truncated");
   std::uint64_t v = 0;
-  for (int i = bytes - 1; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(b[at + static_cast<std::size_t>(i)]);
+  for (int i = bytes - 1; i >= 0; --i)
+    v = (v << 8) | static_cast<unsigned char>(b[at + static_cast<std::size_t>(i)]);
   return v;
 }
 
@@ -35,7 +36,8 @@ std::string Inflate(const std::string& compressed, std::size_t size, const std::
   const int status = inflate(&z, Z_FINISH);
   const std::size_t produced = z.total_out;
   inflateEnd(&z);
-  if (status != Z_STREAM_END || produced != size) throw ParseError(where + ": corrupt deflate data");
+  if (status != Z_STREAM_END || produced != size)
+    throw ParseError(where + ": corrupt deflate data");
   return out;
 }
 
@@ -103,7 +105,8 @@ NpyArray ParseNpy(const std::string& bytes, const std::string& name) {
   }
   const std::string& t = array.dtype;
   const bool big_endian = !t.empty() && t[0] == '>';
-  const std::string kind = t.size() > 1 && (t[0] == '<' || t[0] == '|' || t[0] == '=') ? t.substr(1) : t;
+  const std::string kind =
+      t.size() > 1 && (t[0] == '<' || t[0] == '|' || t[0] == '=') ? t.substr(1) : t;
   if (big_endian) throw ParseError(name + ": big-endian dtype " + t + " is not supported");
   std::size_t item = 0;
   const char* data = bytes.data() + header_at + header_len;
@@ -113,17 +116,38 @@ NpyArray ParseNpy(const std::string& bytes, const std::string& name) {
     if (count * item > available) throw ParseError(name + ": array data truncated");
   };
   std::vector<double> flat;
-  if (kind == "f8") { need(8); Convert<double>(data, count, &flat); }
-  else if (kind == "f4") { need(4); Convert<float>(data, count, &flat); }
-  else if (kind == "i1") { need(1); Convert<std::int8_t>(data, count, &flat); }
-  else if (kind == "i2") { need(2); Convert<std::int16_t>(data, count, &flat); }
-  else if (kind == "i4") { need(4); Convert<std::int32_t>(data, count, &flat); }
-  else if (kind == "i8") { need(8); Convert<std::int64_t>(data, count, &flat); }
-  else if (kind == "u1" || kind == "b1") { need(1); Convert<std::uint8_t>(data, count, &flat); }
-  else if (kind == "u2") { need(2); Convert<std::uint16_t>(data, count, &flat); }
-  else if (kind == "u4") { need(4); Convert<std::uint32_t>(data, count, &flat); }
-  else if (kind == "u8") { need(8); Convert<std::uint64_t>(data, count, &flat); }
-  else throw ParseError(name + ": dtype " + t + " is not supported");
+  if (kind == "f8") {
+    need(8);
+    Convert<double>(data, count, &flat);
+  } else if (kind == "f4") {
+    need(4);
+    Convert<float>(data, count, &flat);
+  } else if (kind == "i1") {
+    need(1);
+    Convert<std::int8_t>(data, count, &flat);
+  } else if (kind == "i2") {
+    need(2);
+    Convert<std::int16_t>(data, count, &flat);
+  } else if (kind == "i4") {
+    need(4);
+    Convert<std::int32_t>(data, count, &flat);
+  } else if (kind == "i8") {
+    need(8);
+    Convert<std::int64_t>(data, count, &flat);
+  } else if (kind == "u1" || kind == "b1") {
+    need(1);
+    Convert<std::uint8_t>(data, count, &flat);
+  } else if (kind == "u2") {
+    need(2);
+    Convert<std::uint16_t>(data, count, &flat);
+  } else if (kind == "u4") {
+    need(4);
+    Convert<std::uint32_t>(data, count, &flat);
+  } else if (kind == "u8") {
+    need(8);
+    Convert<std::uint64_t>(data, count, &flat);
+  } else
+    throw ParseError(name + ": dtype " + t + " is not supported");
 
   if (!fortran || array.shape.size() < 2) {
     array.values = std::move(flat);
@@ -164,7 +188,8 @@ std::map<std::string, NpyArray> ReadNpz(const std::string& path) {
 
   std::map<std::string, NpyArray> arrays;
   for (std::size_t e = 0; e < entries; ++e) {
-    if (Le(b, at, 4, path) != 0x02014b50) throw ParseError(path + ": corrupt zip central directory");
+    if (Le(b, at, 4, path) != 0x02014b50)
+      throw ParseError(path + ": corrupt zip central directory");
     const int method = static_cast<int>(Le(b, at + 10, 2, path));
     std::uint64_t compressed = Le(b, at + 20, 4, path);
     std::uint64_t size = Le(b, at + 24, 4, path);
@@ -181,9 +206,17 @@ std::map<std::string, NpyArray> ReadNpz(const std::string& path) {
       const auto len = static_cast<std::size_t>(Le(b, x + 2, 2, path));
       if (id == 0x0001) {
         std::size_t f = x + 4;
-        if (size == 0xFFFFFFFFu) { size = Le(b, f, 8, path); f += 8; }
-        if (compressed == 0xFFFFFFFFu) { compressed = Le(b, f, 8, path); f += 8; }
-        if (local == 0xFFFFFFFFu) { local = Le(b, f, 8, path); }
+        if (size == 0xFFFFFFFFu) {
+          size = Le(b, f, 8, path);
+          f += 8;
+        }
+        if (compressed == 0xFFFFFFFFu) {
+          compressed = Le(b, f, 8, path);
+          f += 8;
+        }
+        if (local == 0xFFFFFFFFu) {
+          local = Le(b, f, 8, path);
+        }
       }
       x += 4 + len;
     }
@@ -202,7 +235,8 @@ std::map<std::string, NpyArray> ReadNpz(const std::string& path) {
     } else if (method == 8) {
       bytes = Inflate(raw, static_cast<std::size_t>(size), where);
     } else {
-      throw ParseError(where + ": zip compression method " + std::to_string(method) + " not supported");
+      throw ParseError(where + ": zip compression method " + std::to_string(method) +
+                       " not supported");
     }
     std::string key = name;
     if (key.size() > 4 && key.compare(key.size() - 4, 4, ".npy") == 0) key.resize(key.size() - 4);

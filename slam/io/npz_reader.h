@@ -9,9 +9,9 @@ namespace slamrig::slam {
 
 /// One array of a numpy .npy/.npz file, converted to double, in C (row-major) order.
 struct NpyArray {
-  std::string dtype;                ///< numpy descr, e.g. "<f8", "<i2"
-  std::vector<std::size_t> shape;   ///< () for a scalar
-  std::vector<double> values;       ///< row-major: element (i, j) of a 2-D array at i * shape[1] + j
+  std::string dtype;               ///< numpy descr, e.g. "<f8", "<i2"
+  std::vector<std::size_t> shape;  ///< () for a scalar
+  std::vector<double> values;      ///< row-major: element (i, j) of a 2-D array at i * shape[1] + j
 
   /// Number of elements (1 for a scalar).
   std::size_t size() const { return values.size(); }

@@ -39,7 +39,8 @@ void LikelihoodField::Update(const OccupancyGrid& grid, const Eigen::AlignedBox2
   // Kernel of scores by cell offset, rebuilt only when the resolution changes.
   if (kernel_resolution_ != resolution_) {
     kernel_resolution_ = resolution_;
-    radius_cells_ = static_cast<int>(std::ceil(options_.cutoff_sigmas * options_.sigma_m / resolution_));
+    radius_cells_ =
+        static_cast<int>(std::ceil(options_.cutoff_sigmas * options_.sigma_m / resolution_));
     const int side = 2 * radius_cells_ + 1;
     kernel_.assign(static_cast<std::size_t>(side * side), 0.0f);
     for (int dy = -radius_cells_; dy <= radius_cells_; ++dy) {

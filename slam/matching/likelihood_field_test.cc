@@ -27,7 +27,8 @@ TEST(LikelihoodFieldTest, ValueFollowsDistanceToTheNearestWall) {
     for (double y = 0.25; y < 1.75; y += 0.05) {
       const Eigen::Array2i cell = grid.WorldToCell({x, y});
       const Eigen::Vector2d c = grid.CellCenter(cell);
-      const double d = std::min((c - grid.CellCenter(wall_a)).norm(), (c - grid.CellCenter(wall_b)).norm());
+      const double d =
+          std::min((c - grid.CellCenter(wall_a)).norm(), (c - grid.CellCenter(wall_b)).norm());
       const int vx = static_cast<int>(std::floor((c.x() - view.origin.x()) / view.resolution));
       const int vy = static_cast<int>(std::floor((c.y() - view.origin.y()) / view.resolution));
       ASSERT_NEAR(view.At(vx, vy), field.Score(d), 1e-5) << x << " " << y;

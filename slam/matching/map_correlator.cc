@@ -47,8 +47,8 @@ struct IndicatorOp {
 // Adds, for every patch row r and column c < 4*K, the contribution of cell
 // values[offset + r*width + c] over all `offsets` into sums[r*4K + c].
 template <int K, typename Op>
-void AccumulateRows(const float* values, int width, int side, const std::vector<std::int64_t>& offsets,
-                    const Op& op, float* sums) {
+void AccumulateRows(const float* values, int width, int side,
+                    const std::vector<std::int64_t>& offsets, const Op& op, float* sums) {
   for (int r = 0; r < side; ++r) {
     V4 acc[K] = {};
     const float* row_base = values + static_cast<std::ptrdiff_t>(r) * width;
@@ -64,15 +64,24 @@ template <typename Op>
 void AccumulateDispatch(int chunks, const float* values, int width, int side,
                         const std::vector<std::int64_t>& offsets, const Op& op, float* sums) {
   switch (chunks) {
-    case 1: return AccumulateRows<1>(values, width, side, offsets, op, sums);
-    case 2: return AccumulateRows<2>(values, width, side, offsets, op, sums);
-    case 3: return AccumulateRows<3>(values, width, side, offsets, op, sums);
-    case 4: return AccumulateRows<4>(values, width, side, offsets, op, sums);
-    case 5: return AccumulateRows<5>(values, width, side, offsets, op, sums);
-    case 6: return AccumulateRows<6>(values, width, side, offsets, op, sums);
-    case 7: return AccumulateRows<7>(values, width, side, offsets, op, sums);
-    case 8: return AccumulateRows<8>(values, width, side, offsets, op, sums);
-    default: SLAMRIG_CHECK(false, "shift grid too wide");
+    case 1:
+      return AccumulateRows<1>(values, width, side, offsets, op, sums);
+    case 2:
+      return AccumulateRows<2>(values, width, side, offsets, op, sums);
+    case 3:
+      return AccumulateRows<3>(values, width, side, offsets, op, sums);
+    case 4:
+      return AccumulateRows<4>(values, width, side, offsets, op, sums);
+    case 5:
+      return AccumulateRows<5>(values, width, side, offsets, op, sums);
+    case 6:
+      return AccumulateRows<6>(values, width, side, offsets, op, sums);
+    case 7:
+      return AccumulateRows<7>(values, width, side, offsets, op, sums);
+    case 8:
+      return AccumulateRows<8>(values, width, side, offsets, op, sums);
+    default:
+      SLAMRIG_CHECK(false, "shift grid too wide");
   }
 }
 
@@ -84,8 +93,8 @@ inline int FastFloor(double v) {
 
 // Scratch reused across calls on the same thread.
 struct Scratch {
-  std::vector<std::int64_t> offsets;    // patch corner offsets of points fully inside
-  std::vector<Eigen::Array2i> border;   // patch corner cells of points near or over the edge
+  std::vector<std::int64_t> offsets;   // patch corner offsets of points fully inside
+  std::vector<Eigen::Array2i> border;  // patch corner cells of points near or over the edge
   std::vector<float> sums;
 };
 
@@ -124,12 +133,14 @@ CorrelationResult MapCorrelator::Correlate(const GridView& grid,
   const double inv_res = 1.0 / grid.resolution;
   const IndicatorOp indicator{options_.occupied_threshold};
   const RawOp raw;
-  if (table != nullptr) table->assign(static_cast<std::size_t>(options_.num_yaws() * side * side), 0.0f);
+  if (table != nullptr)
+    table->assign(static_cast<std::size_t>(options_.num_yaws() * side * side), 0.0f);
 
   CorrelationResult best;
   best.score = -std::numeric_limits<float>::infinity();
   long best_rank = std::numeric_limits<long>::max();
-  for (int yaw_index = -options_.yaw_half_steps; yaw_index <= options_.yaw_half_steps; ++yaw_index) {
+  for (int yaw_index = -options_.yaw_half_steps; yaw_index <= options_.yaw_half_steps;
+       ++yaw_index) {
     const double yaw = world_from_base.theta() + yaw_index * options_.yaw_step_rad;
     const double c = std::cos(yaw) * inv_res;
     const double s = std::sin(yaw) * inv_res;
@@ -182,8 +193,8 @@ CorrelationResult MapCorrelator::Correlate(const GridView& grid,
         const float score = scratch.sums[static_cast<std::size_t>(r * padded + col)];
         const int dx = col - n, dy = r - n;
         if (table != nullptr) {
-          (*table)[static_cast<std::size_t>(((yaw_index + options_.yaw_half_steps) * side + r) * side + col)] =
-              score;
+          (*table)[static_cast<std::size_t>(
+              ((yaw_index + options_.yaw_half_steps) * side + r) * side + col)] = score;
         }
         const long rank = static_cast<long>(dx) * dx + static_cast<long>(dy) * dy +
                           static_cast<long>(yaw_index) * yaw_index;

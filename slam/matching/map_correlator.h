@@ -39,12 +39,12 @@ struct MapCorrelatorOptions {
 
 /// The best shift found for one pose.
 struct CorrelationResult {
-  float score = 0.0f;  ///< correlation at the best shift
-  int dx_cells = 0;    ///< best shift in cells (world x)
-  int dy_cells = 0;    ///< best shift in cells (world y)
-  int dyaw_steps = 0;  ///< best yaw shift in steps
-  Pose2 pose;          ///< the input pose moved by the best shift
-  int points_used = 0; ///< distinct cells the points fell in at the unshifted yaw
+  float score = 0.0f;   ///< correlation at the best shift
+  int dx_cells = 0;     ///< best shift in cells (world x)
+  int dy_cells = 0;     ///< best shift in cells (world y)
+  int dyaw_steps = 0;   ///< best yaw shift in steps
+  Pose2 pose;           ///< the input pose moved by the best shift
+  int points_used = 0;  ///< distinct cells the points fell in at the unshifted yaw
 };
 
 /// Correlates a scan with a map raster over a grid of x/y/yaw shifts around a pose (the laser
@@ -53,7 +53,8 @@ struct CorrelationResult {
 /// The sum over shifts is computed as S x S patch sums: every point is transformed once per yaw
 /// to an integer cell, consecutive points in the same cell are counted once, and the S rows of the
 /// patch are accumulated row by row in SIMD registers over all points (cache-friendly, no per-shift
-/// transform). Scores are float sums in a fixed order, so results are bit-reproducible. Thread-safe.
+/// transform). Scores are float sums in a fixed order, so results are bit-reproducible.
+/// Thread-safe.
 class MapCorrelator {
  public:
   explicit MapCorrelator(const MapCorrelatorOptions& options);

@@ -25,7 +25,9 @@ float NaiveScore(const GridView& grid, const std::vector<Eigen::Vector2d>& point
     last_x = ix;
     last_y = iy;
     const float v = grid.At(ix, iy);
-    sum += options.value == CorrelationValue::kRawValue ? v : (v > options.occupied_threshold ? 1.0f : 0.0f);
+    sum += options.value == CorrelationValue::kRawValue
+               ? v
+               : (v > options.occupied_threshold ? 1.0f : 0.0f);
   }
   return sum;
 }
@@ -46,7 +48,8 @@ RandomRaster MakeRaster(RandomEngine& rng, int width, int height) {
 TEST(MapCorrelatorTest, MatchesBruteForceOnRandomRastersIncludingEdges) {
   RandomEngine rng(11);
   RandomRaster raster = MakeRaster(rng, 60, 50);
-  for (const CorrelationValue value : {CorrelationValue::kOccupiedIndicator, CorrelationValue::kRawValue}) {
+  for (const CorrelationValue value :
+       {CorrelationValue::kOccupiedIndicator, CorrelationValue::kRawValue}) {
     MapCorrelatorOptions options;
     options.value = value;
     options.yaw_half_steps = 1;
@@ -56,16 +59,19 @@ TEST(MapCorrelatorTest, MatchesBruteForceOnRandomRastersIncludingEdges) {
       std::vector<Eigen::Vector2d> points;
       for (int i = 0; i < 200; ++i) {
         // Clustered points so consecutive duplicates occur; some fall off the raster.
-        points.emplace_back(0.8 * std::cos(0.03 * i) + 0.001 * i, 0.8 * std::sin(0.03 * i) * (1 + trial % 3));
+        points.emplace_back(0.8 * std::cos(0.03 * i) + 0.001 * i,
+                            0.8 * std::sin(0.03 * i) * (1 + trial % 3));
       }
-      const Pose2 pose(0.2 + 0.4 * Uniform01(rng), 0.3 + 0.4 * Uniform01(rng), 6.0 * Uniform01(rng));
+      const Pose2 pose(0.2 + 0.4 * Uniform01(rng), 0.3 + 0.4 * Uniform01(rng),
+                       6.0 * Uniform01(rng));
       std::vector<float> table;
       const CorrelationResult result = correlator.Correlate(raster.view, points, pose, &table);
       float best = -1e30f;
       for (int k = -1; k <= 1; ++k) {
         for (int dy = -4; dy <= 4; ++dy) {
           for (int dx = -4; dx <= 4; ++dx) {
-            const Pose2 shifted(pose.x() + dx * 0.05, pose.y() + dy * 0.05, pose.theta() + k * 0.02);
+            const Pose2 shifted(pose.x() + dx * 0.05, pose.y() + dy * 0.05,
+                                pose.theta() + k * 0.02);
             const float naive = NaiveScore(raster.view, points, shifted, options);
             const float fast = table[static_cast<std::size_t>(((k + 1) * 9 + dy + 4) * 9 + dx + 4)];
             ASSERT_NEAR(fast, naive, 1e-3) << trial << " " << k << " " << dx << " " << dy;
@@ -124,9 +130,10 @@ TEST(MapCorrelatorTest, ValidateNamesFieldValueAndRule) {
   options.xy_half_width_cells = -1;
   options.yaw_half_steps = 2;
   options.yaw_step_rad = 0.0;
-  EXPECT_THAT(options.Validate(),
-              ::testing::ElementsAre("correlation.xy_half_width_cells = -1; must be in [0, 15]",
-                                   "correlation.yaw_step_rad = 0; must be > 0 when yaw_half_steps > 0"));
+  EXPECT_THAT(
+      options.Validate(),
+      ::testing::ElementsAre("correlation.xy_half_width_cells = -1; must be in [0, 15]",
+                             "correlation.yaw_step_rad = 0; must be > 0 when yaw_half_steps > 0"));
 }
 
 }  // namespace

@@ -42,7 +42,8 @@ TEST(ScanPointsTest, VoxelFilterKeepsOnePointPerVoxelInBeamOrder) {
   const std::vector<Eigen::Vector2d> all = ScanToBasePoints(scan, ScanPointsOptions{});
   const std::vector<Eigen::Vector2d> kept = ScanToBasePoints(scan, options);
   std::set<std::pair<long, long>> voxels;
-  for (const auto& p : all) voxels.insert({std::lround(std::floor(p.x() / 0.1)), std::lround(std::floor(p.y() / 0.1))});
+  for (const auto& p : all)
+    voxels.insert({std::lround(std::floor(p.x() / 0.1)), std::lround(std::floor(p.y() / 0.1))});
   EXPECT_EQ(kept.size(), voxels.size());
   for (std::size_t i = 1; i < kept.size(); ++i) {
     EXPECT_LT(std::atan2(kept[i - 1].y(), kept[i - 1].x()), std::atan2(kept[i].y(), kept[i].x()));

@@ -89,7 +89,8 @@ RefineResult ScanRefiner::Refine(const GridView& raster, float max_value,
     if (!step.allFinite()) break;
     const double t_norm = step.head<2>().norm();
     if (t_norm > options_.max_step_m) step *= options_.max_step_m / t_norm;
-    if (std::abs(step.z()) > options_.max_step_rad) step *= options_.max_step_rad / std::abs(step.z());
+    if (std::abs(step.z()) > options_.max_step_rad)
+      step *= options_.max_step_rad / std::abs(step.z());
     const Pose2 candidate(pose.x() + step.x(), pose.y() + step.y(), pose.theta() + step.z());
     const double score = Score(raster, points_base, candidate);
     ++result.iterations;

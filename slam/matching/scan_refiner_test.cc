@@ -31,9 +31,11 @@ TEST(ScanRefinerTest, RecoversSubCellOffsets) {
   options.max_iterations = 20;
   const ScanRefiner refiner(options);
   for (int trial = 0; trial < 20; ++trial) {
-    const Pose2 start(truth.x() + 0.08 * (2 * Uniform01(rng) - 1), truth.y() + 0.08 * (2 * Uniform01(rng) - 1),
+    const Pose2 start(truth.x() + 0.08 * (2 * Uniform01(rng) - 1),
+                      truth.y() + 0.08 * (2 * Uniform01(rng) - 1),
                       truth.theta() + 0.02 * (2 * Uniform01(rng) - 1));
-    const RefineResult r = refiner.Refine(field.view(), static_cast<float>(field.Score(0.0)), points, start);
+    const RefineResult r =
+        refiner.Refine(field.view(), static_cast<float>(field.Score(0.0)), points, start);
     EXPECT_NEAR(r.pose.x(), truth.x(), 0.015) << trial;
     EXPECT_NEAR(r.pose.y(), truth.y(), 0.015) << trial;
     EXPECT_NEAR(r.pose.theta(), truth.theta(), 0.003) << trial;

@@ -1,6 +1,7 @@
 // Differential-drive kinematics, discretised two ways:
 //  - exact arc: Wang, "Simultaneous Localization and Mapping with Texture" (ECE276A), Eq. 6,
-//    x' = x + v tau sinc(w tau / 2) cos(theta + w tau / 2), same for y with sin, theta' = theta + w tau;
+//    x' = x + v tau sinc(w tau / 2) cos(theta + w tau / 2), same for y with sin, theta' = theta + w
+//    tau;
 //  - Euler: Kansal, "Particle Filter SLAM and Texture Mapping" (ECE276A), Sec. III-A.
 #include "slam/odometry/diff_drive_model.h"
 

@@ -11,8 +11,8 @@ namespace {
 // error shrinks in proportion to the step (first order).
 TEST(DiffDriveModelTest, ExactArcIsStepIndependentEulerIsFirstOrder) {
   const double v = 0.8, omega = 0.5, duration = 4.0;
-  const Pose2 truth(v / omega * std::sin(omega * duration), v / omega * (1.0 - std::cos(omega * duration)),
-                    omega * duration);
+  const Pose2 truth(v / omega * std::sin(omega * duration),
+                    v / omega * (1.0 - std::cos(omega * duration)), omega * duration);
   double previous_euler_error = 0.0;
   for (const int steps : {10, 20, 40, 80}) {
     const double tau = duration / steps;

@@ -13,9 +13,7 @@ namespace slamrig::slam {
 using RandomEngine = std::mt19937_64;
 
 /// Uniform double in [0, 1) with 53 random bits.
-inline double Uniform01(RandomEngine& rng) {
-  return static_cast<double>(rng() >> 11) * 0x1.0p-53;
-}
+inline double Uniform01(RandomEngine& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
 /// Standard normal sample (Box-Muller; one of the pair is discarded to keep the stream stateless).
 inline double StandardNormal(RandomEngine& rng) {

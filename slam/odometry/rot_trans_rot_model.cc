@@ -44,9 +44,12 @@ Pose2 RotTransRot::ToIncrement() const {
 
 std::vector<std::string> RotTransRotNoise::Validate() const {
   std::vector<std::string> errors;
-  const std::pair<const char*, double> fields[] = {
-      {"alpha1", alpha1}, {"alpha2", alpha2}, {"alpha3", alpha3}, {"alpha4", alpha4},
-      {"min_trans_sigma_m", min_trans_sigma_m}, {"min_rot_sigma_rad", min_rot_sigma_rad}};
+  const std::pair<const char*, double> fields[] = {{"alpha1", alpha1},
+                                                   {"alpha2", alpha2},
+                                                   {"alpha3", alpha3},
+                                                   {"alpha4", alpha4},
+                                                   {"min_trans_sigma_m", min_trans_sigma_m},
+                                                   {"min_rot_sigma_rad", min_rot_sigma_rad}};
   for (const auto& [name, value] : fields) {
     if (!(value >= 0.0)) errors.push_back(Rule(name, value, "must be >= 0"));
   }

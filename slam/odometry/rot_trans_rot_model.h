@@ -26,12 +26,12 @@ struct RotTransRot {
 /// variances rot1: a1 rot1^2 + a2 trans^2, trans: a3 trans^2 + a4 (rot1^2 + rot2^2),
 /// rot2: a1 rot2^2 + a2 trans^2; plus small floors so a standing robot still diffuses a little.
 struct RotTransRotNoise {
-  double alpha1 = 0.05;   ///< rotation variance per rotation^2, rad^2/rad^2
-  double alpha2 = 0.001;  ///< rotation variance per translation^2, rad^2/m^2
-  double alpha3 = 0.01;   ///< translation variance per translation^2, m^2/m^2
-  double alpha4 = 0.001;  ///< translation variance per rotation^2, m^2/rad^2
-  double min_trans_sigma_m = 0.0;    ///< standard deviation floor on the translation
-  double min_rot_sigma_rad = 0.0;    ///< standard deviation floor on each rotation
+  double alpha1 = 0.05;            ///< rotation variance per rotation^2, rad^2/rad^2
+  double alpha2 = 0.001;           ///< rotation variance per translation^2, rad^2/m^2
+  double alpha3 = 0.01;            ///< translation variance per translation^2, m^2/m^2
+  double alpha4 = 0.001;           ///< translation variance per rotation^2, m^2/rad^2
+  double min_trans_sigma_m = 0.0;  ///< standard deviation floor on the translation
+  double min_rot_sigma_rad = 0.0;  ///< standard deviation floor on each rotation
 
   /// One message per broken rule, e.g. "rot_trans_rot.alpha1 = -1; must be >= 0".
   std::vector<std::string> Validate() const;

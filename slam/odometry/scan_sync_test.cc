@@ -23,9 +23,8 @@ ImuSample Gyro(double t_s, double wz) {
 }
 
 std::vector<Record> SortedByTime(std::vector<Record> records) {
-  std::stable_sort(records.begin(), records.end(), [](const Record& a, const Record& b) {
-    return RecordTime(a) < RecordTime(b);
-  });
+  std::stable_sort(records.begin(), records.end(),
+                   [](const Record& a, const Record& b) { return RecordTime(a) < RecordTime(b); });
   return records;
 }
 
@@ -74,8 +73,11 @@ TEST(ScanSyncTest, TicksAreSummedAndGyroAveragedPerScanInterval) {
 }
 
 TEST(ScanSyncTest, GyroDropoutHoldsTheLastRateAndIsCounted) {
-  std::vector<Record> records = {Scan(0.0), Gyro(0.01, 0.5), WheelTicks{Time::FromSeconds(0.02), {1}, {1}},
-                                 Scan(0.025), WheelTicks{Time::FromSeconds(0.04), {1}, {1}},
+  std::vector<Record> records = {Scan(0.0),
+                                 Gyro(0.01, 0.5),
+                                 WheelTicks{Time::FromSeconds(0.02), {1}, {1}},
+                                 Scan(0.025),
+                                 WheelTicks{Time::FromSeconds(0.04), {1}, {1}},
                                  Scan(0.05)};
   const ScanSyncResult result = SyncToScans(records, ScanSyncOptions{});
   ASSERT_EQ(result.scans.size(), 3u);
@@ -103,7 +105,8 @@ TEST(ScanSyncTest, OdometryPosesAreInterpolatedToScanTimes) {
     return Pose2(radius * std::sin(phi), radius * (1.0 - std::cos(phi)), phi);
   };
   std::vector<Record> records;
-  for (int k = 0; k <= 200; ++k) records.push_back(OdometryPose{Time::FromSeconds(0.05 * k), circle(0.05 * k)});
+  for (int k = 0; k <= 200; ++k)
+    records.push_back(OdometryPose{Time::FromSeconds(0.05 * k), circle(0.05 * k)});
   for (int k = 0; k < 60; ++k) records.push_back(Scan(0.013 + k / 7.0));
   records = SortedByTime(std::move(records));
   const ScanSyncResult result = SyncToScans(records, ScanSyncOptions{});

@@ -13,9 +13,9 @@ namespace slamrig::slam {
 /// (0.254 m wheels, 360 ticks per revolution, i.e. 0.0022 m per tick; effective track width
 /// 0.3937 m, the mean of its inner and outer wheel spacing).
 struct DiffDriveParams {
-  double wheel_radius_m = 0.127;     ///< radius of every wheel
-  int ticks_per_revolution = 360;    ///< encoder ticks per wheel revolution
-  double track_width_m = 0.3937;     ///< lateral distance between left and right wheel contacts
+  double wheel_radius_m = 0.127;   ///< radius of every wheel
+  int ticks_per_revolution = 360;  ///< encoder ticks per wheel revolution
+  double track_width_m = 0.3937;   ///< lateral distance between left and right wheel contacts
 
   /// Distance a wheel rolls per encoder tick, metres.
   double MetresPerTick() const;
@@ -36,10 +36,11 @@ struct WheelOdometryOptions {
 };
 
 /// Integrates encoder tick increments, optionally with gyro yaw rate, into an odometry pose in the
-/// `odom` frame, which starts at the identity. Each interval is integrated as one constant-curvature
-/// arc (the exact differential-drive model with the sinc term, Wang, ECE276A report, Eq. 6).
-/// Yaw comes from the gyro when `use_gyro` and at least one IMU sample fell into the interval;
-/// otherwise (first ticks record, gyro dropout) from the encoders, and that is counted.
+/// `odom` frame, which starts at the identity. Each interval is integrated as one
+/// constant-curvature arc (the exact differential-drive model with the sinc term, Wang, ECE276A
+/// report, Eq. 6). Yaw comes from the gyro when `use_gyro` and at least one IMU sample fell into
+/// the interval; otherwise (first ticks record, gyro dropout) from the encoders, and that is
+/// counted.
 class WheelOdometry {
  public:
   explicit WheelOdometry(const WheelOdometryOptions& options);

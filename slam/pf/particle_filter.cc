@@ -3,7 +3,8 @@
 //    or the rot-trans-rot alpha model (Probabilistic Robotics, Table 5.6);
 //  - update with the laser correlation model over a 9x9 (+yaw) shift grid and softmax weights,
 //    alpha_k <- alpha_k exp(corr_k) / sum (Wang, Eq. 7; Zafari, step 5), or the likelihood field;
-//  - map update from the best particle with log-odds +log 4 / free decrement / clamps (Wang, Eq. 17);
+//  - map update from the best particle with log-odds +log 4 / free decrement / clamps (Wang, Eq.
+//  17);
 //  - resampling when Neff = 1 / sum alpha^2 < 0.5 N (Zafari, Eq. 6), stratified or systematic.
 #include "slam/pf/particle_filter.h"
 
@@ -59,7 +60,7 @@ void ParticleFilter::Predict(const Pose2& odometry_increment) {
 }
 
 std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& points,
-                                         float* best_score) {
+                                          float* best_score) {
   const int n = options_.num_particles;
   const bool use_field = options_.observation == ObservationModel::kLikelihoodField;
   GridView field_view;
@@ -69,10 +70,12 @@ std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& po
     for (const Particle& p : particles_) particles_box.extend(p.pose.translation());
     double reach = 0.0;
     for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
-    const double margin = reach + (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
-                          options_.likelihood_field.cutoff_sigmas * options_.likelihood_field.sigma_m;
+    const double margin =
+        reach + (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
+        options_.likelihood_field.cutoff_sigmas * options_.likelihood_field.sigma_m;
     const Eigen::Vector2d m = Eigen::Vector2d::Constant(margin);
-    likelihood_field_.Update(map_, Eigen::AlignedBox2d(particles_box.min() - m, particles_box.max() + m));
+    likelihood_field_.Update(map_,
+                             Eigen::AlignedBox2d(particles_box.min() - m, particles_box.max() + m));
     field_view = likelihood_field_.view();
   }
   const GridView view = use_field ? field_view : GridView::Of(map_);
@@ -146,7 +149,8 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
     particles_[i].weight = weights[i];
     if (weights[i] > weights[best]) best = i;
     // Keep log-weights bounded: the normalised log is equivalent.
-    log_weights_[i] = weights[i] > 0.0 ? std::log(weights[i]) : -std::numeric_limits<double>::infinity();
+    log_weights_[i] =
+        weights[i] > 0.0 ? std::log(weights[i]) : -std::numeric_limits<double>::infinity();
   }
   step.best_pose = particles_[best].pose;
   step.mean_pose = WeightedMeanPose(particles_);
@@ -158,7 +162,8 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
     std::vector<Particle> resampled;
     resampled.reserve(particles_.size());
     const double uniform = 1.0 / options_.num_particles;
-    for (const int k : keep) resampled.push_back(Particle{particles_[static_cast<std::size_t>(k)].pose, uniform});
+    for (const int k : keep)
+      resampled.push_back(Particle{particles_[static_cast<std::size_t>(k)].pose, uniform});
     particles_ = std::move(resampled);
     std::fill(log_weights_.begin(), log_weights_.end(), 0.0);
     step.resampled = true;

@@ -22,13 +22,13 @@ struct Particle {
 
 /// What one AddScan did.
 struct ParticleFilterStep {
-  Pose2 best_pose;           ///< pose of the highest-weight particle (the map was updated there)
-  Pose2 mean_pose;           ///< weighted mean (circular mean for yaw)
-  double neff = 0.0;         ///< effective sample size after the update, before resampling
+  Pose2 best_pose;    ///< pose of the highest-weight particle (the map was updated there)
+  Pose2 mean_pose;    ///< weighted mean (circular mean for yaw)
+  double neff = 0.0;  ///< effective sample size after the update, before resampling
   bool resampled = false;
-  bool updated = false;      ///< false: the robot moved too little, poses follow the odometry
-  float best_score = 0.0f;   ///< observation score of the best particle
-  int points_used = 0;       ///< scan points used for weighting
+  bool updated = false;     ///< false: the robot moved too little, poses follow the odometry
+  float best_score = 0.0f;  ///< observation score of the best particle
+  int points_used = 0;      ///< scan points used for weighting
 };
 
 /// Particle-filter SLAM on one shared log-odds map, as in the UCSD ECE276A reports (Wang,
@@ -65,7 +65,7 @@ class ParticleFilter {
   std::vector<Particle> particles_;
   std::vector<double> log_weights_;
   bool started_ = false;
-  Pose2 pending_motion_;       // odometry since the last update
+  Pose2 pending_motion_;  // odometry since the last update
   ParticleFilterStep last_step_;
   int resample_count_ = 0;
 };

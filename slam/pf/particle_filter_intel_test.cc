@@ -22,8 +22,9 @@ TEST(ParticleFilterIntelTest, BeatsTheReferenceBoundAndDeadReckoning) {
   Trajectory reference;
   for (const GroundTruthPose& g : data.reference) reference.Append(g.time, g.map_from_base);
 
-  const double dr = ComputeAte(RunDeadReckoning(synced.scans, OccupancyGridOptions{}).trajectory, reference)
-                        .translation_m.rmse;
+  const double dr =
+      ComputeAte(RunDeadReckoning(synced.scans, OccupancyGridOptions{}).trajectory, reference)
+          .translation_m.rmse;
   ParticleFilterOptions options;
   options.num_particles = 100;
   const SlamRunResult pf = RunParticleFilter(synced.scans, options);

@@ -46,7 +46,8 @@ std::vector<std::string> ParticleFilterOptions::Validate() const {
   std::vector<std::string> errors;
   if (num_particles <= 0) errors.push_back(Rule("num_particles", num_particles, "must be > 0"));
   if (!(sigma_xy_m >= 0.0)) errors.push_back(Rule("sigma_xy_m", sigma_xy_m, "must be >= 0"));
-  if (!(sigma_yaw_rad >= 0.0)) errors.push_back(Rule("sigma_yaw_rad", sigma_yaw_rad, "must be >= 0"));
+  if (!(sigma_yaw_rad >= 0.0))
+    errors.push_back(Rule("sigma_yaw_rad", sigma_yaw_rad, "must be >= 0"));
   if (!(observation_scale > 0.0)) {
     errors.push_back(Rule("observation_scale", observation_scale, "must be > 0"));
   }

@@ -71,7 +71,8 @@ struct ParticleFilterOptions {
   double min_update_distance_m = 0.25;
   double min_update_angle_rad = 0.1;
 
-  int num_threads = 1;  ///< worker threads for the per-particle scoring (results do not depend on it)
+  int num_threads =
+      1;  ///< worker threads for the per-particle scoring (results do not depend on it)
   /// Record the particle cloud every n scans (0: never).
   int cloud_every_n_scans = 0;
 

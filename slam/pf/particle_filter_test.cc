@@ -58,7 +58,8 @@ ParticleFilterOptions FastOptions() {
 TEST(ParticleFilterTest, BeatsDeadReckoningOnASyntheticOfficeRun) {
   const ShortRun& run = GetShortRun();
   ASSERT_EQ(run.scans.size(), run.run.truth.size());
-  const double dr = PositionRmse(RunDeadReckoning(run.scans, OccupancyGridOptions{}).trajectory, run.run.truth);
+  const double dr =
+      PositionRmse(RunDeadReckoning(run.scans, OccupancyGridOptions{}).trajectory, run.run.truth);
   const SlamRunResult pf = RunParticleFilter(run.scans, FastOptions());
   const double pf_rmse = PositionRmse(pf.trajectory, run.run.truth);
   RecordProperty("dead_reckoning_rmse_m", std::to_string(dr));
@@ -138,9 +139,10 @@ TEST(ParticleFilterTest, ValidateNamesFieldValueAndRule) {
   ParticleFilterOptions options;
   options.num_particles = 0;
   options.correlation.xy_half_width_cells = 20;
-  EXPECT_THAT(options.Validate(),
-              ::testing::ElementsAre("pf.num_particles = 0; must be > 0",
-                                     "pf.correlation.xy_half_width_cells = 20; must be in [0, 15]"));
+  EXPECT_THAT(
+      options.Validate(),
+      ::testing::ElementsAre("pf.num_particles = 0; must be > 0",
+                             "pf.correlation.xy_half_width_cells = 20; must be in [0, 15]"));
   EXPECT_TRUE(ParticleFilterOptions{}.Validate().empty());
   EXPECT_TRUE(ParticleFilterOptions::ReportsPreset().Validate().empty());
 }

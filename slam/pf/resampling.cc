@@ -46,7 +46,8 @@ std::vector<int> Resample(std::span<const double> weights, ResamplingScheme sche
   std::size_t j = 0;
   double cumulative = weights[0];
   for (std::size_t k = 0; k < n; ++k) {
-    const double u = scheme == ResamplingScheme::kSystematic ? shared : (k == 0 ? shared : Uniform01(rng));
+    const double u =
+        scheme == ResamplingScheme::kSystematic ? shared : (k == 0 ? shared : Uniform01(rng));
     const double beta = (static_cast<double>(k) + u) / static_cast<double>(n);
     // Rounding can leave the last cumulative sum a hair under 1: never run past the end.
     while (beta > cumulative && j + 1 < n) cumulative += weights[++j];

@@ -40,7 +40,8 @@ TEST(ResamplingTest, EffectiveSampleSize) {
 // indices come out ascending.
 TEST(ResamplingTest, KeepsCountAndDrawsEachParticleInProportion) {
   RandomEngine rng(9);
-  for (const ResamplingScheme scheme : {ResamplingScheme::kSystematic, ResamplingScheme::kStratified}) {
+  for (const ResamplingScheme scheme :
+       {ResamplingScheme::kSystematic, ResamplingScheme::kStratified}) {
     const double bound = scheme == ResamplingScheme::kSystematic ? 1.0 : 2.0;
     for (int trial = 0; trial < 2000; ++trial) {
       const int n = 1 + trial % 200;
@@ -51,7 +52,8 @@ TEST(ResamplingTest, KeepsCountAndDrawsEachParticleInProportion) {
       std::vector<int> count(static_cast<std::size_t>(n), 0);
       for (const int i : idx) ++count[static_cast<std::size_t>(i)];
       for (int j = 0; j < n; ++j) {
-        ASSERT_LT(std::abs(count[static_cast<std::size_t>(j)] - n * w[static_cast<std::size_t>(j)]), bound + 1e-9)
+        ASSERT_LT(std::abs(count[static_cast<std::size_t>(j)] - n * w[static_cast<std::size_t>(j)]),
+                  bound + 1e-9)
             << "n=" << n << " j=" << j;
       }
     }
@@ -60,7 +62,8 @@ TEST(ResamplingTest, KeepsCountAndDrawsEachParticleInProportion) {
 
 TEST(ResamplingTest, UniformWeightsKeepEveryParticleOnceWithSystematic) {
   RandomEngine rng(2);
-  const std::vector<int> idx = Resample(std::vector<double>(7, 1.0 / 7), ResamplingScheme::kSystematic, rng);
+  const std::vector<int> idx =
+      Resample(std::vector<double>(7, 1.0 / 7), ResamplingScheme::kSystematic, rng);
   for (int i = 0; i < 7; ++i) EXPECT_EQ(idx[static_cast<std::size_t>(i)], i);
 }
 
@@ -70,7 +73,8 @@ TEST(ResamplingTest, StratifiedIsUnbiased) {
   std::vector<double> total(4, 0.0);
   const int trials = 20000;
   for (int t = 0; t < trials; ++t) {
-    for (const int i : Resample(w, ResamplingScheme::kStratified, rng)) total[static_cast<std::size_t>(i)] += 1.0;
+    for (const int i : Resample(w, ResamplingScheme::kStratified, rng))
+      total[static_cast<std::size_t>(i)] += 1.0;
   }
   for (std::size_t j = 0; j < 4; ++j) EXPECT_NEAR(total[j] / (4.0 * trials), w[j], 0.005);
 }

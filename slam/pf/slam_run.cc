@@ -44,7 +44,8 @@ SlamRunResult RunParticleFilter(const std::vector<SyncedScan>& scans,
     const Time time = scans[i].scan.time;
     AppendMonotonic(result.trajectory, time, step.best_pose, &result.reordered_stamps);
     AppendMonotonic(result.mean_trajectory, time, step.mean_pose, nullptr);
-    if (options.cloud_every_n_scans > 0 && i % static_cast<std::size_t>(options.cloud_every_n_scans) == 0) {
+    if (options.cloud_every_n_scans > 0 &&
+        i % static_cast<std::size_t>(options.cloud_every_n_scans) == 0) {
       result.clouds.push_back(ParticleCloud{time, filter.particles()});
     }
     if (progress) progress(i + 1, scans.size());

@@ -17,7 +17,8 @@ TEST(ThreadPoolTest, ParallelForVisitsEveryIndexExactlyOnce) {
           for (int i = begin; i < end; ++i) hits[static_cast<std::size_t>(i)]++;
         });
       }
-      for (int i = 0; i < n; ++i) ASSERT_EQ(hits[static_cast<std::size_t>(i)].load(), 3) << threads << " " << n;
+      for (int i = 0; i < n; ++i)
+        ASSERT_EQ(hits[static_cast<std::size_t>(i)].load(), 3) << threads << " " << n;
     }
   }
 }

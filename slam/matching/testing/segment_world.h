@@ -17,12 +17,12 @@ struct Segment {
 
 /// Beam layout and noise of a simulated planar range finder.
 struct RangeFinderSpec {
-  int num_beams = 1081;                       ///< Hokuyo UTM-30LX
+  int num_beams = 1081;  ///< Hokuyo UTM-30LX
   double angle_min_rad = -0.75 * 3.14159265358979;
   double angle_increment_rad = 0.25 * 3.14159265358979 / 180.0;
   double range_min_m = 0.1;
   double range_max_m = 30.0;
-  double range_sigma_m = 0.01;                ///< Gaussian range noise
+  double range_sigma_m = 0.01;  ///< Gaussian range noise
   Pose2 base_from_laser;
 };
 

@@ -21,9 +21,12 @@ SyntheticRun MakeSyntheticRun(const SegmentWorld& world, const SyntheticRunOptio
 
   const std::int64_t dt_ns = 1'000'000;  // 1 kHz truth
   const double dt = 1e-3;
-  const std::int64_t scan_period = static_cast<std::int64_t>(std::llround(1e9 / options.scan_rate_hz));
-  const std::int64_t encoder_period = static_cast<std::int64_t>(std::llround(1e9 / options.encoder_rate_hz));
-  const std::int64_t imu_period = static_cast<std::int64_t>(std::llround(1e9 / options.imu_rate_hz));
+  const std::int64_t scan_period =
+      static_cast<std::int64_t>(std::llround(1e9 / options.scan_rate_hz));
+  const std::int64_t encoder_period =
+      static_cast<std::int64_t>(std::llround(1e9 / options.encoder_rate_hz));
+  const std::int64_t imu_period =
+      static_cast<std::int64_t>(std::llround(1e9 / options.imu_rate_hz));
   const double metres_per_tick = options.robot.MetresPerTick();
   const double half_track = 0.5 * options.robot.track_width_m;
 
@@ -44,8 +47,10 @@ SyntheticRun MakeSyntheticRun(const SegmentWorld& world, const SyntheticRunOptio
     }
     if (t_ns > 0 && t_ns % encoder_period == 0) {
       // Measured travel: systematic scale error and per-interval noise, then quantised to ticks.
-      right_accum += interval_right * (1.0 + options.right_scale_error + options.wheel_noise * StandardNormal(motion_rng));
-      left_accum += interval_left * (1.0 + options.left_scale_error + options.wheel_noise * StandardNormal(motion_rng));
+      right_accum += interval_right * (1.0 + options.right_scale_error +
+                                       options.wheel_noise * StandardNormal(motion_rng));
+      left_accum += interval_left * (1.0 + options.left_scale_error +
+                                     options.wheel_noise * StandardNormal(motion_rng));
       interval_right = interval_left = 0.0;
       const auto right_ticks = static_cast<std::int32_t>(std::trunc(right_accum / metres_per_tick));
       const auto left_ticks = static_cast<std::int32_t>(std::trunc(left_accum / metres_per_tick));
@@ -68,12 +73,14 @@ SyntheticRun MakeSyntheticRun(const SegmentWorld& world, const SyntheticRunOptio
       if (target == 1 % num_wp) ++laps_done;
       continue;
     }
-    const double heading_error = NormalizeAngle(std::atan2(to_target.y(), to_target.x()) - pose.theta());
+    const double heading_error =
+        NormalizeAngle(std::atan2(to_target.y(), to_target.x()) - pose.theta());
     omega = std::clamp(2.0 * heading_error, -1.0, 1.0);
     const double v = options.speed_m_s * std::max(0.0, std::cos(heading_error));
     interval_right += (v + omega * half_track) * dt;
     interval_left += (v - omega * half_track) * dt;
-    pose = pose * Pose2(v * dt * std::cos(0.5 * omega * dt), v * dt * std::sin(0.5 * omega * dt), omega * dt);
+    pose = pose * Pose2(v * dt * std::cos(0.5 * omega * dt), v * dt * std::sin(0.5 * omega * dt),
+                        omega * dt);
   }
   return run;
 }

@@ -15,16 +15,16 @@ namespace slamrig::slam::testing {
 struct SyntheticRunOptions {
   std::vector<Eigen::Vector2d> waypoints;  ///< closed loop, driven in order, starting at [0]
   int laps = 1;
-  double max_duration_s = 1e9;             ///< stop early after this long
+  double max_duration_s = 1e9;  ///< stop early after this long
   double speed_m_s = 0.5;
   double scan_rate_hz = 40.0;
   double encoder_rate_hz = 40.0;
   double imu_rate_hz = 100.0;
   RangeFinderSpec lidar;
   DiffDriveParams robot;
-  double right_scale_error = 0.01;   ///< systematic wheel-distance error (calibration), relative
+  double right_scale_error = 0.01;  ///< systematic wheel-distance error (calibration), relative
   double left_scale_error = -0.01;
-  double wheel_noise = 0.02;         ///< random relative error per encoder interval
+  double wheel_noise = 0.02;  ///< random relative error per encoder interval
   double gyro_sigma_rad_s = 0.01;
   double gyro_bias_rad_s = 0.002;
   std::uint64_t seed = 1;
