@@ -12,7 +12,7 @@
 namespace slamrig::scenario {
 namespace {
 
-constexpr int kSizePx = 800;
+constexpr int kSizePx = 720;
 
 double WallSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -31,7 +31,8 @@ LiveView::LiveView(const std::string& title, double max_fps)
 
 LiveView::~LiveView() { cv::destroyWindow(title_); }
 
-void LiveView::Update(double sim_time_s, const slam::OccupancyGrid& map, const Pose2& truth,
+void LiveView::Update(double sim_time_s, const slam::OccupancyGrid& map,
+                      const Pose2& world_from_map, const Pose2& truth,
                       const std::vector<LiveEstimate>& estimates) {
   truth_path_.push_back(truth);
   estimate_paths_.resize(estimates.size());
@@ -41,12 +42,17 @@ void LiveView::Update(double sim_time_s, const slam::OccupancyGrid& map, const P
   if (now - last_draw_s_ < min_period_s_) return;
   last_draw_s_ = now;
 
-  // Fit the map (and the paths) into the window.
-  Eigen::AlignedBox2d box(
-      map.origin(), map.origin() + Eigen::Vector2d(map.width(), map.height()) * map.resolution());
+  // Frame the robot's whereabouts with 5 m around them (the map may reach much further).
+  Eigen::AlignedBox2d box;
   for (const Pose2& p : truth_path_) box.extend(p.translation());
-  const double scale = kSizePx / std::max(box.sizes().maxCoeff(), 1.0);
+  for (const auto& path : estimate_paths_) {
+    for (const Pose2& p : path) box.extend(p.translation());
+  }
+  box.min() -= Eigen::Vector2d::Constant(5.0);
+  box.max() += Eigen::Vector2d::Constant(5.0);
+  const double scale = kSizePx / std::max(box.sizes().maxCoeff(), 10.0);
   cv::Mat image(kSizePx, kSizePx, CV_8UC3, cv::Scalar(205, 205, 205));
+  const Pose2 map_from_world = world_from_map.Inverse();
   const auto px = [&](const Eigen::Vector2d& p) {
     return cv::Point(static_cast<int>((p.x() - box.min().x()) * scale),
                      static_cast<int>(kSizePx - (p.y() - box.min().y()) * scale));
@@ -56,7 +62,7 @@ void LiveView::Update(double sim_time_s, const slam::OccupancyGrid& map, const P
     for (int col = 0; col < kSizePx; ++col) {
       const Eigen::Vector2d w(box.min().x() + (col + 0.5) / scale,
                               box.min().y() + (kSizePx - row - 0.5) / scale);
-      const float l = map.LogOdds(map.WorldToCell(w));
+      const float l = map.LogOdds(map.WorldToCell(map_from_world * w));
       if (l == 0.0f) continue;
       const auto v =
           static_cast<std::uint8_t>(std::lround(255.0 / (1.0 + std::exp(static_cast<double>(l)))));
@@ -74,18 +80,18 @@ void LiveView::Update(double sim_time_s, const slam::OccupancyGrid& map, const P
     cv::circle(image, c, 5, colour, 2, cv::LINE_AA);
     cv::line(image, c, tip, colour, 2, cv::LINE_AA);
   };
+  draw_path(truth_path_, cv::Scalar(40, 160, 40));
+  draw_pose(truth, cv::Scalar(40, 160, 40));
   for (std::size_t i = 0; i < estimates.size(); ++i) {
     const Colour c = PaletteColour(i == 2 ? 4 : i);
     const cv::Scalar colour(c.b, c.g, c.r);
     for (const Pose2& p : estimates[i].particles)
       cv::circle(image, px(p.translation()), 1, colour, cv::FILLED);
     draw_path(estimate_paths_[i], colour);
-    draw_pose(estimates[i].pose, colour);
+    if (estimates[i].has_pose) draw_pose(estimates[i].pose, colour);
     cv::putText(image, estimates[i].name, {10, 44 + 20 * static_cast<int>(i)},
                 cv::FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv::LINE_AA);
   }
-  draw_path(truth_path_, cv::Scalar(40, 160, 40));
-  draw_pose(truth, cv::Scalar(40, 160, 40));
   char text[64];
   std::snprintf(text, sizeof(text), "t = %.1f s   truth", sim_time_s);
   cv::putText(image, text, {10, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(40, 160, 40), 1,

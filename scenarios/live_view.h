@@ -11,6 +11,7 @@ namespace slamrig::scenario {
 /// One estimate to draw: its pose, its recent path and, for a particle filter, its particles.
 struct LiveEstimate {
   std::string name;
+  bool has_pose = false;  ///< false until the estimator has processed its first scan
   Pose2 pose;
   std::vector<Pose2> particles;
 };
@@ -27,9 +28,10 @@ class LiveView {
   LiveView(const LiveView&) = delete;
   LiveView& operator=(const LiveView&) = delete;
 
-  /// Redraws when due: `map` in grey, true pose and path in green, each estimate in its colour.
-  void Update(double sim_time_s, const slam::OccupancyGrid& map, const Pose2& truth,
-              const std::vector<LiveEstimate>& estimates);
+  /// Redraws when due: `map` (whose frame sits at `world_from_map` in the world) in grey, the
+  /// true pose and path in green, each estimate (world frame) in its colour.
+  void Update(double sim_time_s, const slam::OccupancyGrid& map, const Pose2& world_from_map,
+              const Pose2& truth, const std::vector<LiveEstimate>& estimates);
 
  private:
   std::string title_;

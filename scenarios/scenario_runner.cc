@@ -45,6 +45,9 @@ class Estimator {
   }
 
   const std::string& name() const { return config_.name; }
+  bool started() const { return started_; }
+  const Pose2& map_from_start() const { return map_from_start_; }
+  bool is_particle_filter() const { return pf_ != nullptr; }
   const Pose2& pose() const { return last_pose_; }
   const slam::OccupancyGrid& map() const { return pf_ ? pf_->map() : *map_; }
   std::vector<Pose2> Particles() const {
@@ -202,8 +205,14 @@ ScenarioResult RunScenario(const ScenarioSpec& spec, const RunnerOptions& option
       if (options.progress) options.progress(now_s, spec.duration_s);
       if (view) {
         std::vector<LiveEstimate> live;
-        for (const auto& e : estimators) live.push_back({e->name(), e->pose(), e->Particles()});
-        view->Update(now_s, estimators.front()->map(), simulator.Truth().map_from_base, live);
+        // The map of the first particle filter (the system under test), else the first one's.
+        const Estimator* shown = estimators.front().get();
+        for (const auto& e : estimators) {
+          live.push_back({e->name(), e->started(), e->pose(), e->Particles()});
+          if (e->is_particle_filter() && !shown->is_particle_filter()) shown = e.get();
+        }
+        view->Update(now_s, shown->map(), shown->map_from_start(), simulator.Truth().map_from_base,
+                     live);
       }
     }
   }
