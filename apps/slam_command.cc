@@ -6,11 +6,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
 
 #include "apps/cli_args.h"
 #include "apps/commands.h"
 #include "apps/data_path.h"
 #include "slam/eval/json_writer.h"
+#include "slam/eval/map_score.h"
 #include "slam/eval/run_timing.h"
 #include "slam/eval/trajectory_metrics.h"
 #include "slam/io/atomic_file.h"
@@ -121,6 +123,17 @@ std::string CloudsCsv(const std::vector<slam::ParticleCloud>& clouds) {
   return out;
 }
 
+void WriteMapScore(slam::JsonWriter& json, const std::string& key, const slam::MapScore& s) {
+  json.BeginObject(key)
+      .Integer("estimate_occupied", s.estimate_occupied)
+      .Integer("truth_occupied", s.truth_occupied)
+      .Number("precision", s.precision)
+      .Number("recall", s.recall)
+      .Number("f1", s.f1)
+      .Number("iou", s.iou)
+      .EndObject();
+}
+
 void WritePfConfig(slam::JsonWriter& json, const slam::ParticleFilterOptions& pf) {
   json.BeginObject("pf")
       .Integer("num_particles", pf.num_particles)
@@ -157,6 +170,7 @@ void WritePfConfig(slam::JsonWriter& json, const slam::ParticleFilterOptions& pf
 
 int RunSlamCommand(const std::vector<std::string>& args) {
   std::string log_path, out_dir, algorithm = "pf", preset = "default", odometry = "auto";
+  std::string truth_map_path;
   int particles = 100, threads = 1, clouds = 0, max_scans = 0;
   std::uint64_t seed = 1;
   double resolution = 0.05;
@@ -183,6 +197,10 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   parser.AddOption("clouds", "N",
                    "write the particle cloud every N scans to particles.csv (0: never)", &clouds);
   parser.AddOption("max-scans", "N", "stop after N scans (0: all)", &max_scans);
+  parser.AddOption("truth-map", "YAML",
+                   "map_server map of the true world: occupied-cell F1/IoU of the estimated map "
+                   "(aligned by the ATE alignment; needs a log with a reference)",
+                   &truth_map_path);
   parser.AddFlag("lenient", "skip and count malformed CARMEN lines instead of failing", &lenient);
   parser.AddFlag("quiet", "no progress output", &quiet);
   if (!parser.Parse(args)) return 0;
@@ -238,6 +256,13 @@ int RunSlamCommand(const std::vector<std::string>& args) {
       reference.Append(g.time, g.map_from_base);
   }
   const std::string log_name = std::filesystem::path(path).filename().string();
+  std::optional<slam::OccupancyGrid> truth_map;
+  if (!truth_map_path.empty()) {
+    if (reference.empty()) {
+      throw ConfigError("slamrig slam: --truth-map needs a log with a reference trajectory");
+    }
+    truth_map = slam::GridFromMapImage(slam::ReadMapServerMap(truth_map_path));
+  }
 
   slam::SlamRunResult run;
   slam::RunTiming timing;
@@ -274,6 +299,21 @@ int RunSlamCommand(const std::vector<std::string>& args) {
       mean_metrics = slam::EvaluateTrajectory(run.mean_trajectory, reference);
       const slam::SlamRunResult dr = slam::RunDeadReckoning(synced.scans, pf.map);
       dr_metrics = slam::EvaluateTrajectory(dr.trajectory, reference);
+    }
+  }
+  // Map scores: against the same scans inserted at the reference poses, and against the true
+  // world's map when given, both in the reference frame through the ATE alignment.
+  std::optional<slam::MapScore> map_vs_reference, map_vs_truth;
+  if (metrics && !encoder_only) {
+    slam::OccupancyGrid reference_map(pf.map);
+    for (const slam::SyncedScan& s : synced.scans) {
+      if (const std::optional<Pose2> p = reference.Interpolate(s.scan.time)) {
+        reference_map.InsertScan(s.scan, *p);
+      }
+    }
+    map_vs_reference = slam::ScoreMap(run.map, metrics->ate.reference_from_estimate, reference_map);
+    if (truth_map) {
+      map_vs_truth = slam::ScoreMap(run.map, metrics->ate.reference_from_estimate, *truth_map);
     }
   }
 
@@ -344,6 +384,8 @@ int RunSlamCommand(const std::vector<std::string>& args) {
       json.EndObject();
     }
   }
+  if (map_vs_reference) WriteMapScore(json, "map_vs_reference", *map_vs_reference);
+  if (map_vs_truth) WriteMapScore(json, "map_vs_truth", *map_vs_truth);
   json.StringArray("notes", data.notes);
   slam::WriteFileAtomically(dir + "metrics.json", json.Finish());
 
@@ -357,6 +399,7 @@ int RunSlamCommand(const std::vector<std::string>& args) {
     line += "; ATE RMSE " + Fixed(metrics->ate.translation_m.rmse, 3) + " m";
     if (dr_metrics)
       line += " (dead reckoning " + Fixed(dr_metrics->ate.translation_m.rmse, 3) + " m)";
+    if (map_vs_reference) line += "; map F1 " + Fixed(map_vs_reference->f1, 3);
   }
   line += " -> " + out_dir;
   std::puts(line.c_str());
