@@ -66,8 +66,9 @@ struct ParticleFilterOptions {
   OccupancyGridOptions map;  ///< the map built from the best particle
 
   /// Filter only after the robot moved this far or turned this much since the last update
-  /// (GMapping's linear/angular update); in between, poses follow the odometry. 0 and 0: every
-  /// scan, as in the reports.
+  /// (GMapping's linear/angular update); in between, poses follow the odometry and the map is
+  /// left alone (inserting every 40 Hz scan wore walls away: office ATE 0.025 -> 0.16 m).
+  /// 0 and 0: every scan, as in the reports.
   double min_update_distance_m = 0.25;
   double min_update_angle_rad = 0.1;
 
