@@ -130,7 +130,7 @@ TruthSample Simulator::TruthAt(Time time) const {
   if (history_.size() == 1) {
     SLAMRIG_CHECK(time == history_.front().time, "time outside the kept history");
     const Snapshot& s = history_.front();
-    return {time, Pose2(s.x_m, s.y_m, s.yaw_rad), s.velocity_m_s, s.yaw_rate_rad_s, s.wheels};
+    return {time, Pose2(s.x_m, s.y_m, s.yaw_rad), s.velocity_m_s, s.yaw_rate_rad_s, s.wheels, {}};
   }
   const auto [j, f] = Locate(time);
   const Snapshot& a = history_[j];
