@@ -103,5 +103,40 @@ TEST(CliTest, BadFlagsFailWithUsageError) {
   EXPECT_FALSE(std::filesystem::exists(dir.File("o")));
 }
 
+TEST(CliTest, RunWritesAReportAndFailsOnAnUnmetExpectation) {
+  TempDir dir;
+  // Three seconds of the office scenario, with an impossible map expectation.
+  const auto run = RunCommand(Slamrig(std::string("run ") + SLAMRIG_SOURCE_DIR +
+                                      "/scenarios/office_loop.yaml --set duration_s=3 "
+                                      "--set expect.pf.map_f1_min=1.5 --out " +
+                                      dir.File("r")));
+  EXPECT_EQ(run.exit_code, 3) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("FAIL   pf.map_f1"));
+  EXPECT_THAT(run.output, HasSubstr("under by"));
+  EXPECT_THAT(run.output, HasSubstr("office_loop: FAIL -> "));
+  for (const char* f : {"report.html", "metrics.json", "config.yaml", "truth.tum", "pf.tum",
+                        "map.png", "position_error.png", "neff.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir.File(std::string("r/") + f))) << f;
+  }
+}
+
+TEST(CliTest, BadScenarioInputNamesFileLineAndKey) {
+  TempDir dir;
+  const std::string scenario = dir.Write(
+      "bad.yaml", std::string("world: ") + SLAMRIG_SOURCE_DIR +
+                      "/worlds/office.yaml\nrobot: " + SLAMRIG_SOURCE_DIR +
+                      "/robots/ece276a.yaml\nslam:\n  pf: {algorithm: pf, particels: 10}\n");
+  auto run = RunCommand(Slamrig("run " + scenario + " --out " + dir.File("o")));
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_EQ(CountLines(run.output), 1) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("bad.yaml:4:23: slam.pf.particels: unknown key"));
+  run = RunCommand(
+      Slamrig("run " + scenario + " --set slam.pf.particles=abc --out " + dir.File("o")));
+  EXPECT_THAT(run.output, HasSubstr("expected an integer"));
+  run = RunCommand(Slamrig("run " + scenario + " --seed -4 --out " + dir.File("o")));
+  EXPECT_THAT(run.output, HasSubstr("--seed: expected a non-negative integer"));
+  EXPECT_FALSE(std::filesystem::exists(dir.File("o")));
+}
+
 }  // namespace
 }  // namespace slamrig
