@@ -120,6 +120,15 @@ SlamConfig ParseSlamConfig(const std::string& name, const YamlNode& node) {
   }
   node.Read("observation_scale", &pf.observation_scale);
   node.Read("move_to_best_shift", &pf.move_to_best_shift);
+  node.Read("refine", &pf.refine);
+  if (auto n = node.Optional("refiner")) {
+    n->Read("max_iterations", &pf.refiner.max_iterations);
+    n->Read("max_step_m", &pf.refiner.max_step_m);
+    n->Read("max_step_rad", &pf.refiner.max_step_rad);
+    n->Read("converged_step_m", &pf.refiner.converged_step_m);
+  }
+  node.Read("min_update_distance_m", &pf.min_update_distance_m);
+  node.Read("min_update_angle_rad", &pf.min_update_angle_rad);
   ReadEnum(node, "resampling", kResampling, &pf.resampling);
   node.Read("resample_neff_ratio", &pf.resample_neff_ratio);
   node.Read("threads", &pf.num_threads);
@@ -167,6 +176,12 @@ std::string SlamConfigToYaml(const SlamConfig& c) {
       << ", cutoff_sigmas: " << pf.likelihood_field.cutoff_sigmas << "}\n"
       << "  observation_scale: " << pf.observation_scale << "\n"
       << "  move_to_best_shift: " << (pf.move_to_best_shift ? "true" : "false") << "\n"
+      << "  refine: " << (pf.refine ? "true" : "false") << "\n"
+      << "  refiner: {max_iterations: " << pf.refiner.max_iterations
+      << ", max_step_m: " << pf.refiner.max_step_m << ", max_step_rad: " << pf.refiner.max_step_rad
+      << ", converged_step_m: " << pf.refiner.converged_step_m << "}\n"
+      << "  min_update_distance_m: " << pf.min_update_distance_m << "\n"
+      << "  min_update_angle_rad: " << pf.min_update_angle_rad << "\n"
       << "  resampling: " << EnumName(kResampling, pf.resampling) << "\n"
       << "  resample_neff_ratio: " << pf.resample_neff_ratio << "\n  threads: " << pf.num_threads
       << "\n";

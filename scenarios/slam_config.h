@@ -44,6 +44,10 @@ struct SlamConfig {
 ///   likelihood_field: {sigma_m: 0.05, z_hit: 0.9, z_rand: 0.1, cutoff_sigmas: 3}
 ///   observation_scale: 1.0
 ///   move_to_best_shift: true
+///   refine: true                      # Gauss-Newton refinement on the likelihood field
+///   refiner: {max_iterations: 6, max_step_m: 0.05, max_step_rad: 0.02, converged_step_m: 1e-4}
+///   min_update_distance_m: 0.25       # filter only after this much motion (odometry between)
+///   min_update_angle_rad: 0.1
 ///   resampling: systematic            # systematic | stratified
 ///   resample_neff_ratio: 0.5
 ///   threads: 1
