@@ -19,6 +19,11 @@ namespace fs = std::filesystem;
 std::string Number(double v, const char* format = "%.4g") {
   if (!std::isfinite(v)) return "n/a";
   char buffer[32];
+  // Counts (scans, resamples) in full rather than as 2.106e+04.
+  if (std::abs(v) >= 1e4 && std::abs(v) < 1e12 && v == std::floor(v)) {
+    std::snprintf(buffer, sizeof(buffer), "%.0f", v);
+    return buffer;
+  }
   std::snprintf(buffer, sizeof(buffer), format, v);
   return buffer;
 }
