@@ -8,7 +8,7 @@
 #include "scenarios/live_view.h"
 #include "sim/simulator.h"
 #include "slam/eval/map_score.h"
-#include "slam/eval/trajectory_error.h"
+#include "slam/eval/trajectory_metrics.h"
 #include "slam/odometry/scan_sync.h"
 #include "slam/pf/particle_filter.h"
 
@@ -114,11 +114,6 @@ bool InBlackout(const ScenarioSpec& spec, Time t) {
   return false;
 }
 
-double Metric(const std::map<std::string, double>& m, const std::string& key) {
-  const auto it = m.find(key);
-  return it == m.end() ? NAN : it->second;
-}
-
 void Score(const ScenarioResult& run, double sim_time_s, double wall_s, int resamples,
            ConfigResult* c) {
   auto& m = c->metrics;
@@ -131,23 +126,22 @@ void Score(const ScenarioResult& run, double sim_time_s, double wall_s, int resa
     m["resamples"] = resamples;
   }
   if (c->estimate.size() < 2) return;
-  const slam::AteResult ate = slam::ComputeAte(c->estimate, run.truth);
-  m["ate_rmse_m"] = ate.translation_m.rmse;
-  m["ate_mean_m"] = ate.translation_m.mean;
-  m["ate_median_m"] = ate.translation_m.median;
-  m["ate_max_m"] = ate.translation_m.max;
-  m["ate_rot_rmse_rad"] = ate.rotation_rad.rmse;
-  const auto rpe = [&](double d) { return slam::ComputeRpe(c->estimate, run.truth, d); };
-  const slam::RpeResult per_scan = rpe(0.0), per_1m = rpe(1.0), per_10m = rpe(10.0);
-  m["rpe_m_per_scan"] = per_scan.translation_m.count ? per_scan.translation_m.mean : NAN;
-  m["rpe_m_per_1m"] = per_1m.translation_m.count ? per_1m.translation_m.mean : NAN;
-  m["rpe_m_per_10m"] = per_10m.translation_m.count ? per_10m.translation_m.mean : NAN;
-  m["rpe_rad_per_10m"] = per_10m.rotation_rad.count ? per_10m.rotation_rad.mean : NAN;
+  const slam::TrajectoryMetrics t = slam::EvaluateTrajectory(c->estimate, run.truth);
+  m["ate_rmse_m"] = t.ate.translation_m.rmse;
+  m["ate_mean_m"] = t.ate.translation_m.mean;
+  m["ate_median_m"] = t.ate.translation_m.median;
+  m["ate_max_m"] = t.ate.translation_m.max;
+  m["ate_rot_rmse_rad"] = t.ate.rotation_rad.rmse;
+  // Means of the pairs' translation errors; NaN when the run is too short for a spacing.
+  const auto mean = [](const slam::ErrorStats& s) { return s.count ? s.mean : NAN; };
+  m["rpe_m_per_scan"] = mean(t.rpe_per_scan.translation_m);
+  m["rpe_m_per_1m"] = mean(t.rpe_1m.translation_m);
+  m["rpe_m_per_10m"] = mean(t.rpe_10m.translation_m);
+  m["rpe_rad_per_10m"] = mean(t.rpe_10m.rotation_rad);
   const StampedPose& last = c->estimate.poses().back();
   if (const auto truth = run.truth.Interpolate(last.time)) {
     m["final_error_m"] = (truth->translation() - last.pose.translation()).norm();
   }
-  (void)Metric;
 }
 
 }  // namespace
