@@ -110,6 +110,9 @@ SlamConfig ParseSlamConfig(const std::string& name, const YamlNode& node) {
     n->Read("yaw_step_rad", &pf.correlation.yaw_step_rad);
     ReadEnum(*n, "value", kCorrelationValue, &pf.correlation.value);
     n->Read("occupied_threshold", &pf.correlation.occupied_threshold);
+    n->Read("prior_sigma_xy_m", &pf.correlation.prior_sigma_xy_m);
+    n->Read("prior_sigma_yaw_rad", &pf.correlation.prior_sigma_yaw_rad);
+    n->Read("min_shift_gain", &pf.correlation.min_shift_gain);
   }
   if (auto n = node.Optional("likelihood_field")) {
     n->Read("sigma_m", &pf.likelihood_field.sigma_m);
@@ -126,6 +129,8 @@ SlamConfig ParseSlamConfig(const std::string& name, const YamlNode& node) {
     n->Read("max_step_m", &pf.refiner.max_step_m);
     n->Read("max_step_rad", &pf.refiner.max_step_rad);
     n->Read("converged_step_m", &pf.refiner.converged_step_m);
+    n->Read("prior_sigma_xy_m", &pf.refiner.prior_sigma_xy_m);
+    n->Read("prior_sigma_yaw_rad", &pf.refiner.prior_sigma_yaw_rad);
   }
   node.Read("min_update_distance_m", &pf.min_update_distance_m);
   node.Read("min_update_angle_rad", &pf.min_update_angle_rad);
@@ -169,7 +174,10 @@ std::string SlamConfigToYaml(const SlamConfig& c) {
       << ", yaw_half_steps: " << pf.correlation.yaw_half_steps
       << ", yaw_step_rad: " << pf.correlation.yaw_step_rad
       << ", value: " << EnumName(kCorrelationValue, pf.correlation.value)
-      << ", occupied_threshold: " << pf.correlation.occupied_threshold << "}\n"
+      << ", occupied_threshold: " << pf.correlation.occupied_threshold
+      << ", prior_sigma_xy_m: " << pf.correlation.prior_sigma_xy_m
+      << ", prior_sigma_yaw_rad: " << pf.correlation.prior_sigma_yaw_rad
+      << ", min_shift_gain: " << pf.correlation.min_shift_gain << "}\n"
       << "  likelihood_field: {sigma_m: " << pf.likelihood_field.sigma_m
       << ", z_hit: " << pf.likelihood_field.z_hit << ", z_rand: " << pf.likelihood_field.z_rand
       << ", occupied_threshold: " << pf.likelihood_field.occupied_threshold
@@ -179,7 +187,9 @@ std::string SlamConfigToYaml(const SlamConfig& c) {
       << "  refine: " << (pf.refine ? "true" : "false") << "\n"
       << "  refiner: {max_iterations: " << pf.refiner.max_iterations
       << ", max_step_m: " << pf.refiner.max_step_m << ", max_step_rad: " << pf.refiner.max_step_rad
-      << ", converged_step_m: " << pf.refiner.converged_step_m << "}\n"
+      << ", converged_step_m: " << pf.refiner.converged_step_m
+      << ", prior_sigma_xy_m: " << pf.refiner.prior_sigma_xy_m
+      << ", prior_sigma_yaw_rad: " << pf.refiner.prior_sigma_yaw_rad << "}\n"
       << "  min_update_distance_m: " << pf.min_update_distance_m << "\n"
       << "  min_update_angle_rad: " << pf.min_update_angle_rad << "\n"
       << "  resampling: " << EnumName(kResampling, pf.resampling) << "\n"

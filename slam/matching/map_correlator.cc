@@ -114,6 +114,11 @@ std::vector<std::string> MapCorrelatorOptions::Validate() const {
   if (yaw_half_steps > 0 && !(yaw_step_rad > 0.0)) {
     add("yaw_step_rad", yaw_step_rad, "must be > 0 when yaw_half_steps > 0");
   }
+  if (!(prior_sigma_xy_m >= 0.0)) add("prior_sigma_xy_m", prior_sigma_xy_m, "must be >= 0");
+  if (!(prior_sigma_yaw_rad >= 0.0)) {
+    add("prior_sigma_yaw_rad", prior_sigma_yaw_rad, "must be >= 0");
+  }
+  if (!(min_shift_gain >= 0.0f)) add("min_shift_gain", min_shift_gain, "must be >= 0");
   return errors;
 }
 
@@ -136,8 +141,20 @@ CorrelationResult MapCorrelator::Correlate(const GridView& grid,
   if (table != nullptr)
     table->assign(static_cast<std::size_t>(options_.num_yaws() * side * side), 0.0f);
 
+  // The prior's cost per cell and per yaw step squared (0: no prior on that part).
+  const double xy_sigma_cells = options_.prior_sigma_xy_m / grid.resolution;
+  const float xy_cost =
+      xy_sigma_cells > 0.0 ? static_cast<float>(0.5 / (xy_sigma_cells * xy_sigma_cells)) : 0.0f;
+  float yaw_cost = 0.0f;
+  if (options_.yaw_half_steps > 0 && options_.prior_sigma_yaw_rad > 0.0) {
+    const double yaw_sigma_steps = options_.prior_sigma_yaw_rad / options_.yaw_step_rad;
+    yaw_cost = static_cast<float>(0.5 / (yaw_sigma_steps * yaw_sigma_steps));
+  }
+
   CorrelationResult best;
   best.score = -std::numeric_limits<float>::infinity();
+  float best_value = -std::numeric_limits<float>::infinity();
+  float centre_score = -std::numeric_limits<float>::infinity();
   long best_rank = std::numeric_limits<long>::max();
   for (int yaw_index = -options_.yaw_half_steps; yaw_index <= options_.yaw_half_steps;
        ++yaw_index) {
@@ -198,8 +215,14 @@ CorrelationResult MapCorrelator::Correlate(const GridView& grid,
         }
         const long rank = static_cast<long>(dx) * dx + static_cast<long>(dy) * dy +
                           static_cast<long>(yaw_index) * yaw_index;
-        if (score > best.score || (score == best.score && rank < best_rank)) {
+        if (rank == 0) centre_score = score;
+        const float cost = xy_cost * static_cast<float>(dx * dx + dy * dy) +
+                           yaw_cost * static_cast<float>(yaw_index * yaw_index);
+        const float value = score - cost;
+        if (value > best_value || (value == best_value && rank < best_rank)) {
+          best_value = value;
           best.score = score;
+          best.prior_cost = cost;
           best_rank = rank;
           best.dx_cells = dx;
           best.dy_cells = dy;
@@ -208,6 +231,12 @@ CorrelationResult MapCorrelator::Correlate(const GridView& grid,
       }
     }
     if (yaw_index == 0) best.points_used = distinct;
+  }
+  // A near-tie with the centre is noise, not evidence: stay put.
+  if (options_.min_shift_gain > 0.0f && !(best_value - centre_score > options_.min_shift_gain)) {
+    best.score = centre_score;
+    best.prior_cost = 0.0f;
+    best.dx_cells = best.dy_cells = best.dyaw_steps = 0;
   }
   best.pose = Pose2(world_from_base.x() + best.dx_cells * grid.resolution,
                     world_from_base.y() + best.dy_cells * grid.resolution,

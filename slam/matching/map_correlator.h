@@ -29,6 +29,17 @@ struct MapCorrelatorOptions {
   CorrelationValue value = CorrelationValue::kOccupiedIndicator;
   float occupied_threshold = 0.0f;  ///< for kOccupiedIndicator: log-odds above this is a wall
 
+  /// Motion prior over the window (Olson, "Real-Time Correlative Scan Matching", ICRA 2009,
+  /// Sec. III: the scan likelihood times the odometry prior): a shift (dx, dy, dyaw) is ranked by
+  /// score - 0.5 (|(dx, dy)| / prior_sigma_xy_m)^2 - 0.5 (dyaw / prior_sigma_yaw_rad)^2, in score
+  /// units. Where the score is flat (a corridor, along its axis) the centre wins instead of a
+  /// noisy near-tie. 0 = no prior on that part (the reports).
+  double prior_sigma_xy_m = 0.0;
+  double prior_sigma_yaw_rad = 0.0;
+  /// Leave the pose unshifted unless the best shift's ranked value beats the centre's score by more
+  /// than this (score units). 0 = any gain moves it.
+  float min_shift_gain = 0.0f;
+
   /// Side of the xy shift grid, 2n + 1.
   int side() const { return 2 * xy_half_width_cells + 1; }
   /// Number of yaw shifts, 2n + 1.
@@ -39,12 +50,13 @@ struct MapCorrelatorOptions {
 
 /// The best shift found for one pose.
 struct CorrelationResult {
-  float score = 0.0f;   ///< correlation at the best shift
-  int dx_cells = 0;     ///< best shift in cells (world x)
-  int dy_cells = 0;     ///< best shift in cells (world y)
-  int dyaw_steps = 0;   ///< best yaw shift in steps
-  Pose2 pose;           ///< the input pose moved by the best shift
-  int points_used = 0;  ///< distinct cells the points fell in at the unshifted yaw
+  float score = 0.0f;       ///< correlation at the best shift
+  float prior_cost = 0.0f;  ///< the motion prior's penalty at the best shift (score units)
+  int dx_cells = 0;         ///< best shift in cells (world x)
+  int dy_cells = 0;         ///< best shift in cells (world y)
+  int dyaw_steps = 0;       ///< best yaw shift in steps
+  Pose2 pose;               ///< the input pose moved by the best shift
+  int points_used = 0;      ///< distinct cells the points fell in at the unshifted yaw
 };
 
 /// Correlates a scan with a map raster over a grid of x/y/yaw shifts around a pose (the laser
@@ -61,7 +73,8 @@ class MapCorrelator {
 
   const MapCorrelatorOptions& options() const { return options_; }
 
-  /// Best shift for `points_base` (points in the base frame) seen from `world_from_base`.
+  /// Best shift for `points_base` (points in the base frame) seen from `world_from_base`, ranked
+  /// by score minus the prior's cost; the prior is centred on `world_from_base`.
   /// Ties go to the shift closest to the centre. If `table` is given it receives every score,
   /// indexed [yaw][dy][dx] with dx, dy from -n to n.
   CorrelationResult Correlate(const GridView& grid, std::span<const Eigen::Vector2d> points_base,

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "slam/matching/likelihood_field.h"
 #include "slam/matching/scan_points.h"
 #include "slam/matching/testing/segment_world.h"
 
@@ -114,6 +115,97 @@ TEST(MapCorrelatorTest, RecoversARandomOffsetInsideItsWindow) {
   }
 }
 
+// Two long parallel walls 2.4 m apart: seen from inside, a scan pins y and yaw but not x.
+struct Corridor {
+  testing::SegmentWorld world{{{{-30.0, 1.2}, {90.0, 1.2}}, {{-30.0, -1.2}, {90.0, -1.2}}}};
+  testing::RangeFinderSpec spec;
+  OccupancyGrid grid{OccupancyGridOptions{}};
+  LikelihoodField field{LikelihoodFieldOptions{0.08, 0.9, 0.1, 0.0f, 3.0}};
+
+  // Maps the corridor from a few poses along it, then computes the field around `around`.
+  explicit Corridor(const Pose2& around) {
+    RandomEngine rng(7);
+    for (double x = around.x() - 1.0; x <= around.x() + 1.0; x += 0.25) {
+      const Pose2 pose(x, 0.0, 0.0);
+      grid.InsertScan(world.Scan(pose, Time{}, spec, &rng), pose);
+    }
+    field.Update(grid, Eigen::AlignedBox2d(around.translation() - Eigen::Vector2d(35, 5),
+                                           around.translation() + Eigen::Vector2d(35, 5)));
+  }
+};
+
+MapCorrelatorOptions CorridorSearch() {
+  MapCorrelatorOptions options;
+  options.yaw_half_steps = 4;
+  options.yaw_step_rad = 0.0075;
+  options.value = CorrelationValue::kRawValue;
+  options.prior_sigma_xy_m = 0.01;
+  options.prior_sigma_yaw_rad = 0.02;
+  return options;
+}
+
+// Along the corridor the score is flat up to noise: with the motion prior the search keeps the
+// predicted x (without it the best near-tie slides the pose by up to the window's half width),
+// while it still corrects the constrained offsets across the corridor and in yaw.
+TEST(MapCorrelatorTest, PriorKeepsTheAlongCorridorCoordinateAndFixesTheRest) {
+  const Pose2 truth(10.0, 0.0, 0.0);
+  const Corridor corridor(truth);
+  const LikelihoodField& field = corridor.field;
+  RandomEngine rng(21);
+  const MapCorrelator correlator(CorridorSearch());
+  for (int trial = 0; trial < 20; ++trial) {
+    const Pose2 scan_pose(truth.x() + 0.5 * (2.0 * Uniform01(rng) - 1.0), 0.0, 0.0);
+    const std::vector<Eigen::Vector2d> points = ScanToBasePoints(
+        corridor.world.Scan(scan_pose, Time{}, corridor.spec, &rng), ScanPointsOptions{});
+    // The prediction is off by 0.1 m across the corridor and 0.02 rad in yaw.
+    const Pose2 predicted(scan_pose.x() + 0.1, scan_pose.y() + 0.1, 0.02);
+    const CorrelationResult r = correlator.Correlate(field.view(), points, predicted);
+    EXPECT_EQ(r.dx_cells, 0) << trial;
+    EXPECT_NEAR(r.pose.y(), scan_pose.y(), 0.051) << trial;
+    EXPECT_NEAR(r.pose.theta(), scan_pose.theta(), 0.0076) << trial;
+  }
+}
+
+// In a room every direction is constrained: the prior does not stop a true offset of up to
+// 0.1 m (ten prior sigmas) from being found.
+TEST(MapCorrelatorTest, PriorStillRecoversAConstrainedOffset) {
+  const testing::SegmentWorld world = testing::SegmentWorld::Office();
+  const testing::RangeFinderSpec spec;
+  OccupancyGrid grid(OccupancyGridOptions{});
+  const Pose2 truth(6.0, 1.5, 0.1);
+  RandomEngine rng(3);
+  for (int i = 0; i < 3; ++i) grid.InsertScan(world.Scan(truth, Time{}, spec, &rng), truth);
+  LikelihoodField field(LikelihoodFieldOptions{0.08, 0.9, 0.1, 0.0f, 3.0});
+  field.Update(grid, Eigen::AlignedBox2d(Eigen::Vector2d(-5, -5), Eigen::Vector2d(25, 17)));
+  const std::vector<Eigen::Vector2d> points =
+      ScanToBasePoints(world.Scan(truth, Time{}, spec, &rng), ScanPointsOptions{});
+  const MapCorrelator correlator(CorridorSearch());
+  for (int trial = 0; trial < 10; ++trial) {
+    const Pose2 start(truth.x() + 0.1 * (2.0 * Uniform01(rng) - 1.0),
+                      truth.y() + 0.1 * (2.0 * Uniform01(rng) - 1.0), truth.theta());
+    const CorrelationResult r = correlator.Correlate(field.view(), points, start);
+    EXPECT_NEAR(r.pose.x(), truth.x(), 0.051) << trial;
+    EXPECT_NEAR(r.pose.y(), truth.y(), 0.051) << trial;
+  }
+}
+
+TEST(MapCorrelatorTest, NearTiesWithTheCentreStayPut) {
+  // A raster that rises by 0.1 per cell in x: the best shift gains 0.4 per point.
+  std::vector<float> ramp(100 * 100);
+  for (int y = 0; y < 100; ++y) {
+    for (int x = 0; x < 100; ++x)
+      ramp[static_cast<std::size_t>(y * 100 + x)] = 0.1f * static_cast<float>(x);
+  }
+  const GridView view{ramp.data(), 100, 100, Eigen::Vector2d::Zero(), 0.1};
+  const std::vector<Eigen::Vector2d> points = {{1.0, 0.0}, {0.0, 1.0}};
+  MapCorrelatorOptions options;
+  options.value = CorrelationValue::kRawValue;
+  options.min_shift_gain = 1.0f;  // two points gain 0.8 in all
+  EXPECT_EQ(MapCorrelator(options).Correlate(view, points, Pose2(5.0, 5.0, 0.0)).dx_cells, 0);
+  options.min_shift_gain = 0.5f;
+  EXPECT_EQ(MapCorrelator(options).Correlate(view, points, Pose2(5.0, 5.0, 0.0)).dx_cells, 4);
+}
+
 TEST(MapCorrelatorTest, TiesPreferTheCentre) {
   std::vector<float> zeros(100 * 100, 0.0f);
   const GridView flat{zeros.data(), 100, 100, Eigen::Vector2d::Zero(), 0.1};
@@ -134,6 +226,12 @@ TEST(MapCorrelatorTest, ValidateNamesFieldValueAndRule) {
       options.Validate(),
       ::testing::ElementsAre("correlation.xy_half_width_cells = -1; must be in [0, 15]",
                              "correlation.yaw_step_rad = 0; must be > 0 when yaw_half_steps > 0"));
+  options = MapCorrelatorOptions{};
+  options.prior_sigma_xy_m = -0.1;
+  options.min_shift_gain = -1.0f;
+  EXPECT_THAT(options.Validate(),
+              ::testing::ElementsAre("correlation.prior_sigma_xy_m = -0.1; must be >= 0",
+                                     "correlation.min_shift_gain = -1; must be >= 0"));
 }
 
 }  // namespace

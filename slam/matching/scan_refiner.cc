@@ -35,6 +35,8 @@ Sample Interpolate(const GridView& g, const Eigen::Vector2d& world) {
   return s;
 }
 
+double Square(double v) { return v * v; }
+
 }  // namespace
 
 std::vector<std::string> ScanRefinerOptions::Validate() const {
@@ -48,6 +50,10 @@ std::vector<std::string> ScanRefinerOptions::Validate() const {
   if (!(max_step_m > 0.0)) add("max_step_m", max_step_m, "must be > 0");
   if (!(max_step_rad > 0.0)) add("max_step_rad", max_step_rad, "must be > 0");
   if (!(converged_step_m >= 0.0)) add("converged_step_m", converged_step_m, "must be >= 0");
+  if (!(prior_sigma_xy_m >= 0.0)) add("prior_sigma_xy_m", prior_sigma_xy_m, "must be >= 0");
+  if (!(prior_sigma_yaw_rad >= 0.0)) {
+    add("prior_sigma_yaw_rad", prior_sigma_yaw_rad, "must be >= 0");
+  }
   return errors;
 }
 
@@ -65,7 +71,26 @@ double ScanRefiner::Score(const GridView& raster, std::span<const Eigen::Vector2
 RefineResult ScanRefiner::Refine(const GridView& raster, float max_value,
                                  std::span<const Eigen::Vector2d> points_base,
                                  const Pose2& initial) const {
-  RefineResult result{initial, Score(raster, points_base, initial), 0};
+  return Refine(raster, max_value, points_base, initial, initial);
+}
+
+RefineResult ScanRefiner::Refine(const GridView& raster, float max_value,
+                                 std::span<const Eigen::Vector2d> points_base, const Pose2& initial,
+                                 const Pose2& prior_mean) const {
+  // Prior information per unit of score (0: no prior on that part).
+  const Eigen::Vector3d info(
+      options_.prior_sigma_xy_m > 0.0 ? 1.0 / Square(options_.prior_sigma_xy_m) : 0.0,
+      options_.prior_sigma_xy_m > 0.0 ? 1.0 / Square(options_.prior_sigma_xy_m) : 0.0,
+      options_.prior_sigma_yaw_rad > 0.0 ? 1.0 / Square(options_.prior_sigma_yaw_rad) : 0.0);
+  auto offset = [&](const Pose2& pose) {
+    return Eigen::Vector3d(pose.x() - prior_mean.x(), pose.y() - prior_mean.y(),
+                           NormalizeAngle(pose.theta() - prior_mean.theta()));
+  };
+  auto prior_cost = [&](const Pose2& pose) {
+    const Eigen::Vector3d d = offset(pose);
+    return 0.5 * d.dot(info.cwiseProduct(d));
+  };
+  RefineResult result{initial, Score(raster, points_base, initial), prior_cost(initial), 0};
   if (!(max_value > 0.0f) || points_base.empty()) return result;
   const double scale = 1.0 / max_value;
   for (int it = 0; it < options_.max_iterations; ++it) {
@@ -73,6 +98,7 @@ RefineResult ScanRefiner::Refine(const GridView& raster, float max_value,
     const double c = std::cos(pose.theta()), s = std::sin(pose.theta());
     Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
     Eigen::Vector3d b = Eigen::Vector3d::Zero();
+    double residual_sum = 0.0;
     for (const Eigen::Vector2d& p : points_base) {
       const Sample m = Interpolate(raster, pose * p);
       const double residual = 1.0 - scale * m.value;
@@ -82,7 +108,15 @@ RefineResult ScanRefiner::Refine(const GridView& raster, float max_value,
                               scale * m.gradient.dot(dtheta));
       h += j * j.transpose();
       b += j * residual;
+      residual_sum += residual;
     }
+    // The prior as extra residuals. The data's gradient is sum r_i scale grad M_i where the
+    // score's is sum grad M_i: weighting the prior's information by scale * mean(r_i) makes the
+    // two stationary points agree, so the steps head for the maximum of score - prior cost.
+    const Eigen::Vector3d w =
+        scale * (residual_sum / static_cast<double>(points_base.size())) * info;
+    h.diagonal() += w;
+    b -= w.cwiseProduct(offset(pose));
     // Levenberg-style damping keeps flat directions (a corridor) from exploding.
     h.diagonal() += Eigen::Vector3d::Constant(1e-6 + 1e-3 * h.trace());
     Eigen::Vector3d step = h.ldlt().solve(b);
@@ -93,10 +127,12 @@ RefineResult ScanRefiner::Refine(const GridView& raster, float max_value,
       step *= options_.max_step_rad / std::abs(step.z());
     const Pose2 candidate(pose.x() + step.x(), pose.y() + step.y(), pose.theta() + step.z());
     const double score = Score(raster, points_base, candidate);
+    const double cost = prior_cost(candidate);
     ++result.iterations;
-    if (!(score > result.score)) break;
+    if (!(score - cost > result.score - result.prior_cost)) break;
     result.pose = candidate;
     result.score = score;
+    result.prior_cost = cost;
     if (step.head<2>().norm() < options_.converged_step_m && std::abs(step.z()) < 1e-4) break;
   }
   return result;

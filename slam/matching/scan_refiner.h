@@ -16,6 +16,13 @@ struct ScanRefinerOptions {
   double max_step_m = 0.05;        ///< a larger translation step is scaled down to this
   double max_step_rad = 0.02;      ///< a larger rotation step is scaled down to this
   double converged_step_m = 1e-4;  ///< stop when the step is smaller (and its rotation < 1e-4 rad)
+  /// Gaussian prior on the pose around a given mean (Cartographer's Ceres scan matcher's
+  /// translation and rotation weights): the refiner maximises score - 0.5 (|d_xy| /
+  /// prior_sigma_xy_m)^2 - 0.5 (d_yaw / prior_sigma_yaw_rad)^2 (score units) and the prior enters
+  /// the normal equations, so a flat direction (a corridor) is pulled back to the mean instead of
+  /// drifting. 0 = no prior on that part.
+  double prior_sigma_xy_m = 0.0;
+  double prior_sigma_yaw_rad = 0.0;
 
   /// One message per broken rule (prefixed "refine.").
   std::vector<std::string> Validate() const;
@@ -24,7 +31,8 @@ struct ScanRefinerOptions {
 /// A refined pose and its score.
 struct RefineResult {
   Pose2 pose;
-  double score = 0.0;  ///< sum over points of the bilinearly interpolated raster value
+  double score = 0.0;       ///< sum over points of the bilinearly interpolated raster value
+  double prior_cost = 0.0;  ///< the prior's penalty at `pose` (score units)
   int iterations = 0;
 };
 
@@ -32,14 +40,22 @@ struct RefineResult {
 /// by Gauss-Newton on the residuals 1 - M(S(xi) p) with M the raster scaled to [0, 1]
 /// (Kohlbrecher et al., "A Flexible and Scalable SLAM System with Full 3D Motion Estimation"
 /// (Hector SLAM), SSRR 2011, Sec. IV-A, Eqs. 6-13), run on the likelihood field instead of the
-/// occupancy probabilities. A step that lowers the score is not taken. Thread-safe.
+/// occupancy probabilities. A step that lowers the score (minus the prior's cost) is not taken.
+/// Thread-safe.
 class ScanRefiner {
  public:
   explicit ScanRefiner(const ScanRefinerOptions& options);
 
   /// Refines `initial`; `max_value` is the raster's largest possible value (scales M to [0, 1]).
+  /// The prior, if any, is centred on `initial`.
   RefineResult Refine(const GridView& raster, float max_value,
                       std::span<const Eigen::Vector2d> points_base, const Pose2& initial) const;
+
+  /// As above with the prior centred on `prior_mean` (e.g. the predicted pose before a shift
+  /// search moved it to `initial`).
+  RefineResult Refine(const GridView& raster, float max_value,
+                      std::span<const Eigen::Vector2d> points_base, const Pose2& initial,
+                      const Pose2& prior_mean) const;
 
   /// Sum over points of the interpolated raster value at `pose`.
   static double Score(const GridView& raster, std::span<const Eigen::Vector2d> points_base,

@@ -43,10 +43,48 @@ TEST(ScanRefinerTest, RecoversSubCellOffsets) {
   }
 }
 
+// Two long parallel walls: nothing pins x. With the prior the refiner keeps the predicted x
+// within a prior sigma (Gauss-Newton on the flat direction alone follows the map's noise) and
+// keeps y and yaw on the walls.
+TEST(ScanRefinerTest, PriorHoldsTheFlatDirectionOfACorridor) {
+  const testing::SegmentWorld world({{{-30.0, 1.2}, {90.0, 1.2}}, {{-30.0, -1.2}, {90.0, -1.2}}});
+  testing::RangeFinderSpec spec;
+  spec.range_max_m = 8.0;  // the scans never see where the mapped walls end
+  OccupancyGrid grid(OccupancyGridOptions{});
+  RandomEngine rng(9);
+  for (double x = 9.0; x <= 11.0; x += 0.25) {
+    grid.InsertScan(world.Scan(Pose2(x, 0.0, 0.0), Time{}, spec, &rng), Pose2(x, 0.0, 0.0));
+  }
+  LikelihoodField field(LikelihoodFieldOptions{0.08, 0.9, 0.1, 0.0f, 3.0});
+  field.Update(grid, Eigen::AlignedBox2d(Eigen::Vector2d(-25, -5), Eigen::Vector2d(45, 5)));
+  ScanPointsOptions point_options;
+  point_options.voxel_size_m = 0.05;
+  ScanRefinerOptions options;
+  options.max_iterations = 20;
+  options.prior_sigma_xy_m = 0.01;
+  options.prior_sigma_yaw_rad = 0.02;
+  const ScanRefiner refiner(options);
+  for (int trial = 0; trial < 10; ++trial) {
+    const Pose2 truth(9.5 + 0.1 * trial, 0.0, 0.0);
+    const std::vector<Eigen::Vector2d> points =
+        ScanToBasePoints(world.Scan(truth, Time{}, spec, &rng), point_options);
+    const Pose2 predicted(truth.x() + 0.03, 0.0, 0.0);
+    const RefineResult r =
+        refiner.Refine(field.view(), static_cast<float>(field.Score(0.0)), points, predicted);
+    EXPECT_NEAR(r.pose.x(), predicted.x(), 0.01) << trial;
+    EXPECT_NEAR(r.pose.y(), truth.y(), 0.01) << trial;
+    EXPECT_NEAR(r.pose.theta(), truth.theta(), 0.002) << trial;
+  }
+}
+
 TEST(ScanRefinerTest, ValidateNamesFieldValueAndRule) {
   ScanRefinerOptions options;
   options.max_step_m = 0.0;
   EXPECT_THAT(options.Validate(), ::testing::ElementsAre("refine.max_step_m = 0; must be > 0"));
+  options = ScanRefinerOptions{};
+  options.prior_sigma_yaw_rad = -1.0;
+  EXPECT_THAT(options.Validate(),
+              ::testing::ElementsAre("refine.prior_sigma_yaw_rad = -1; must be >= 0"));
 }
 
 }  // namespace

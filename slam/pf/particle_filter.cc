@@ -84,9 +84,12 @@ std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& po
   auto score_block = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
       CorrelationResult& r = results[static_cast<std::size_t>(i)];
-      r = correlator_.Correlate(view, points, particles_[static_cast<std::size_t>(i)].pose);
+      const Pose2& predicted = particles_[static_cast<std::size_t>(i)].pose;
+      r = correlator_.Correlate(view, points, predicted);
       if (options_.refine) {
-        const RefineResult refined = refiner_.Refine(field_view, field_max, points, r.pose);
+        // The refiner's prior stays on the predicted pose, not on the shift the search chose.
+        const RefineResult refined =
+            refiner_.Refine(field_view, field_max, points, r.pose, predicted);
         r.pose = refined.pose;
         if (use_field) r.score = static_cast<float>(refined.score);
       }
