@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite, as CI runs it: dependencies, a Release build with warnings as errors,
 # every ctest label (unit, integration, scenario), an ASan/UBSan build of the unit tests, and
-# the clang-format check. Build folders: build-ci/ and build-asan/ (both ignored by git).
+# the clang-format check (last, so that a formatting slip never hides a test result). Build folders: build-ci/ and build-asan/ (both ignored by git).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -17,13 +17,13 @@ cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSLAMRIG_SANITIZE=ON
   -DSLAMRIG_BUILD_BENCHMARKS=OFF -DCMAKE_COMPILE_WARNING_AS_ERROR=ON >/dev/null
 cmake --build build-asan -j"$jobs"
 
-echo "== clang-format"
-mapfile -t sources < <(git ls-files '*.h' '*.cc')
-clang-format --dry-run --Werror "${sources[@]}"
-
 echo "== unit tests under ASan/UBSan"
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-asan -L unit --output-on-failure -j"$jobs"
 
 echo "== all tests (Release)"
 ctest --test-dir build-ci --output-on-failure -j"$jobs"
+
+echo "== clang-format"
+mapfile -t sources < <(git ls-files '*.h' '*.cc')
+clang-format --dry-run --Werror "${sources[@]}"

@@ -63,7 +63,8 @@ TEST(YamlNodeTest, RejectsNonFiniteNumbersAndFractionalIntegers) {
 }
 
 TEST(YamlNodeTest, OverridesSetNestedKeysAndListElements) {
-  auto root = YamlNode::LoadString("slam:\n  pf: {num_particles: 30}\nlist: [1, 2, 3]\nx: 1\n", "o.yaml");
+  auto root =
+      YamlNode::LoadString("slam:\n  pf: {num_particles: 30}\nlist: [1, 2, 3]\nx: 1\n", "o.yaml");
   root.Override("slam.pf.num_particles", "100");
   root.Override("slam.pf.new_key", "true");
   root.Override("list[1]", "20");
