@@ -102,9 +102,9 @@ Frame MakeFrame(const PlotOptions& options, Range y) {
     const std::string label = TickLabel(t);
     PutText(f.image, label, {f.area.x - 8 - TextWidth(label), py + 5});
   }
-  PutText(f.image, options.title, {kMarginLeft, 24}, 0.6);
+  PutText(f.image, options.title, {kMarginLeft, 18}, 0.6);
   // y label, written horizontally above the axis (OpenCV cannot rotate text).
-  PutText(f.image, options.y_label, {8, kMarginTop - 8}, 0.45, cv::Scalar(60, 60, 60));
+  PutText(f.image, options.y_label, {8, kMarginTop - 4}, 0.45, cv::Scalar(60, 60, 60));
   const int xl = f.area.x + (f.area.width - TextWidth(options.x_label)) / 2;
   PutText(f.image, options.x_label, {xl, options.height_px - 12});
   return f;
