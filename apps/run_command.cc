@@ -38,7 +38,7 @@ int RunRunCommand(const std::vector<std::string>& args) {
   parser.AddRepeated(
       "set", "KEY=VALUE",
       "override a scenario key (slam.pf.particles=30), a world key (world.drive.laps=1) "
-      "or a robot key (robot.lidar.range_noise_std_m=0.05)",
+      "or a robot key (robot.lidar.range_noise_stddev_m=0.05)",
       &overrides);
   parser.AddFlag("view", "show the run live in a window (needs a display)", &view);
   parser.AddFlag("quiet", "print only errors and the verdict line", &quiet);

@@ -41,7 +41,7 @@ struct BlackoutFault {
 /// seed: 1
 /// duration_s: 400                    # stop here even if the drive is not finished
 /// world_overrides: {drive.laps: 3}   # key path in the world file -> value
-/// robot_overrides: {lidar.range_noise_std_m: 0.03}
+/// robot_overrides: {lidar.range_noise_stddev_m: 0.03}
 /// faults:
 ///   slip_patches: [{name: oil, shape: {type: box, center_m: [5, 1.2], size_m: [2, 2]}, mu: 0.05}]
 ///   crowd: {count: 4, speed_m_s: 0.7, radius_m: 0.25, lateral_offset_m: 0.8}
