@@ -18,8 +18,8 @@ struct SweepParameter {
 /// scenario: ../office_loop.yaml      # relative to the sweep file
 /// seeds: 5                           # 1..5, or a list [3, 7, 11]
 /// parameters:                        # the grid: every combination, in this order
-///   sensors.lidar.range_noise_std_m: [0.01, 0.03, 0.1]
-///   slam.pf.num_particles: [30, 100, 300]
+///   robot.lidar.range_noise_stddev_m: [0.01, 0.03, 0.1]
+///   slam.pf.particles: [30, 100, 300]
 /// metrics: [pf.ate_rmse_m, pf.realtime_factor]   # optional; config.metric of metrics.json
 /// ```
 struct SweepSpec {
