@@ -1,37 +1,38 @@
 #include "slam/grid/occupancy_grid.h"
 
-#include <sstream>
-
 #include "slam/grid/ray_trace.h"
 #include "slam/types/check.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::slam {
-namespace {
-
-template <typename T>
-std::string Rule(const char* field, T value, const char* rule) {
-  std::ostringstream s;
-  s << field << " = " << value << "; " << rule;
-  return s.str();
-}
-
-}  // namespace
 
 std::vector<std::string> OccupancyGridOptions::Validate() const {
   std::vector<std::string> errors;
-  if (!(resolution_m > 0.0)) errors.push_back(Rule("resolution_m", resolution_m, "must be > 0"));
-  if (!(hit_log_odds > 0.0f)) errors.push_back(Rule("hit_log_odds", hit_log_odds, "must be > 0"));
+  if (!(resolution_m > 0.0)) {
+    errors.push_back(RuleViolation("resolution_m", resolution_m, "must be > 0"));
+  }
+  if (!(hit_log_odds > 0.0f)) {
+    errors.push_back(RuleViolation("hit_log_odds", hit_log_odds, "must be > 0"));
+  }
   if (!(miss_log_odds < 0.0f)) {
-    errors.push_back(Rule("miss_log_odds", miss_log_odds, "must be < 0"));
+    errors.push_back(RuleViolation("miss_log_odds", miss_log_odds, "must be < 0"));
   }
-  if (!(min_log_odds < 0.0f)) errors.push_back(Rule("min_log_odds", min_log_odds, "must be < 0"));
-  if (!(max_log_odds > 0.0f)) errors.push_back(Rule("max_log_odds", max_log_odds, "must be > 0"));
-  if (!(max_range_m > 0.0)) errors.push_back(Rule("max_range_m", max_range_m, "must be > 0"));
+  if (!(min_log_odds < 0.0f)) {
+    errors.push_back(RuleViolation("min_log_odds", min_log_odds, "must be < 0"));
+  }
+  if (!(max_log_odds > 0.0f)) {
+    errors.push_back(RuleViolation("max_log_odds", max_log_odds, "must be > 0"));
+  }
+  if (!(max_range_m > 0.0)) {
+    errors.push_back(RuleViolation("max_range_m", max_range_m, "must be > 0"));
+  }
   if (!(no_return_clear_range_m >= 0.0)) {
-    errors.push_back(Rule("no_return_clear_range_m", no_return_clear_range_m, "must be >= 0"));
+    errors.push_back(
+        RuleViolation("no_return_clear_range_m", no_return_clear_range_m, "must be >= 0"));
   }
-  if (!(grow_margin_m >= 0.0))
-    errors.push_back(Rule("grow_margin_m", grow_margin_m, "must be >= 0"));
+  if (!(grow_margin_m >= 0.0)) {
+    errors.push_back(RuleViolation("grow_margin_m", grow_margin_m, "must be >= 0"));
+  }
   return errors;
 }
 

@@ -3,17 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <sstream>
 
 #include "slam/types/check.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::slam {
 namespace {
 
 std::string Rule(const char* field, double value, const char* rule) {
-  std::ostringstream s;
-  s << "points." << field << " = " << value << "; " << rule;
-  return s.str();
+  return RuleViolation(std::string("points.") + field, value, rule);
 }
 
 }  // namespace

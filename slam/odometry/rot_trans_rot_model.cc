@@ -5,7 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <sstream>
+
+#include "slam/types/validation.h"
 
 namespace slamrig::slam {
 namespace {
@@ -14,9 +15,7 @@ namespace {
 constexpr double kMinTranslationForHeading = 1e-6;
 
 std::string Rule(const char* field, double value, const char* rule) {
-  std::ostringstream s;
-  s << "rot_trans_rot." << field << " = " << value << "; " << rule;
-  return s.str();
+  return RuleViolation(std::string("rot_trans_rot.") + field, value, rule);
 }
 
 }  // namespace

@@ -4,20 +4,13 @@
 #include "slam/odometry/wheel_odometry.h"
 
 #include <numbers>
-#include <sstream>
 
 #include "slam/odometry/diff_drive_model.h"
 #include "slam/types/check.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::slam {
 namespace {
-
-template <typename T>
-std::string Rule(const std::string& field, T value, const char* rule) {
-  std::ostringstream s;
-  s << field << " = " << value << "; " << rule;
-  return s.str();
-}
 
 double MeanTicks(const std::vector<std::int32_t>& ticks) {
   double sum = 0.0;
@@ -34,13 +27,14 @@ double DiffDriveParams::MetresPerTick() const {
 std::vector<std::string> DiffDriveParams::Validate() const {
   std::vector<std::string> errors;
   if (!(wheel_radius_m > 0.0)) {
-    errors.push_back(Rule("diff_drive.wheel_radius_m", wheel_radius_m, "must be > 0"));
+    errors.push_back(RuleViolation("diff_drive.wheel_radius_m", wheel_radius_m, "must be > 0"));
   }
   if (ticks_per_revolution <= 0) {
-    errors.push_back(Rule("diff_drive.ticks_per_revolution", ticks_per_revolution, "must be > 0"));
+    errors.push_back(
+        RuleViolation("diff_drive.ticks_per_revolution", ticks_per_revolution, "must be > 0"));
   }
   if (!(track_width_m > 0.0)) {
-    errors.push_back(Rule("diff_drive.track_width_m", track_width_m, "must be > 0"));
+    errors.push_back(RuleViolation("diff_drive.track_width_m", track_width_m, "must be > 0"));
   }
   return errors;
 }

@@ -1,15 +1,13 @@
 #include "slam/pf/particle_filter_options.h"
 
-#include <sstream>
+#include "slam/types/validation.h"
 
 namespace slamrig::slam {
 namespace {
 
 template <typename T>
 std::string Rule(const char* field, T value, const char* rule) {
-  std::ostringstream s;
-  s << "pf." << field << " = " << value << "; " << rule;
-  return s.str();
+  return RuleViolation(std::string("pf.") + field, value, rule);
 }
 
 void Prefixed(const std::vector<std::string>& from, std::vector<std::string>& to) {
