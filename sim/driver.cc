@@ -5,8 +5,8 @@
 #include <limits>
 #include <numbers>
 
-#include "sim/messages.h"
 #include "slam/types/check.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::sim {
 

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <numbers>
 
-#include "sim/messages.h"
-#include "sim/random_stream.h"
 #include "slam/types/check.h"
+#include "slam/types/random_stream.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::sim {
 

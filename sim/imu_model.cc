@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "sim/messages.h"
 #include "slam/types/check.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::sim {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "sim/mount_pose.h"
-#include "sim/random_stream.h"
+#include "slam/types/random_stream.h"
 #include "slam/types/records.h"
 
 namespace slamrig::sim {

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <numbers>
 
-#include "sim/messages.h"
 #include "slam/types/check.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::sim {
 namespace {

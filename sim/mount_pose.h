@@ -14,4 +14,12 @@ struct MountPose {
   Pose2 ToPose2() const { return Pose2(x_m, y_m, yaw_rad); }
 };
 
+/// Fields of a mounting pose (also used for the spawn pose); see slam/config/fields.h.
+template <typename V>
+void VisitFields(V& v, MountPose& m) {
+  v("x_m", m.x_m);
+  v("y_m", m.y_m);
+  v("yaw_rad", m.yaw_rad);
+}
+
 }  // namespace slamrig::sim

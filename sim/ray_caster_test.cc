@@ -8,7 +8,7 @@
 #include <numbers>
 #include <vector>
 
-#include "sim/random_stream.h"
+#include "slam/types/random_stream.h"
 
 namespace slamrig::sim {
 namespace {

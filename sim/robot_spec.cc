@@ -1,6 +1,6 @@
 #include "sim/robot_spec.h"
 
-#include "sim/messages.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::sim {
 namespace {
@@ -105,6 +105,14 @@ RobotSpec WithoutNoise(RobotSpec spec) {
   spec.lidar.p_max = 0.0;
   spec.lidar.p_random = 0.0;
   return spec;
+}
+
+slam::DiffDriveParams NominalOdometry(const RobotSpec& spec) {
+  slam::DiffDriveParams params;
+  params.wheel_radius_m = spec.wheels.radius_m;
+  params.ticks_per_revolution = spec.encoders.ticks_per_revolution;
+  params.track_width_m = spec.wheels.track_width_m;
+  return params;
 }
 
 }  // namespace slamrig::sim

@@ -6,6 +6,7 @@
 #include "sim/encoder_model.h"
 #include "sim/imu_model.h"
 #include "sim/lidar_model.h"
+#include "slam/odometry/wheel_odometry.h"
 
 namespace slamrig::sim {
 
@@ -91,6 +92,11 @@ struct RobotSpec {
   /// One message per broken rule, field names as in the robot file ("motor.kp_n_m_s_rad = ...").
   std::vector<std::string> Validate() const;
 };
+
+/// The nominal wheel geometry the robot's own odometry (and SLAM) integrates the encoder ticks
+/// with: wheel radius, ticks per revolution and track width as specified, without the
+/// calibration errors only the simulator knows.
+slam::DiffDriveParams NominalOdometry(const RobotSpec& spec);
 
 /// `spec` with every noise source and calibration error switched off: no IMU noise, bias or
 /// scale error, no lidar noise or mixture outliers, no range rounding, nominal = physical geometry.

@@ -1,6 +1,7 @@
 #include "sim/robot_yaml.h"
 
-#include "sim/yaml_fields.h"
+#include "sim/mount_pose.h"
+#include "slam/config/fields.h"
 
 namespace slamrig::sim {
 

@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <optional>
 
-#include "sim/messages.h"
 #include "sim/robot_yaml.h"
 #include "sim/world_yaml.h"
 #include "slam/io/atomic_file.h"
@@ -15,6 +14,7 @@
 #include "slam/odometry/wheel_odometry.h"
 #include "slam/types/check.h"
 #include "slam/types/trajectory.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::sim {
 namespace {
@@ -68,9 +68,7 @@ RunSummary WriteSimulationRun(const SimulatorOptions& options, const RunOptions&
   Simulator sim(options);
   const RobotSpec& robot = options.robot;
   slam::WheelOdometryOptions odometry_options;
-  odometry_options.robot.wheel_radius_m = robot.wheels.radius_m;
-  odometry_options.robot.ticks_per_revolution = robot.encoders.ticks_per_revolution;
-  odometry_options.robot.track_width_m = robot.wheels.track_width_m;
+  odometry_options.robot = NominalOdometry(robot);
   odometry_options.use_gyro = robot.imu.enabled;
   slam::WheelOdometry odometry(odometry_options);
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "sim/messages.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::sim {
 namespace {

@@ -29,9 +29,7 @@ LoopResult DriveOffice(SimulatorOptions options) {
   Simulator sim(options);
   const RobotSpec& robot = options.robot;
   slam::WheelOdometryOptions odometry_options;
-  odometry_options.robot.wheel_radius_m = robot.wheels.radius_m;
-  odometry_options.robot.ticks_per_revolution = robot.encoders.ticks_per_revolution;
-  odometry_options.robot.track_width_m = robot.wheels.track_width_m;
+  odometry_options.robot = NominalOdometry(robot);
   odometry_options.use_gyro = false;
   slam::WheelOdometry encoders_only(odometry_options);
   odometry_options.use_gyro = true;

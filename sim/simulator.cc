@@ -5,8 +5,8 @@
 #include <iterator>
 #include <limits>
 
-#include "sim/messages.h"
 #include "slam/types/check.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::sim {
 namespace {

@@ -1,6 +1,6 @@
 #include "sim/world_spec.h"
 
-#include "sim/messages.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::sim {
 

@@ -2,7 +2,8 @@
 
 #include <filesystem>
 
-#include "sim/yaml_fields.h"
+#include "sim/mount_pose.h"
+#include "slam/config/fields.h"
 #include "slam/io/map_server.h"
 #include "slam/types/error.h"
 
@@ -12,11 +13,11 @@ namespace slamrig::sim {
 
 template <typename V>
 void VisitFields(V& v, ShapeSpec& s) {
-  v.Enum("type", s.type,
-         {{ShapeType::kBox, "box"},
-          {ShapeType::kPolygon, "polygon"},
-          {ShapeType::kPolyline, "polyline"},
-          {ShapeType::kCircle, "circle"}});
+  v.RequiredEnum("type", s.type,
+                 {{ShapeType::kBox, "box"},
+                  {ShapeType::kPolygon, "polygon"},
+                  {ShapeType::kPolyline, "polyline"},
+                  {ShapeType::kCircle, "circle"}});
   switch (s.type) {
     case ShapeType::kBox:
       v("center_m", s.center_m);
@@ -75,10 +76,10 @@ void VisitFields(V& v, ScheduleSegment& s) {
 
 template <typename V>
 void VisitFields(V& v, DriveOptions& d) {
-  v.Enum("mode", d.mode,
-         {{DriveMode::kIdle, "idle"},
-          {DriveMode::kWaypoints, "waypoints"},
-          {DriveMode::kSchedule, "schedule"}});
+  v.RequiredEnum("mode", d.mode,
+                 {{DriveMode::kIdle, "idle"},
+                  {DriveMode::kWaypoints, "waypoints"},
+                  {DriveMode::kSchedule, "schedule"}});
   v("waypoints_m", d.waypoints_m);
   v("closed", d.closed);
   v("laps", d.laps);

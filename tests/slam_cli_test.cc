@@ -109,7 +109,7 @@ TEST(SlamCliTest, BadInputIsOneLineAndNoOutput) {
   const auto bad_particles =
       RunCommand(kBinary + " slam x.log --particles 0 --out " + dir.File("o"));
   EXPECT_EQ(bad_particles.exit_code, 2);
-  EXPECT_NE(bad_particles.output.find("pf.num_particles = 0; must be > 0"), std::string::npos)
+  EXPECT_NE(bad_particles.output.find("particles = 0; must be > 0"), std::string::npos)
       << bad_particles.output;
   const auto eval = RunCommand(kBinary + " eval --truth " + dir.File("t.tum"));
   EXPECT_EQ(eval.exit_code, 2);

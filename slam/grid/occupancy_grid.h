@@ -36,6 +36,20 @@ struct OccupancyGridOptions {
   std::vector<std::string> Validate() const;
 };
 
+/// The field table of OccupancyGridOptions (slam/config/fields.h): YAML keys as the names.
+template <typename V>
+void VisitFields(V& v, OccupancyGridOptions& o) {
+  v("resolution_m", o.resolution_m);
+  v("hit_log_odds", o.hit_log_odds);
+  v("miss_log_odds", o.miss_log_odds);
+  v("min_log_odds", o.min_log_odds);
+  v("max_log_odds", o.max_log_odds);
+  v("max_range_m", o.max_range_m);
+  v("no_return_clear_range_m", o.no_return_clear_range_m);
+  v("update_once_per_scan", o.update_once_per_scan);
+  v("grow_margin_m", o.grow_margin_m);
+}
+
 /// Occupancy state of a cell after thresholding its probability.
 enum class CellState : std::int8_t { kUnknown = -1, kFree = 0, kOccupied = 100 };
 

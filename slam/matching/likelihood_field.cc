@@ -7,15 +7,14 @@
 #include <sstream>
 
 #include "slam/types/check.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::slam {
 
 std::vector<std::string> LikelihoodFieldOptions::Validate() const {
   std::vector<std::string> errors;
-  auto add = [&](const char* field, double value, const char* rule) {
-    std::ostringstream s;
-    s << "likelihood_field." << field << " = " << value << "; " << rule;
-    errors.push_back(s.str());
+  auto add = [&](const char* field, double got, const char* rule) {
+    errors.push_back(RuleViolation(field, got, rule));
   };
   if (!(sigma_m > 0.0)) add("sigma_m", sigma_m, "must be > 0");
   if (!(z_hit > 0.0)) add("z_hit", z_hit, "must be > 0");

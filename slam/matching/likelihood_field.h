@@ -21,6 +21,16 @@ struct LikelihoodFieldOptions {
   std::vector<std::string> Validate() const;
 };
 
+/// The field table of LikelihoodFieldOptions (slam/config/fields.h).
+template <typename V>
+void VisitFields(V& v, LikelihoodFieldOptions& o) {
+  v("sigma_m", o.sigma_m);
+  v("z_hit", o.z_hit);
+  v("z_rand", o.z_rand);
+  v("occupied_threshold", o.occupied_threshold);
+  v("cutoff_sigmas", o.cutoff_sigmas);
+}
+
 /// A likelihood field (Thrun, Burgard, Fox, "Probabilistic Robotics", Sec. 6.4, Table 6.3)
 /// computed from the occupied cells of an OccupancyGrid over a window. Cell value:
 /// log(z_hit * exp(-d^2 / (2 sigma^2)) + z_rand) - log(z_rand), with d the distance from the cell

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "slam/types/check.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::slam {
 namespace {
@@ -103,9 +104,7 @@ struct Scratch {
 std::vector<std::string> MapCorrelatorOptions::Validate() const {
   std::vector<std::string> errors;
   auto add = [&](const char* field, double got, const char* rule) {
-    std::ostringstream s;
-    s << "correlation." << field << " = " << got << "; " << rule;
-    errors.push_back(s.str());
+    errors.push_back(RuleViolation(field, got, rule));
   };
   if (xy_half_width_cells < 0 || xy_half_width_cells > 15) {
     add("xy_half_width_cells", xy_half_width_cells, "must be in [0, 15]");

@@ -48,6 +48,21 @@ struct MapCorrelatorOptions {
   std::vector<std::string> Validate() const;
 };
 
+/// The field table of MapCorrelatorOptions (slam/config/fields.h).
+template <typename V>
+void VisitFields(V& v, MapCorrelatorOptions& o) {
+  v("xy_half_width_cells", o.xy_half_width_cells);
+  v("yaw_half_steps", o.yaw_half_steps);
+  v("yaw_step_rad", o.yaw_step_rad);
+  v.Enum("value", o.value,
+         {{CorrelationValue::kOccupiedIndicator, "occupied"},
+          {CorrelationValue::kRawValue, "log_odds"}});
+  v("occupied_threshold", o.occupied_threshold);
+  v("prior_sigma_xy_m", o.prior_sigma_xy_m);
+  v("prior_sigma_yaw_rad", o.prior_sigma_yaw_rad);
+  v("min_shift_gain", o.min_shift_gain);
+}
+
 /// The best shift found for one pose.
 struct CorrelationResult {
   float score = 0.0f;       ///< correlation at the best shift

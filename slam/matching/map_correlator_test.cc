@@ -222,16 +222,14 @@ TEST(MapCorrelatorTest, ValidateNamesFieldValueAndRule) {
   options.xy_half_width_cells = -1;
   options.yaw_half_steps = 2;
   options.yaw_step_rad = 0.0;
-  EXPECT_THAT(
-      options.Validate(),
-      ::testing::ElementsAre("correlation.xy_half_width_cells = -1; must be in [0, 15]",
-                             "correlation.yaw_step_rad = 0; must be > 0 when yaw_half_steps > 0"));
+  EXPECT_THAT(options.Validate(),
+              ::testing::ElementsAre("xy_half_width_cells = -1; must be in [0, 15]",
+                                     "yaw_step_rad = 0; must be > 0 when yaw_half_steps > 0"));
   options = MapCorrelatorOptions{};
   options.prior_sigma_xy_m = -0.1;
   options.min_shift_gain = -1.0f;
-  EXPECT_THAT(options.Validate(),
-              ::testing::ElementsAre("correlation.prior_sigma_xy_m = -0.1; must be >= 0",
-                                     "correlation.min_shift_gain = -1; must be >= 0"));
+  EXPECT_THAT(options.Validate(), ::testing::ElementsAre("prior_sigma_xy_m = -0.1; must be >= 0",
+                                                         "min_shift_gain = -1; must be >= 0"));
 }
 
 }  // namespace

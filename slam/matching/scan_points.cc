@@ -11,7 +11,7 @@ namespace slamrig::slam {
 namespace {
 
 std::string Rule(const char* field, double value, const char* rule) {
-  return RuleViolation(std::string("points.") + field, value, rule);
+  return RuleViolation(field, value, rule);
 }
 
 }  // namespace

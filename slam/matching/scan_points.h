@@ -21,6 +21,15 @@ struct ScanPointsOptions {
   std::vector<std::string> Validate() const;
 };
 
+/// The field table of ScanPointsOptions (slam/config/fields.h).
+template <typename V>
+void VisitFields(V& v, ScanPointsOptions& o) {
+  v("min_range_m", o.min_range_m);
+  v("max_range_m", o.max_range_m);
+  v("beam_stride", o.beam_stride);
+  v("voxel_size_m", o.voxel_size_m);
+}
+
 /// The scan's hit points in the base_link frame (through scan.base_from_laser), in beam order.
 std::vector<Eigen::Vector2d> ScanToBasePoints(const LaserScan& scan,
                                               const ScanPointsOptions& options);

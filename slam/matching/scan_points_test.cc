@@ -53,7 +53,7 @@ TEST(ScanPointsTest, VoxelFilterKeepsOnePointPerVoxelInBeamOrder) {
 TEST(ScanPointsTest, ValidateNamesFieldValueAndRule) {
   ScanPointsOptions options;
   options.beam_stride = 0;
-  EXPECT_THAT(options.Validate(), testing::ElementsAre("points.beam_stride = 0; must be >= 1"));
+  EXPECT_THAT(options.Validate(), testing::ElementsAre("beam_stride = 0; must be >= 1"));
 }
 
 }  // namespace

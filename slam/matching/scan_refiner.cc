@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "slam/types/check.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::slam {
 namespace {
@@ -42,9 +43,7 @@ double Square(double v) { return v * v; }
 std::vector<std::string> ScanRefinerOptions::Validate() const {
   std::vector<std::string> errors;
   auto add = [&](const char* field, double got, const char* rule) {
-    std::ostringstream s;
-    s << "refine." << field << " = " << got << "; " << rule;
-    errors.push_back(s.str());
+    errors.push_back(RuleViolation(field, got, rule));
   };
   if (max_iterations < 0) add("max_iterations", max_iterations, "must be >= 0");
   if (!(max_step_m > 0.0)) add("max_step_m", max_step_m, "must be > 0");

@@ -28,6 +28,17 @@ struct ScanRefinerOptions {
   std::vector<std::string> Validate() const;
 };
 
+/// The field table of ScanRefinerOptions (slam/config/fields.h).
+template <typename V>
+void VisitFields(V& v, ScanRefinerOptions& o) {
+  v("max_iterations", o.max_iterations);
+  v("max_step_m", o.max_step_m);
+  v("max_step_rad", o.max_step_rad);
+  v("converged_step_m", o.converged_step_m);
+  v("prior_sigma_xy_m", o.prior_sigma_xy_m);
+  v("prior_sigma_yaw_rad", o.prior_sigma_yaw_rad);
+}
+
 /// A refined pose and its score.
 struct RefineResult {
   Pose2 pose;

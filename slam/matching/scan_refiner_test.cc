@@ -80,11 +80,10 @@ TEST(ScanRefinerTest, PriorHoldsTheFlatDirectionOfACorridor) {
 TEST(ScanRefinerTest, ValidateNamesFieldValueAndRule) {
   ScanRefinerOptions options;
   options.max_step_m = 0.0;
-  EXPECT_THAT(options.Validate(), ::testing::ElementsAre("refine.max_step_m = 0; must be > 0"));
+  EXPECT_THAT(options.Validate(), ::testing::ElementsAre("max_step_m = 0; must be > 0"));
   options = ScanRefinerOptions{};
   options.prior_sigma_yaw_rad = -1.0;
-  EXPECT_THAT(options.Validate(),
-              ::testing::ElementsAre("refine.prior_sigma_yaw_rad = -1; must be >= 0"));
+  EXPECT_THAT(options.Validate(), ::testing::ElementsAre("prior_sigma_yaw_rad = -1; must be >= 0"));
 }
 
 }  // namespace

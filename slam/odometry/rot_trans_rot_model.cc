@@ -15,7 +15,7 @@ namespace {
 constexpr double kMinTranslationForHeading = 1e-6;
 
 std::string Rule(const char* field, double value, const char* rule) {
-  return RuleViolation(std::string("rot_trans_rot.") + field, value, rule);
+  return RuleViolation(field, value, rule);
 }
 
 }  // namespace

@@ -37,6 +37,17 @@ struct RotTransRotNoise {
   std::vector<std::string> Validate() const;
 };
 
+/// The field table of RotTransRotNoise (slam/config/fields.h).
+template <typename V>
+void VisitFields(V& v, RotTransRotNoise& o) {
+  v("alpha1", o.alpha1);
+  v("alpha2", o.alpha2);
+  v("alpha3", o.alpha3);
+  v("alpha4", o.alpha4);
+  v("min_trans_sigma_m", o.min_trans_sigma_m);
+  v("min_rot_sigma_rad", o.min_rot_sigma_rad);
+}
+
 /// Draws a noisy version of the robot-frame increment `before_from_after` (Table 5.6).
 Pose2 SampleRotTransRot(const Pose2& before_from_after, const RotTransRotNoise& noise,
                         RandomEngine& rng);

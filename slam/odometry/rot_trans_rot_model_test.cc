@@ -81,7 +81,7 @@ TEST(RotTransRotTest, SameSeedSameSamples) {
 TEST(RotTransRotTest, ValidateNamesFieldValueAndRule) {
   RotTransRotNoise noise;
   noise.alpha3 = -1.0;
-  EXPECT_THAT(noise.Validate(), testing::ElementsAre("rot_trans_rot.alpha3 = -1; must be >= 0"));
+  EXPECT_THAT(noise.Validate(), testing::ElementsAre("alpha3 = -1; must be >= 0"));
 }
 
 TEST(GaussianTest, StandardNormalHasUnitMoments) {

@@ -7,11 +7,11 @@ namespace {
 
 template <typename T>
 std::string Rule(const char* field, T value, const char* rule) {
-  return RuleViolation(std::string("pf.") + field, value, rule);
+  return RuleViolation(field, value, rule);
 }
 
-void Prefixed(const std::vector<std::string>& from, std::vector<std::string>& to) {
-  for (const std::string& e : from) to.push_back("pf." + e);
+void Prefixed(const char* key, const std::vector<std::string>& from, std::vector<std::string>& to) {
+  AppendErrors(&to, PrefixErrors(key, from));
 }
 
 }  // namespace
@@ -42,7 +42,7 @@ ParticleFilterOptions ParticleFilterOptions::ReportsPreset() {
 
 std::vector<std::string> ParticleFilterOptions::Validate() const {
   std::vector<std::string> errors;
-  if (num_particles <= 0) errors.push_back(Rule("num_particles", num_particles, "must be > 0"));
+  if (num_particles <= 0) errors.push_back(Rule("particles", num_particles, "must be > 0"));
   if (!(sigma_xy_m >= 0.0)) errors.push_back(Rule("sigma_xy_m", sigma_xy_m, "must be >= 0"));
   if (!(sigma_yaw_rad >= 0.0))
     errors.push_back(Rule("sigma_yaw_rad", sigma_yaw_rad, "must be >= 0"));
@@ -58,23 +58,20 @@ std::vector<std::string> ParticleFilterOptions::Validate() const {
   if (!(min_update_angle_rad >= 0.0)) {
     errors.push_back(Rule("min_update_angle_rad", min_update_angle_rad, "must be >= 0"));
   }
-  if (num_threads < 1) errors.push_back(Rule("num_threads", num_threads, "must be >= 1"));
-  if (cloud_every_n_scans < 0) {
-    errors.push_back(Rule("cloud_every_n_scans", cloud_every_n_scans, "must be >= 0"));
-  }
-  Prefixed(rot_trans_rot.Validate(), errors);
-  Prefixed(points.Validate(), errors);
-  Prefixed(correlation.Validate(), errors);
-  Prefixed(likelihood_field.Validate(), errors);
-  Prefixed(refiner.Validate(), errors);
+  if (num_threads < 1) errors.push_back(Rule("threads", num_threads, "must be >= 1"));
+  Prefixed("rot_trans_rot", rot_trans_rot.Validate(), errors);
+  Prefixed("points", points.Validate(), errors);
+  Prefixed("correlation", correlation.Validate(), errors);
+  Prefixed("likelihood_field", likelihood_field.Validate(), errors);
+  Prefixed("refiner", refiner.Validate(), errors);
   if (observation == ObservationModel::kLikelihoodField &&
       correlation.value != CorrelationValue::kRawValue) {
-    errors.push_back("pf.correlation.value = indicator; must be raw with the likelihood field");
+    errors.push_back("correlation.value = occupied; must be log_odds with the likelihood field");
   }
   if (refine && !move_to_best_shift) {
-    errors.push_back("pf.refine = true; needs pf.move_to_best_shift = true");
+    errors.push_back("refine = true; needs move_to_best_shift = true");
   }
-  for (const std::string& e : map.Validate()) errors.push_back("pf.map." + e);
+  Prefixed("map", map.Validate(), errors);
   return errors;
 }
 

@@ -74,8 +74,6 @@ struct ParticleFilterOptions {
 
   int num_threads =
       1;  ///< worker threads for the per-particle scoring (results do not depend on it)
-  /// Record the particle cloud every n scans (0: never).
-  int cloud_every_n_scans = 0;
 
   /// The ECE276A reports' method: Gaussian prediction noise, all beams, 9x9 x/y shifts, no yaw
   /// shift, softmax of correlations, stratified resampling at Neff < N/2, particles not moved,
@@ -85,5 +83,37 @@ struct ParticleFilterOptions {
   /// One message per broken rule, e.g. "pf.num_particles = 0; must be > 0".
   std::vector<std::string> Validate() const;
 };
+
+/// The field table of ParticleFilterOptions (slam/config/fields.h): the keys of a scenario's
+/// `slam: {NAME: {algorithm: pf, ...}}` entry, of `--set slam.NAME.KEY=...` and of the messages of
+/// Validate(). `seed` is not a field: it derives from the run's seed.
+template <typename V>
+void VisitFields(V& v, ParticleFilterOptions& o) {
+  v("particles", o.num_particles);
+  v.Enum("motion_noise", o.motion_noise,
+         {{MotionNoiseModel::kGaussianPerStep, "gaussian"},
+          {MotionNoiseModel::kRotTransRot, "rot_trans_rot"}});
+  v("sigma_xy_m", o.sigma_xy_m);
+  v("sigma_yaw_rad", o.sigma_yaw_rad);
+  v.Struct("rot_trans_rot", o.rot_trans_rot);
+  v.Enum("observation", o.observation,
+         {{ObservationModel::kMapCorrelation, "correlation"},
+          {ObservationModel::kLikelihoodField, "likelihood_field"}});
+  v.Struct("points", o.points);
+  v.Struct("correlation", o.correlation);
+  v.Struct("likelihood_field", o.likelihood_field);
+  v("observation_scale", o.observation_scale);
+  v("move_to_best_shift", o.move_to_best_shift);
+  v("refine", o.refine);
+  v.Struct("refiner", o.refiner);
+  v("min_update_distance_m", o.min_update_distance_m);
+  v("min_update_angle_rad", o.min_update_angle_rad);
+  v.Enum("resampling", o.resampling,
+         {{ResamplingScheme::kSystematic, "systematic"},
+          {ResamplingScheme::kStratified, "stratified"}});
+  v("resample_neff_ratio", o.resample_neff_ratio);
+  v("threads", o.num_threads);
+  v.Struct("map", o.map);
+}
 
 }  // namespace slamrig::slam

@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "slam/odometry/scan_sync.h"
-#include "slam/pf/slam_run.h"
 #include "slam/pf/testing/synthetic_run.h"
+#include "slam/types/trajectory.h"
 
 namespace slamrig::slam {
 namespace {
@@ -48,6 +48,35 @@ double PositionRmse(const Trajectory& estimate, const std::vector<GroundTruthPos
   return std::sqrt(sum / static_cast<double>(estimate.size()));
 }
 
+// The filter over a whole run: best and mean particle per scan, the map, and clouds.
+struct PfRun {
+  Trajectory trajectory;
+  Trajectory mean_trajectory;
+  OccupancyGrid map{OccupancyGridOptions{}};
+  std::vector<std::vector<Particle>> clouds;
+};
+
+PfRun RunParticleFilter(const std::vector<SyncedScan>& scans, const ParticleFilterOptions& options,
+                        std::size_t cloud_every = 0) {
+  PfRun run;
+  ParticleFilter filter(options);
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    const ParticleFilterStep step = filter.AddScan(scans[i].scan, scans[i].increment);
+    run.trajectory.Append(scans[i].scan.time, step.best_pose);
+    run.mean_trajectory.Append(scans[i].scan.time, step.mean_pose);
+    if (cloud_every > 0 && i % cloud_every == 0) run.clouds.push_back(filter.particles());
+  }
+  run.map = filter.map();
+  return run;
+}
+
+Trajectory DeadReckoning(const std::vector<SyncedScan>& scans) {
+  Trajectory trajectory;
+  const std::vector<Pose2> poses = DeadReckoningPoses(scans);
+  for (std::size_t i = 0; i < scans.size(); ++i) trajectory.Append(scans[i].scan.time, poses[i]);
+  return trajectory;
+}
+
 ParticleFilterOptions FastOptions() {
   ParticleFilterOptions options;
   options.num_particles = 30;
@@ -58,9 +87,8 @@ ParticleFilterOptions FastOptions() {
 TEST(ParticleFilterTest, BeatsDeadReckoningOnASyntheticOfficeRun) {
   const ShortRun& run = GetShortRun();
   ASSERT_EQ(run.scans.size(), run.run.truth.size());
-  const double dr =
-      PositionRmse(RunDeadReckoning(run.scans, OccupancyGridOptions{}).trajectory, run.run.truth);
-  const SlamRunResult pf = RunParticleFilter(run.scans, FastOptions());
+  const double dr = PositionRmse(DeadReckoning(run.scans), run.run.truth);
+  const PfRun pf = RunParticleFilter(run.scans, FastOptions());
   const double pf_rmse = PositionRmse(pf.trajectory, run.run.truth);
   RecordProperty("dead_reckoning_rmse_m", std::to_string(dr));
   RecordProperty("pf_rmse_m", std::to_string(pf_rmse));
@@ -74,7 +102,7 @@ TEST(ParticleFilterTest, ReportsPresetRunsAndTracks) {
   const ShortRun& run = GetShortRun();
   ParticleFilterOptions options = ParticleFilterOptions::ReportsPreset();
   options.num_particles = 30;
-  const SlamRunResult pf = RunParticleFilter(run.scans, options);
+  const PfRun pf = RunParticleFilter(run.scans, options);
   EXPECT_LT(PositionRmse(pf.trajectory, run.run.truth), 0.3);
 }
 
@@ -85,7 +113,7 @@ TEST(ParticleFilterTest, MapCorrelationWithoutRefinementTracks) {
   options.correlation.value = CorrelationValue::kOccupiedIndicator;
   options.refine = false;
   options.observation_scale = 1.0;
-  const SlamRunResult pf = RunParticleFilter(run.scans, options);
+  const PfRun pf = RunParticleFilter(run.scans, options);
   EXPECT_LT(PositionRmse(pf.trajectory, run.run.truth), 0.1);
 }
 
@@ -93,11 +121,10 @@ TEST(ParticleFilterTest, SameSeedSameTrajectoryWhateverTheThreadCount) {
   const ShortRun& run = GetShortRun();
   std::vector<SyncedScan> scans(run.scans.begin(), run.scans.begin() + 90);
   ParticleFilterOptions options = FastOptions();
-  options.cloud_every_n_scans = 50;
-  const SlamRunResult a = RunParticleFilter(scans, options);
-  const SlamRunResult b = RunParticleFilter(scans, options);
+  const PfRun a = RunParticleFilter(scans, options, 50);
+  const PfRun b = RunParticleFilter(scans, options);
   options.num_threads = 3;
-  const SlamRunResult c = RunParticleFilter(scans, options);
+  const PfRun c = RunParticleFilter(scans, options);
   ASSERT_EQ(a.trajectory.size(), scans.size());
   for (std::size_t i = 0; i < scans.size(); ++i) {
     ASSERT_EQ(a.trajectory[i].pose, b.trajectory[i].pose) << i;
@@ -106,10 +133,10 @@ TEST(ParticleFilterTest, SameSeedSameTrajectoryWhateverTheThreadCount) {
   }
   EXPECT_EQ(a.map.log_odds(), c.map.log_odds());
   ASSERT_EQ(a.clouds.size(), 2u);
-  EXPECT_EQ(a.clouds[1].particles.size(), 30u);
+  EXPECT_EQ(a.clouds[1].size(), 30u);
   options.seed = 18;
   options.num_threads = 1;
-  const SlamRunResult d = RunParticleFilter(scans, options);
+  const PfRun d = RunParticleFilter(scans, options);
   EXPECT_NE(a.trajectory.poses().back().pose, d.trajectory.poses().back().pose);
 }
 
@@ -139,10 +166,9 @@ TEST(ParticleFilterTest, ValidateNamesFieldValueAndRule) {
   ParticleFilterOptions options;
   options.num_particles = 0;
   options.correlation.xy_half_width_cells = 20;
-  EXPECT_THAT(
-      options.Validate(),
-      ::testing::ElementsAre("pf.num_particles = 0; must be > 0",
-                             "pf.correlation.xy_half_width_cells = 20; must be in [0, 15]"));
+  EXPECT_THAT(options.Validate(),
+              ::testing::ElementsAre("particles = 0; must be > 0",
+                                     "correlation.xy_half_width_cells = 20; must be in [0, 15]"));
   EXPECT_TRUE(ParticleFilterOptions{}.Validate().empty());
   EXPECT_TRUE(ParticleFilterOptions::ReportsPreset().Validate().empty());
 }

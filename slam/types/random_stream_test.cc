@@ -1,10 +1,10 @@
-#include "sim/random_stream.h"
+#include "slam/types/random_stream.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-namespace slamrig::sim {
+namespace slamrig {
 namespace {
 
 TEST(RandomStreamTest, SameSeedAndNameGiveTheSameNumbers) {
@@ -57,4 +57,4 @@ TEST(RandomStreamTest, DistributionsHaveTheirMoments) {
 }
 
 }  // namespace
-}  // namespace slamrig::sim
+}  // namespace slamrig

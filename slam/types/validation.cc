@@ -1,8 +1,8 @@
-#include "sim/messages.h"
+#include "slam/types/validation.h"
 
 #include <charconv>
 
-namespace slamrig::sim {
+namespace slamrig {
 
 std::string FormatNumber(double value) {
   char buffer[64];
@@ -19,4 +19,4 @@ void AppendErrors(std::vector<std::string>* errors, const std::vector<std::strin
   errors->insert(errors->end(), more.begin(), more.end());
 }
 
-}  // namespace slamrig::sim
+}  // namespace slamrig

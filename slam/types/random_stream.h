@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string_view>
 
-namespace slamrig::sim {
+namespace slamrig {
 
 /// A named pseudo-random stream: xoshiro256** (Blackman and Vigna, "Scrambled linear
 /// pseudorandom number generators", 2021) seeded from (seed, name) through SplitMix64 over the
@@ -32,4 +32,4 @@ class RandomStream {
 /// 64-bit FNV-1a hash of `text`; stable across platforms (used to name streams).
 std::uint64_t Fnv1a64(std::string_view text);
 
-}  // namespace slamrig::sim
+}  // namespace slamrig

@@ -1,23 +1,33 @@
 #pragma once
 
-// Field visitors shared by the world and robot file readers and writers: each options struct
-// lists its fields once, in a VisitFields(visitor, struct) overload, and the same list reads
-// the file (FieldReader, strict, through YamlNode) and writes the resolved config (FieldWriter).
+// Field tables: each options struct lists its fields once, in a VisitFields(visitor, struct)
+// overload beside the struct (a template: the struct's header includes no YAML), and the same list
+// reads a file (FieldReader, strict, through YamlNode), writes the resolved config (FieldWriter)
+// and writes metrics.json (slam/eval/json_fields.h). Reader and writers cannot drift apart.
+//
+// The visitor interface every VisitFields may use:
+//   v(key, scalar)                  double, float, int, bool, std::string, std::uint64_t,
+//                                   Eigen::Vector2d ([x, y]), std::vector<Eigen::Vector2d>
+//   v.Enum(key, e, {{E::kA, "a"}})  an enum by name; absent keeps the default
+//   v.RequiredEnum(key, e, names)   the same, but the key must be there
+//   v.Struct(key, s)                a nested map (its own VisitFields and Validate())
+//   v.OptionalStruct(key, opt)      a nested map that may be absent (std::optional)
+//   v.List(key, vector)             a list of maps
 
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Core>
+#include <charconv>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "sim/messages.h"
-#include "sim/mount_pose.h"
 #include "slam/config/yaml_node.h"
+#include "slam/types/validation.h"
 
-namespace slamrig::sim {
+namespace slamrig {
 
 /// Reads fields from a YAML map, keeping defaults for absent keys. A nested struct or list
 /// element is validated where it is read, so its errors point at its own line.
@@ -42,9 +52,15 @@ class FieldReader {
     values.clear();
     for (const YamlNode& element : child->Elements()) values.push_back(ReadPoint(element));
   }
-  /// One of `names` (pairs of enum value and name); required.
+  /// One of `names` (pairs of enum value and name); absent keeps the default.
   template <typename E>
   void Enum(const char* key, E& value, const std::vector<std::pair<E, const char*>>& names) {
+    if (node_.Has(key)) RequiredEnum(key, value, names);
+  }
+  /// One of `names`; the key must be there.
+  template <typename E>
+  void RequiredEnum(const char* key, E& value,
+                    const std::vector<std::pair<E, const char*>>& names) {
     const YamlNode child = node_.Required(key);
     const std::string text = child.As<std::string>();
     std::string choices;
@@ -115,6 +131,11 @@ class FieldWriter {
   void operator()(const char* key, const double& value) {
     out_ << YAML::Key << key << YAML::Value << FormatNumber(value);
   }
+  void operator()(const char* key, const float& value) {
+    char buffer[32];  // the shortest text that reads back as this float
+    const auto end = std::to_chars(buffer, buffer + sizeof(buffer), value).ptr;
+    out_ << YAML::Key << key << YAML::Value << std::string(buffer, end);
+  }
   void operator()(const char* key, const int& value) {
     out_ << YAML::Key << key << YAML::Value << value;
   }
@@ -142,6 +163,11 @@ class FieldWriter {
     for (const auto& [option, name] : names) {
       if (option == value) out_ << YAML::Key << key << YAML::Value << name;
     }
+  }
+  template <typename E>
+  void RequiredEnum(const char* key, E& value,
+                    const std::vector<std::pair<E, const char*>>& names) {
+    Enum(key, value, names);
   }
   /// A nested map.
   template <typename T>
@@ -177,14 +203,6 @@ class FieldWriter {
   YAML::Emitter& out_;
 };
 
-/// Fields of a mounting pose (also used for the spawn pose).
-template <typename V>
-void VisitFields(V& v, MountPose& m) {
-  v("x_m", m.x_m);
-  v("y_m", m.y_m);
-  v("yaw_rad", m.yaw_rad);
-}
-
 /// Emits `value` (a struct with a VisitFields overload) as a YAML document.
 template <typename T>
 std::string ToYaml(T value, const std::string& header_comment) {
@@ -197,4 +215,4 @@ std::string ToYaml(T value, const std::string& header_comment) {
   return std::string(out.c_str()) + "\n";
 }
 
-}  // namespace slamrig::sim
+}  // namespace slamrig

@@ -1,10 +1,10 @@
-#include "sim/random_stream.h"
+#include "slam/types/random_stream.h"
 
 #include <cmath>
 
 #include "slam/types/check.h"
 
-namespace slamrig::sim {
+namespace slamrig {
 namespace {
 
 std::uint64_t SplitMix64(std::uint64_t* x) {
@@ -109,4 +109,4 @@ double RandomStream::Exponential(double rate) {
   return -std::log1p(-Uniform()) / rate;
 }
 
-}  // namespace slamrig::sim
+}  // namespace slamrig
