@@ -242,12 +242,16 @@ class CarmenParser {
     const Pose2 pose = f.PoseAt(1, "pose");
     for (std::size_t k = 4; k < 7; ++k) f.Number(k, k == 4 ? "tv" : k == 5 ? "rv" : "accel");
     const double stamp = f.Number(7, "ipc_timestamp");
-    // GMapping's corrected logs echo the corrected scan pose as an ODOM line with stamp 0.
-    if (stamp == 0.0 && last_was_laser_ && !log_.scans.empty()) {
+    // GMapping's corrected logs echo each scan's corrected pose as the ODOM line right after
+    // it. Recognised by position and content: most echoes have stamp 0, but some carry junk
+    // stamps (1e-42, 1.7e-153, ... on intel), so the stamp alone does not tell. A stamp at or
+    // after the scan's keeps a raw log's ODOM of a robot standing still from looking like one.
+    if (last_was_laser_ && !log_.scans.empty() && log_.scans.back().has_pose &&
+        (stamp == 0.0 || stamp < stamped_.back().stamp_s)) {
       const Pose2 d = log_.scans.back().logged_pose.Between(pose);
       if (std::abs(d.x()) < 1e-4 && std::abs(d.y()) < 1e-4 && std::abs(d.theta()) < 1e-4) {
         log_.is_corrected = true;
-        ++log_.stats.skipped["GMapping echo ODOM (corrected pose, timestamp 0)"];
+        ++log_.stats.skipped["GMapping echo ODOM (the scan's corrected pose)"];
         throw Skip{};
       }
     }
@@ -346,11 +350,9 @@ class CarmenParser {
       Time t = log_.timestamps_usable
                    ? Time::FromSeconds(s.stamp_s)
                    : Time::FromNanoseconds(static_cast<std::int64_t>(s.line) * 1'000'000);
-      if (t < previous) {
-        ++log_.stats.out_of_order_times;
-        t = previous;
-      }
-      previous = t;
+      // A stamp earlier than its predecessor's stays as it is (the message stays in file order).
+      if (t < previous) ++log_.stats.out_of_order_times;
+      previous = std::max(previous, t);
       switch (s.kind) {
         case Stamped::Kind::kScan:
           log_.scans[s.index].scan.time = t;
@@ -365,7 +367,8 @@ class CarmenParser {
     }
     if (log_.stats.out_of_order_times > 0) {
       log_.notes.push_back(std::to_string(log_.stats.out_of_order_times) +
-                           " stamps earlier than the message before them; kept in file order");
+                           " stamps earlier than the message before them; kept in file order, each "
+                           "with its own stamp");
     }
   }
 

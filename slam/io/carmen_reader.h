@@ -53,7 +53,8 @@ struct CarmenLog {
   std::vector<GroundTruthPose> true_poses;    ///< TRUEPOS lines
   std::map<std::string, std::string> params;  ///< PARAM name -> value
   /// The log is a GMapping "corrected" log: its FLASER poses are a reference, its ODOM lines
-  /// are corrected-pose-plus-raw-increment (detected from the echo ODOM lines, timestamp 0).
+  /// are corrected-pose-plus-raw-increment (detected from the echo ODOM line after each scan: its
+  /// corrected pose again).
   bool is_corrected = false;
   /// False when the stamps are all zero, constant or garbage: times were then synthesized from
   /// file order (one millisecond per line) and `notes` says so.

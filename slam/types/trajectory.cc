@@ -7,21 +7,19 @@
 
 namespace slamrig {
 
-Trajectory::Trajectory(std::vector<StampedPose> poses) : poses_(std::move(poses)) {
-  SLAMRIG_CHECK(
-      std::is_sorted(poses_.begin(), poses_.end(),
-                     [](const StampedPose& a, const StampedPose& b) { return a.time < b.time; }),
-      "trajectory times must be non-decreasing");
+Trajectory::Trajectory(std::vector<StampedPose> poses) {
+  poses_.reserve(poses.size());
+  for (const StampedPose& p : poses) Append(p.time, p.pose);
 }
 
 void Trajectory::Append(Time time, const Pose2& pose) {
-  SLAMRIG_CHECK(poses_.empty() || poses_.back().time <= time,
-                "trajectory times must be non-decreasing");
+  if (!poses_.empty() && time < poses_.back().time) ++out_of_order_;
   poses_.push_back({time, pose});
 }
 
 std::optional<Pose2> Trajectory::Interpolate(Time time) const {
-  if (poses_.empty() || time < poses_.front().time || time > poses_.back().time) {
+  if (poses_.empty() || !time_ordered() || time < poses_.front().time ||
+      time > poses_.back().time) {
     return std::nullopt;
   }
   const auto after = std::lower_bound(poses_.begin(), poses_.end(), time,

@@ -12,17 +12,24 @@ namespace slamrig {
 struct StampedPose {
   Time time;
   Pose2 pose;
+  friend bool operator==(const StampedPose&, const StampedPose&) = default;
 };
 
-/// A time-ordered sequence of stamped poses (an estimate or a reference).
-/// Times are non-decreasing; `Append` enforces it.
+/// A sequence of stamped poses (an estimate or a reference), in the order they were produced
+/// (one per scan, say). Stamps are normally non-decreasing; a real log's stamps may go backwards
+/// in places, and then each pose still keeps its own stamp (`time_ordered()` is false) rather than
+/// a made-up one, so outside tools pair it with the right reference pose.
 class Trajectory {
  public:
   Trajectory() = default;
   explicit Trajectory(std::vector<StampedPose> poses);
 
-  /// Adds a pose; its time must not be earlier than the last one (checked).
+  /// Adds a pose at the end, whatever its stamp.
   void Append(Time time, const Pose2& pose);
+  /// True when no stamp is earlier than the one before it.
+  bool time_ordered() const { return out_of_order_ == 0; }
+  /// Number of poses stamped earlier than their predecessor.
+  int out_of_order() const { return out_of_order_; }
 
   const std::vector<StampedPose>& poses() const { return poses_; }
   std::size_t size() const { return poses_.size(); }
@@ -30,7 +37,8 @@ class Trajectory {
   const StampedPose& operator[](std::size_t i) const { return poses_[i]; }
 
   /// The pose at `time`, linearly interpolated (angle along the shortest arc) between the two
-  /// neighbouring samples; nullopt outside [front, back] time.
+  /// neighbouring samples; nullopt outside [front, back] time, and on a trajectory whose stamps
+  /// are not time-ordered (there is no "the pose at a time" there).
   std::optional<Pose2> Interpolate(Time time) const;
 
   /// Sum of the distances between consecutive positions, metres.
@@ -38,6 +46,7 @@ class Trajectory {
 
  private:
   std::vector<StampedPose> poses_;
+  int out_of_order_ = 0;
 };
 
 }  // namespace slamrig
