@@ -7,10 +7,10 @@
 
 #include "apps/cli_args.h"
 #include "apps/commands.h"
-#include "apps/data_path.h"
 #include "slam/grid/occupancy_grid.h"
 #include "slam/io/atomic_file.h"
 #include "slam/io/carmen_reader.h"
+#include "slam/io/log_reader.h"
 #include "slam/io/map_image.h"
 #include "slam/io/map_server.h"
 #include "slam/io/tum_io.h"
@@ -69,7 +69,7 @@ int RunMapCommand(const std::vector<std::string>& args) {
   const auto start = std::chrono::steady_clock::now();
   slam::CarmenReadOptions read_options;
   read_options.lenient = lenient;
-  const CarmenLog log = slam::ReadCarmenLog(ResolveDataPath(log_path), read_options);
+  const CarmenLog log = slam::ReadCarmenLog(slam::ResolveLogPath(log_path), read_options);
   if (log.scans.empty())
     throw ParseError(log.path + ": no laser scans (FLASER, ROBOTLASER1, ...) to map");
   const bool use_truth = poses == "truth" || (poses == "auto" && !log.true_poses.empty());

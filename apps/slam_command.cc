@@ -1,7 +1,8 @@
-// `slamrig slam LOG --algorithm dead-reckoning|pf --out DIR`: SLAM on a CARMEN log (a real one or
-// one written by `slamrig simulate`) or an ECE276A robot log, scored against the log's reference
-// when it has one.
+// `slamrig slam LOG --algorithm NAME --out DIR`: any estimator of the pipeline on a log (CARMEN,
+// real or written by `slamrig simulate`; an ECE276A robot log), scored against the log's
+// reference when it has one.
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -10,21 +11,19 @@
 
 #include "apps/cli_args.h"
 #include "apps/commands.h"
-#include "apps/data_path.h"
+#include "slam/config/yaml_node.h"
 #include "slam/eval/json_writer.h"
 #include "slam/eval/map_score.h"
 #include "slam/eval/run_timing.h"
 #include "slam/eval/trajectory_metrics.h"
 #include "slam/io/atomic_file.h"
-#include "slam/io/carmen_reader.h"
-#include "slam/io/dataset.h"
-#include "slam/io/ece276a_reader.h"
+#include "slam/io/log_reader.h"
 #include "slam/io/map_image.h"
 #include "slam/io/map_server.h"
 #include "slam/io/tum_io.h"
 #include "slam/odometry/scan_sync.h"
 #include "slam/odometry/wheel_odometry.h"
-#include "slam/pf/slam_run.h"
+#include "slam/pipeline/estimator_runner.h"
 #include "slam/types/error.h"
 
 namespace slamrig::app {
@@ -36,17 +35,6 @@ std::string Fixed(double v, int digits) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), "%.*f", digits, v);
   return buffer;
-}
-
-slam::Dataset LoadLog(const std::string& path, bool lenient, std::string* kind) {
-  if (slam::LooksLikeEce276a(path)) {
-    *kind = "ece276a";
-    return slam::ReadEce276a(slam::FindEce276aFiles(path));
-  }
-  *kind = "carmen";
-  slam::CarmenReadOptions options;
-  options.lenient = lenient;
-  return slam::CarmenToDataset(slam::ReadCarmenLog(path, options));
 }
 
 const char* SourceName(slam::OdometrySource s) {
@@ -109,20 +97,6 @@ class Progress {
   Clock::time_point start_, next_;
 };
 
-std::string CloudsCsv(const std::vector<slam::ParticleCloud>& clouds) {
-  std::string out = "# time_s,particle,x_m,y_m,yaw_rad,weight\n";
-  char line[160];
-  for (const slam::ParticleCloud& c : clouds) {
-    for (std::size_t i = 0; i < c.particles.size(); ++i) {
-      const slam::Particle& p = c.particles[i];
-      std::snprintf(line, sizeof(line), "%.9f,%zu,%.6f,%.6f,%.6f,%.9g\n", c.time.seconds(), i,
-                    p.pose.x(), p.pose.y(), p.pose.theta(), p.weight);
-      out += line;
-    }
-  }
-  return out;
-}
-
 void WriteMapScore(slam::JsonWriter& json, const std::string& key, const slam::MapScore& s) {
   json.BeginObject(key)
       .Integer("estimate_occupied", s.estimate_occupied)
@@ -134,64 +108,72 @@ void WriteMapScore(slam::JsonWriter& json, const std::string& key, const slam::M
       .EndObject();
 }
 
-void WritePfConfig(slam::JsonWriter& json, const slam::ParticleFilterOptions& pf) {
-  json.BeginObject("pf")
-      .Integer("num_particles", pf.num_particles)
-      .Integer("seed", static_cast<long long>(pf.seed))
-      .String("motion_noise", pf.motion_noise == slam::MotionNoiseModel::kRotTransRot
-                                  ? "rot_trans_rot"
-                                  : "gaussian")
-      .Number("sigma_xy_m", pf.sigma_xy_m)
-      .Number("sigma_yaw_rad", pf.sigma_yaw_rad)
-      .Number("alpha1", pf.rot_trans_rot.alpha1)
-      .Number("alpha2", pf.rot_trans_rot.alpha2)
-      .Number("alpha3", pf.rot_trans_rot.alpha3)
-      .Number("alpha4", pf.rot_trans_rot.alpha4)
-      .String("observation", pf.observation == slam::ObservationModel::kLikelihoodField
-                                 ? "likelihood_field"
-                                 : "correlation")
-      .Integer("xy_half_width_cells", pf.correlation.xy_half_width_cells)
-      .Integer("yaw_half_steps", pf.correlation.yaw_half_steps)
-      .Number("yaw_step_rad", pf.correlation.yaw_step_rad)
-      .Number("likelihood_sigma_m", pf.likelihood_field.sigma_m)
-      .Number("observation_scale", pf.observation_scale)
-      .Integer("beam_stride", pf.points.beam_stride)
-      .Number("voxel_size_m", pf.points.voxel_size_m)
-      .Bool("move_to_best_shift", pf.move_to_best_shift)
-      .Bool("refine", pf.refine)
-      .String("resampling",
-              pf.resampling == slam::ResamplingScheme::kSystematic ? "systematic" : "stratified")
-      .Number("resample_neff_ratio", pf.resample_neff_ratio)
-      .Integer("threads", pf.num_threads)
-      .EndObject();
+std::string CloudLines(double time_s, const slam::EstimatorView& view) {
+  std::string out;
+  char line[160];
+  for (std::size_t i = 0; i < view.particles.size(); ++i) {
+    const slam::WeightedPose& p = view.particles[i];
+    std::snprintf(line, sizeof(line), "%.9f,%zu,%.6f,%.6f,%.6f,%.9g\n", time_s, i, p.pose.x(),
+                  p.pose.y(), p.pose.theta(), p.weight);
+    out += line;
+  }
+  return out;
+}
+
+// The configuration the command line asks for: an algorithm, its preset, and field values from
+// the shorthand flags and --set, read by the algorithm's own field table (so a key it does not
+// have is an error naming the flag).
+slam::EstimatorConfig ConfigFromFlags(
+    const std::string& algorithm, const std::string& preset,
+    const std::vector<std::pair<std::string, std::string>>& fields, const std::string& odometry,
+    bool no_gyro) {
+  std::string yaml = "algorithm: " + algorithm + "\n";
+  if (!preset.empty()) yaml += "preset: " + preset + "\n";
+  YamlNode node = YamlNode::LoadString(yaml, "slamrig slam");
+  for (const auto& [key, origin] : fields) {
+    const std::size_t eq = key.find('=');
+    if (eq == std::string::npos || eq == 0) throw ConfigError(origin + ": expected KEY=VALUE");
+    node.Override(key.substr(0, eq), key.substr(eq + 1), origin);
+  }
+  node.Override("odometry.source", odometry, "--odometry " + odometry);
+  if (no_gyro) node.Override("odometry.use_gyro", "false", "--no-gyro");
+  slam::EstimatorConfig config = slam::ParseEstimatorConfig(algorithm, node);
+  node.CheckAllKeysUsed();
+  return config;
 }
 
 }  // namespace
 
 int RunSlamCommand(const std::vector<std::string>& args) {
-  std::string log_path, out_dir, algorithm = "pf", preset = "default", odometry = "auto";
-  std::string truth_map_path;
-  int particles = 100, threads = 1, clouds = 0, max_scans = 0;
+  std::string log_path, out_dir, algorithm = "pf", preset, odometry = "auto";
+  std::string truth_map_path, particles, threads, resolution;
+  std::vector<std::string> sets;
+  int clouds = 0, max_scans = 0;
   std::uint64_t seed = 1;
-  double resolution = 0.05;
   bool no_gyro = false, lenient = false, quiet = false;
   ArgParser parser(
       "slamrig slam", "LOG --out DIR [options]",
-      "Runs dead reckoning or particle-filter SLAM on a log and writes, into DIR:\n"
-      "trajectory.tum (one pose per scan, stamped with the scan time), map.pgm +\n"
-      "map.yaml (ROS map_server), map.png (with the reference trajectory when the log\n"
-      "has one) and metrics.json (ATE/RPE against the reference, timing, settings).\n"
+      "Runs one estimator on a log and writes, into DIR: trajectory.tum (one pose per scan,\n"
+      "stamped with the scan's own time; the final trajectory, revised where the estimator\n"
+      "revises its past), map.pgm + map.yaml (ROS map_server), map.png (with the reference\n"
+      "trajectory when the log has one) and metrics.json (ATE/RPE against the reference,\n"
+      "dead reckoning alongside, timing, statistics, the resolved configuration).\n"
       "LOG is a CARMEN log (plain or .gz; real, or written by `slamrig simulate`) or an\n"
-      "ECE276A dataset (DIR/20, or one of its Encoders/Imu/Hokuyo files).");
+      "ECE276A dataset (DIR/20, or one of its Encoders/Imu/Hokuyo files).\n"
+      "Algorithms: " +
+          slam::AlgorithmNames());
   parser.AddPositional("LOG", "log path; a path, or relative to SLAMRIG_DATA_DIR", &log_path);
   parser.AddOption("out", "DIR", "output folder (created)", &out_dir);
-  parser.AddOption("algorithm", "NAME", "pf or dead-reckoning", &algorithm);
-  parser.AddOption("preset", "NAME",
-                   "pf settings: default (the improved filter) or reports (ECE276A)", &preset);
-  parser.AddOption("particles", "N", "number of particles", &particles);
+  parser.AddOption("algorithm", "NAME", slam::AlgorithmNames(), &algorithm);
+  parser.AddOption("preset", "NAME", "the algorithm's preset (pf: default or reports)", &preset);
+  parser.AddRepeated("set", "KEY=VALUE",
+                     "set a field of the algorithm, as in a scenario's slam: entry "
+                     "(particles=30, map.resolution_m=0.1, correlation.yaw_half_steps=2)",
+                     &sets);
+  parser.AddOption("particles", "N", "shorthand for --set particles=N", &particles);
+  parser.AddOption("threads", "N", "shorthand for --set threads=N", &threads);
+  parser.AddOption("resolution", "M", "shorthand for --set map.resolution_m=M", &resolution);
   parser.AddOption("seed", "N", "random seed (same seed, same result)", &seed);
-  parser.AddOption("threads", "N", "worker threads for the particle scoring", &threads);
-  parser.AddOption("resolution", "M", "map cell size in metres", &resolution);
   parser.AddOption("odometry", "SOURCE", "auto, wheel_ticks, poses or none", &odometry);
   parser.AddFlag("no-gyro", "yaw from the wheel encoders even when the log has a gyro", &no_gyro);
   parser.AddOption("clouds", "N",
@@ -205,56 +187,27 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   parser.AddFlag("quiet", "no progress output", &quiet);
   if (!parser.Parse(args)) return 0;
   if (out_dir.empty()) throw ConfigError("slamrig slam: --out DIR is required");
-  if (algorithm != "pf" && algorithm != "dead-reckoning") {
-    throw ConfigError("slamrig slam: --algorithm: expected pf or dead-reckoning, got '" +
-                      algorithm + "'");
-  }
-  if (preset != "default" && preset != "reports") {
-    throw ConfigError("slamrig slam: --preset: expected default or reports, got '" + preset + "'");
-  }
   if (max_scans < 0)
     throw ConfigError("slamrig slam: --max-scans = " + std::to_string(max_scans) +
                       "; must be >= 0");
-  slam::ParticleFilterOptions pf = preset == "reports"
-                                       ? slam::ParticleFilterOptions::ReportsPreset()
-                                       : slam::ParticleFilterOptions{};
-  pf.num_particles = particles;
-  pf.seed = seed;
-  pf.num_threads = threads;
-  pf.map.resolution_m = resolution;
-  pf.cloud_every_n_scans = clouds;
-  for (const std::string& e : pf.Validate()) throw ConfigError("slamrig slam: " + e);
-  slam::ScanSyncOptions sync;
-  sync.use_gyro = !no_gyro;
-  const std::map<std::string, slam::OdometrySource> sources = {
-      {"auto", slam::OdometrySource::kAuto},
-      {"wheel_ticks", slam::OdometrySource::kWheelTicks},
-      {"poses", slam::OdometrySource::kOdometryPoses},
-      {"none", slam::OdometrySource::kNone}};
-  if (!sources.count(odometry)) {
-    throw ConfigError("slamrig slam: --odometry: expected auto, wheel_ticks, poses or none, got '" +
-                      odometry + "'");
-  }
-  sync.source = sources.at(odometry);
+  if (clouds < 0)
+    throw ConfigError("slamrig slam: --clouds = " + std::to_string(clouds) + "; must be >= 0");
+  std::vector<std::pair<std::string, std::string>> fields;
+  if (!particles.empty()) fields.push_back({"particles=" + particles, "--particles " + particles});
+  if (!threads.empty()) fields.push_back({"threads=" + threads, "--threads " + threads});
+  if (!resolution.empty())
+    fields.push_back({"map.resolution_m=" + resolution, "--resolution " + resolution});
+  for (const std::string& s : sets) fields.push_back({s, "--set " + s});
+  const slam::EstimatorConfig base = ConfigFromFlags(algorithm, preset, fields, odometry, no_gyro);
 
   // Read and run everything before creating any output, so bad input leaves nothing behind.
-  std::string path = ResolveDataPath(log_path);
-  // An ECE276A dataset named by folder and number ("ece276a_pr2_partial/20") is no file itself.
-  if (!std::filesystem::exists(path) && !slam::LooksLikeEce276a(path) &&
-      slam::LooksLikeEce276a((std::filesystem::path(DataDir()) / log_path).string())) {
-    path = (std::filesystem::path(DataDir()) / log_path).string();
-  }
-  std::string kind;
-  const slam::Dataset data = LoadLog(path, lenient, &kind);
-  slam::ScanSyncResult synced = slam::SyncToScans(data.records, sync);
-  if (max_scans > 0 && synced.scans.size() > static_cast<std::size_t>(max_scans)) {
-    synced.scans.resize(static_cast<std::size_t>(max_scans));
-  }
+  slam::LogReadOptions read;
+  read.lenient = lenient;
+  const std::string path = slam::ResolveLogPath(log_path);
+  const slam::Dataset data = slam::ReadLog(path, read);
+  slam::EstimatorConfig config = base;
   Trajectory reference;
-  for (const GroundTruthPose& g : data.reference) {
-    if (reference.empty() || reference.poses().back().time <= g.time)
-      reference.Append(g.time, g.map_from_base);
-  }
+  for (const GroundTruthPose& g : data.reference) reference.Append(g.time, g.map_from_base);
   const std::string log_name = std::filesystem::path(path).filename().string();
   std::optional<slam::OccupancyGrid> truth_map;
   if (!truth_map_path.empty()) {
@@ -263,53 +216,98 @@ int RunSlamCommand(const std::vector<std::string>& args) {
     }
     truth_map = slam::GridFromMapImage(slam::ReadMapServerMap(truth_map_path));
   }
+  const bool has_scans = std::any_of(data.records.begin(), data.records.end(), [](const Record& r) {
+    return std::holds_alternative<LaserScan>(r);
+  });
 
-  slam::SlamRunResult run;
+  slam::RunLimits limits;
+  limits.max_scans = static_cast<std::size_t>(max_scans);
   slam::RunTiming timing;
   const auto start = Clock::now();
   Progress progress(!quiet);
+  std::size_t total_scans = 0;
+  for (const Record& r : data.records) total_scans += std::holds_alternative<LaserScan>(r);
+  if (limits.max_scans > 0) total_scans = std::min(total_scans, limits.max_scans);
+  std::string cloud_csv;
+  if (clouds > 0) cloud_csv = "# time_s,particle,x_m,y_m,yaw_rad,weight\n";
+  slam::EstimatorRun run;
   bool encoder_only = false;
-  if (synced.scans.empty()) {
-    if (algorithm == "pf")
-      throw ParseError(path + ": no laser scans; the particle filter needs them");
-    run.trajectory = EncoderDeadReckoning(data.records, sync);
-    if (run.trajectory.empty())
-      throw ParseError(path + ": no laser scans and no wheel encoder records");
-    run.mean_trajectory = run.trajectory;
+  if (!has_scans) {
+    // Logs without a lidar (the shared ECE276A data): the encoders' (and gyro's) own trajectory,
+    // one pose per encoder record. Only dead reckoning can run on that.
+    if (config.algorithm != "dead-reckoning")
+      throw ParseError(path + ": no laser scans; " + config.algorithm +
+                       " needs them (only "
+                       "dead-reckoning runs on encoder records alone)");
+    run.name = config.name;
+    run.algorithm = config.algorithm;
+    run.final = run.online = EncoderDeadReckoning(data.records, config.odometry);
+    if (run.final.empty()) throw ParseError(path + ": no laser scans and no wheel encoder records");
+    run.odometry_source = slam::OdometrySource::kWheelTicks;
     encoder_only = true;
-  } else if (algorithm == "pf") {
-    run = slam::RunParticleFilter(synced.scans, pf,
-                                  [&](std::size_t d, std::size_t t) { progress(d, t); });
   } else {
-    run = slam::RunDeadReckoning(synced.scans, pf.map,
-                                 [&](std::size_t d, std::size_t t) { progress(d, t); });
+    const slam::OdometrySource source =
+        slam::ResolveOdometrySource(data.records, config.odometry.source);
+    slam::EstimatorRunner runner(config, source, seed);
+    runner.SetScanCallback(
+        [&](std::size_t i, const slam::SyncedScan& s, const slam::ScanEstimate&) {
+          progress(i + 1, total_scans);
+          if (clouds > 0 && i % static_cast<std::size_t>(clouds) == 0) {
+            cloud_csv += CloudLines(s.scan.time.seconds(), runner.estimator().View());
+          }
+        });
+    std::size_t scans = 0;
+    for (const Record& r : data.records) {
+      if (std::holds_alternative<LaserScan>(r) && limits.max_scans > 0 &&
+          ++scans > limits.max_scans)
+        break;
+      runner.Add(r);
+    }
+    runner.Finish();
+    run = runner.TakeResult();
   }
   timing.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
-  timing.scans = static_cast<int>(synced.scans.size());
-  if (run.trajectory.size() >= 2) {
-    timing.data_s =
-        SecondsBetween(run.trajectory.poses().back().time, run.trajectory.poses().front().time);
+  timing.scans = static_cast<int>(encoder_only ? 0 : run.final.size());
+  if (run.final.size() >= 2) {
+    Time first = run.final[0].time, last = run.final[0].time;
+    for (const StampedPose& p : run.final.poses()) {
+      first = std::min(first, p.time);
+      last = std::max(last, p.time);
+    }
+    timing.data_s = SecondsBetween(last, first);
   }
 
-  // Scores against the reference, with dead reckoning alongside for comparison.
-  std::optional<slam::TrajectoryMetrics> metrics, mean_metrics, dr_metrics;
+  // Scores against the reference (pose k with reference pose k: the same scans), with dead
+  // reckoning alongside for comparison.
+  std::optional<slam::TrajectoryMetrics> metrics, mean_metrics, online_metrics, dr_metrics;
   if (!reference.empty()) {
-    metrics = slam::EvaluateTrajectory(run.trajectory, reference);
-    if (algorithm == "pf") {
-      mean_metrics = slam::EvaluateTrajectory(run.mean_trajectory, reference);
-      const slam::SlamRunResult dr = slam::RunDeadReckoning(synced.scans, pf.map);
-      dr_metrics = slam::EvaluateTrajectory(dr.trajectory, reference);
+    if (!encoder_only && reference.size() > run.final.size()) {
+      std::vector<StampedPose> head(reference.poses().begin(),
+                                    reference.poses().begin() + run.final.size());
+      reference = Trajectory(std::move(head));
+    }
+    metrics = slam::EvaluateTrajectory(run.final, reference);
+    if (!run.mean.empty()) mean_metrics = slam::EvaluateTrajectory(run.mean, reference);
+    if (run.final.poses() != run.online.poses())
+      online_metrics = slam::EvaluateTrajectory(run.online, reference);
+    if (config.algorithm != "dead-reckoning" && !encoder_only) {
+      slam::EstimatorConfig dr = slam::DefaultEstimatorConfig("dead_reckoning", "dead-reckoning");
+      dr.odometry = config.odometry;
+      dr_metrics = slam::EvaluateTrajectory(
+          slam::RunEstimator(dr, data.records, seed, limits).final, reference);
     }
   }
   // Map scores: against the same scans inserted at the reference poses, and against the true
   // world's map when given, both in the reference frame through the ATE alignment.
   std::optional<slam::MapScore> map_vs_reference, map_vs_truth;
   if (metrics && !encoder_only) {
-    slam::OccupancyGrid reference_map(pf.map);
-    for (const slam::SyncedScan& s : synced.scans) {
-      if (const std::optional<Pose2> p = reference.Interpolate(s.scan.time)) {
-        reference_map.InsertScan(s.scan, *p);
-      }
+    slam::OccupancyGrid reference_map(run.map.options());
+    std::size_t k = 0;
+    for (const Record& r : data.records) {
+      const auto* scan = std::get_if<LaserScan>(&r);
+      if (scan == nullptr) continue;
+      if (k >= reference.size()) break;
+      reference_map.InsertScan(*scan, reference[k++].pose);
     }
     map_vs_reference = slam::ScoreMap(run.map, metrics->ate.reference_from_estimate, reference_map);
     if (truth_map) {
@@ -319,10 +317,11 @@ int RunSlamCommand(const std::vector<std::string>& args) {
 
   std::filesystem::create_directories(out_dir);
   const std::string dir = out_dir + "/";
-  slam::WriteTum(dir + "trajectory.tum", run.trajectory);
-  if (algorithm == "pf") slam::WriteTum(dir + "trajectory_mean.tum", run.mean_trajectory);
+  slam::WriteTum(dir + "trajectory.tum", run.final);
+  if (!run.mean.empty()) slam::WriteTum(dir + "trajectory_mean.tum", run.mean);
+  if (online_metrics) slam::WriteTum(dir + "trajectory_online.tum", run.online);
   if (!reference.empty()) slam::WriteTum(dir + "reference.tum", reference);
-  if (!run.clouds.empty()) slam::WriteFileAtomically(dir + "particles.csv", CloudsCsv(run.clouds));
+  if (clouds > 0) slam::WriteFileAtomically(dir + "particles.csv", cloud_csv);
   if (!encoder_only) {
     slam::WriteMapServerMap(run.map, dir + "map");
     // The reference drawn in the estimator's frame: the inverse of the ATE alignment.
@@ -337,32 +336,32 @@ int RunSlamCommand(const std::vector<std::string>& args) {
       overlays.push_back({&reference_in_map,
                           data.reference_kind.empty() ? "reference" : data.reference_kind, 40, 160,
                           40});
-    overlays.push_back({&run.trajectory,
-                        algorithm == "pf" ? "particle filter (best particle)" : "dead reckoning",
-                        200, 60, 0});
+    overlays.push_back({&run.final, config.algorithm, 200, 60, 0});
     slam::MapImageOptions image_options;
-    image_options.title = log_name + ": " + algorithm;
+    image_options.title = log_name + ": " + config.algorithm;
     slam::WriteMapPng(dir + "map.png", run.map, overlays, image_options);
   }
 
   slam::JsonWriter json;
-  json.String("log", path).String("log_format", kind).String("algorithm", algorithm);
-  if (algorithm == "pf") json.String("preset", preset);
+  json.String("log", path).String("log_format", data.format).String("algorithm", config.algorithm);
   json.String("odometry_source", encoder_only ? "wheel_ticks (encoder records, no scans)"
-                                              : SourceName(synced.source_used))
+                                              : SourceName(run.odometry_source))
+      .Integer("seed", static_cast<long long>(seed))
       .Integer("scans", timing.scans)
-      .Integer("poses", static_cast<long long>(run.trajectory.size()))
+      .Integer("poses", static_cast<long long>(run.final.size()))
       .Number("wall_time_s", timing.wall_s)
       .Number("data_time_s", timing.data_s)
       .Number("real_time_factor", timing.RealTimeFactor())
       .Number("ms_per_scan", timing.MillisecondsPerScan())
-      .Integer("gyro_fallbacks", synced.gyro_fallbacks)
-      .Integer("scans_without_odometry", synced.scans_without_odometry)
-      .Integer("reordered_stamps", run.reordered_stamps);
-  if (algorithm == "pf") {
-    json.Integer("resamples", run.resamples).Number("mean_neff", run.mean_neff);
-    WritePfConfig(json, pf);
-  }
+      .Integer("gyro_fallbacks", run.gyro_fallbacks)
+      .Integer("scans_without_odometry", run.scans_without_odometry)
+      .Integer("out_of_order_stamps", run.final.out_of_order());
+  json.BeginObject("statistics");
+  for (const auto& [name, value] : run.statistics) json.Number(name, value);
+  json.EndObject();
+  json.BeginObject("config");
+  slam::WriteEstimatorConfigJson(config, &json);
+  json.EndObject();
   json.BeginObject("map")
       .Number("resolution_m", run.map.resolution())
       .Integer("width", run.map.width())
@@ -373,6 +372,11 @@ int RunSlamCommand(const std::vector<std::string>& args) {
     json.BeginObject("trajectory");
     slam::WriteTrajectoryMetrics(json, *metrics);
     json.EndObject();
+    if (online_metrics) {
+      json.BeginObject("online_trajectory");
+      slam::WriteTrajectoryMetrics(json, *online_metrics);
+      json.EndObject();
+    }
     if (mean_metrics) {
       json.BeginObject("mean_trajectory");
       slam::WriteTrajectoryMetrics(json, *mean_metrics);
@@ -386,12 +390,18 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   }
   if (map_vs_reference) WriteMapScore(json, "map_vs_reference", *map_vs_reference);
   if (map_vs_truth) WriteMapScore(json, "map_vs_truth", *map_vs_truth);
-  json.StringArray("notes", data.notes);
+  std::vector<std::string> notes = data.notes;
+  if (run.final.out_of_order() > 0) {
+    notes.push_back(std::to_string(run.final.out_of_order()) +
+                    " poses are stamped earlier than the one before them (the log's own scan "
+                    "stamps); kept in scan order");
+  }
+  json.StringArray("notes", notes);
   slam::WriteFileAtomically(dir + "metrics.json", json.Finish());
 
   std::string line =
-      log_name + ": " + algorithm + " on " +
-      (encoder_only ? std::to_string(run.trajectory.size()) + " encoder records (no scans)"
+      log_name + ": " + config.algorithm + " on " +
+      (encoder_only ? std::to_string(run.final.size()) + " encoder records (no scans)"
                     : std::to_string(timing.scans) + " scans") +
       " in " + Fixed(timing.wall_s, 2) + " s";
   if (!encoder_only) line += " (" + Fixed(timing.RealTimeFactor(), 1) + "x real time)";
@@ -403,7 +413,7 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   }
   line += " -> " + out_dir;
   std::puts(line.c_str());
-  for (const std::string& note : data.notes) std::printf("  note: %s\n", note.c_str());
+  for (const std::string& note : notes) std::printf("  note: %s\n", note.c_str());
   return 0;
 }
 

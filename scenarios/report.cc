@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -6,6 +7,7 @@
 #include "scenarios/plot.h"
 #include "scenarios/scenario_result.h"
 #include "slam/eval/json_writer.h"
+#include "slam/eval/pose_association.h"
 #include "slam/io/atomic_file.h"
 #include "slam/io/map_image.h"
 #include "slam/io/map_server.h"
@@ -43,23 +45,35 @@ std::string Html(const std::string& s) {
   return out;
 }
 
-// Position and heading error of `estimate` against `truth` at each estimate time.
+// Position and heading error of `estimate` against `truth`, pose for pose as evaluation pairs
+// them, over time since the first reference pose.
 void ErrorsOverTime(const Trajectory& estimate, const Trajectory& truth, std::vector<double>* t,
                     std::vector<double>* position, std::vector<double>* heading) {
   const double t0 = truth.empty() ? 0.0 : truth[0].time.seconds();
-  for (const StampedPose& p : estimate.poses()) {
-    const auto ref = truth.Interpolate(p.time);
-    if (!ref) continue;
+  for (const slam::PosePair& p : slam::AssociatePoses(estimate, truth)) {
     t->push_back(p.time.seconds() - t0);
-    position->push_back((ref->translation() - p.pose.translation()).norm());
-    heading->push_back(std::abs(NormalizeAngle(ref->theta() - p.pose.theta())));
+    position->push_back((p.reference.translation() - p.estimate.translation()).norm());
+    heading->push_back(std::abs(NormalizeAngle(p.reference.theta() - p.estimate.theta())));
   }
+}
+
+// Every metric any configuration has, KnownMetrics() first, in a stable order.
+std::vector<std::string> AllMetrics(const ScenarioResult& r) {
+  std::vector<std::string> names = KnownMetrics();
+  for (const ConfigResult& c : r.configs) {
+    for (const auto& [name, value] : c.metrics) {
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    }
+  }
+  return names;
 }
 
 std::string MetricsJson(const ScenarioResult& r) {
   slam::JsonWriter j;
   j.String("scenario", r.spec->name)
-      .Integer("seed", static_cast<long long>(r.spec->sim.seed))
+      .Integer("seed", static_cast<long long>(r.spec->seed))
+      .String("source", r.spec->simulated ? "simulation" : r.spec->log->path)
+      .String("reference", r.reference_kind)
       .Bool("passed", r.passed)
       .Number("sim_time_s", r.sim_time_s)
       .Integer("scans", r.scans)
@@ -69,6 +83,11 @@ std::string MetricsJson(const ScenarioResult& r) {
   for (const ConfigResult& c : r.configs) {
     j.BeginObject(c.name);
     for (const auto& [name, value] : c.metrics) j.Number(name, value);
+    j.BeginObject("config");
+    for (const slam::EstimatorConfig& config : r.spec->configs) {
+      if (config.name == c.name) slam::WriteEstimatorConfigJson(config, &j);
+    }
+    j.EndObject();
     j.EndObject();
   }
   j.EndObject();
@@ -82,6 +101,7 @@ std::string MetricsJson(const ScenarioResult& r) {
         .EndObject();
   }
   j.EndObject();
+  j.StringArray("notes", r.notes);
   return j.Finish();
 }
 
@@ -153,30 +173,31 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
   slam::WriteTum(file("truth.tum"), r.truth);
 
   // Trajectories and maps.
-  std::vector<slam::TrajectoryOverlay> overlays = {{&r.truth, "ground truth", 40, 160, 40}};
+  std::vector<slam::TrajectoryOverlay> overlays = {{&r.truth, r.reference_kind, 40, 160, 40}};
   for (std::size_t i = 0; i < r.configs.size(); ++i) {
     const ConfigResult& c = r.configs[i];
     slam::WriteTum(file(c.name + ".tum"), c.estimate);
+    // An estimator that revised its past: what it reported online, too.
+    if (c.run.final.poses() != c.run.online.poses()) {
+      slam::WriteTum(file(c.name + "_online.tum"), c.online);
+    }
     const Colour colour = PaletteColour(i == 2 ? 4 : i);  // skip palette green (the truth's)
     overlays.push_back({&c.estimate, c.name, colour.b, colour.g, colour.r});
-    if (c.map) slam::WriteMapServerMap(*c.map, file(c.name + "_map"));
+    slam::WriteMapServerMap(c.run.map, file(c.name + "_map"));
   }
   // The map picture: the truth map (true poses, same scans) under every trajectory.
   const slam::OccupancyGrid* background = r.truth_map ? &*r.truth_map : nullptr;
-  for (const ConfigResult& c : r.configs) {
-    if (!background && c.map) background = &*c.map;
-  }
+  if (!background && !r.configs.empty()) background = &r.configs.front().run.map;
+  const std::string truth_source = r.spec->simulated ? "true poses" : r.reference_kind;
   std::string html_maps;
   if (background) {
     slam::MapImageOptions options;
-    options.title = r.spec->name + ": map from true poses, trajectories overlaid";
+    options.title = r.spec->name + ": map from " + truth_source + ", trajectories overlaid";
     slam::WriteMapPng(file("map.png"), *background, overlays, options);
-    html_maps +=
-        "<figure><img src=\"map.png\"><figcaption>Ground-truth map with the true and estimated "
-        "trajectories.</figcaption></figure>";
+    html_maps += "<figure><img src=\"map.png\"><figcaption>The map from the " + Html(truth_source) +
+                 " with the reference and estimated trajectories.</figcaption></figure>";
     for (std::size_t i = 0; i < r.configs.size(); ++i) {
       const ConfigResult& c = r.configs[i];
-      if (!c.map) continue;
       // The estimator's map is in its own frame: bring both trajectories there.
       const Pose2 estimator_from_map = c.map_from_estimator.Inverse();
       Trajectory truth_local, estimate_local;
@@ -188,7 +209,8 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
       estimate_overlay.trajectory = &estimate_local;
       slam::MapImageOptions own;
       own.title = c.name + ": its own map and trajectory";
-      slam::WriteMapPng(file(c.name + "_map.png"), *c.map, {truth_overlay, estimate_overlay}, own);
+      slam::WriteMapPng(file(c.name + "_map.png"), c.run.map, {truth_overlay, estimate_overlay},
+                        own);
       html_maps += "<figure><img src=\"" + c.name + "_map.png\"><figcaption>" + Html(c.name) +
                    "'s map with its trajectory (and the truth, in green).</figcaption></figure>";
     }
@@ -218,17 +240,23 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
       "<figure><img src=\"position_error.png\"></figure><figure><img "
       "src=\"heading_error.png\"></figure>";
 
-  std::vector<PlotSeries> neff;
+  // Every per-scan trace the estimators report (a PF's Neff, ...), one plot per name.
+  std::map<std::string, std::vector<PlotSeries>> traces;
+  const double t0 = r.truth.empty() ? 0.0 : r.truth[0].time.seconds();
   for (std::size_t i = 0; i < r.configs.size(); ++i) {
     const ConfigResult& c = r.configs[i];
-    if (c.neff.empty()) continue;
-    neff.push_back({c.name, c.neff_time_s, c.neff, {}, {}, PaletteColour(i == 2 ? 4 : i)});
+    std::vector<double> t = c.run.trace_time_s;
+    for (double& v : t) v -= t0;
+    for (const auto& [name, values] : c.run.traces) {
+      traces[name].push_back({c.name, t, values, {}, {}, PaletteColour(i == 2 ? 4 : i)});
+    }
   }
-  if (!neff.empty()) {
-    options.title = "Effective sample size Neff = 1 / sum(w^2) after each scan";
-    options.y_label = "Neff";
-    slam::WriteFileAtomically(file("neff.png"), RenderLinePlotPng(neff, options));
-    html_plots += "<figure><img src=\"neff.png\"></figure>";
+  for (const auto& [name, series] : traces) {
+    options.title = name == "neff" ? "Effective sample size Neff = 1 / sum(w^2) after each scan"
+                                   : name + " after each scan";
+    options.y_label = name == "neff" ? "Neff" : name;
+    slam::WriteFileAtomically(file(name + ".png"), RenderLinePlotPng(series, options));
+    html_plots += "<figure><img src=\"" + name + ".png\"></figure>";
   }
 
   // Metrics side by side.
@@ -263,8 +291,9 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
        ".fail{color:#c00;font-weight:bold}</style></head><body>";
   h << "<h1>" << Html(r.spec->name) << " <span class=\""
     << (r.passed ? "pass\">PASS" : "fail\">FAIL") << "</span></h1><p>" << Html(r.spec->description)
-    << "</p><p>Seed " << r.spec->sim.seed << ", " << Number(r.sim_time_s, "%.1f")
-    << " s simulated, " << r.scans << " scans";
+    << "</p><p>Seed " << r.spec->seed << ", " << Number(r.sim_time_s, "%.1f")
+    << (r.spec->simulated ? " s simulated, " : " s of " + Html(r.spec->log->path) + ", ") << r.scans
+    << " scans";
   if (r.scans_blacked_out) h << " (" << r.scans_blacked_out << " blacked out)";
   if (r.kidnaps_done) h << ", " << r.kidnaps_done << " kidnapping(s)";
   h << ". Files: <a href=\"config.yaml\">config.yaml</a>, <a "
@@ -283,7 +312,7 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
   h << "</table><h2>Metrics</h2><table><tr><th>metric</th>";
   for (const auto& c : r.configs) h << "<th>" << Html(c.name) << "</th>";
   h << "</tr>";
-  for (const std::string& m : KnownMetrics()) {
+  for (const std::string& m : AllMetrics(r)) {
     h << "<tr><td>" << m << "</td>";
     for (const auto& c : r.configs) {
       const auto it = c.metrics.find(m);
@@ -291,8 +320,13 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
     }
     h << "</tr>";
   }
-  h << "</table><h2>Maps</h2>" << html_maps << "<h2>Errors</h2>" << html_plots
-    << "</body></html>\n";
+  h << "</table>";
+  if (!r.notes.empty()) {
+    h << "<h2>Notes</h2><ul>";
+    for (const std::string& note : r.notes) h << "<li>" << Html(note) << "</li>";
+    h << "</ul>";
+  }
+  h << "<h2>Maps</h2>" << html_maps << "<h2>Errors</h2>" << html_plots << "</body></html>\n";
   slam::WriteFileAtomically(file("metrics.json"), MetricsJson(r));
   slam::WriteFileAtomically(file("report.html"), h.str());
 }

@@ -7,21 +7,22 @@
 
 #include "scenarios/scenario_spec.h"
 #include "slam/grid/occupancy_grid.h"
+#include "slam/pipeline/estimator_runner.h"
 #include "slam/types/trajectory.h"
 
 namespace slamrig::scenario {
 
-/// What one SLAM configuration produced in a scenario run, and its scores.
+/// What one SLAM configuration produced in a scenario run, and its scores. Trajectories are
+/// in the reference's frame: the estimator's frame placed at the reference pose of its first scan.
 struct ConfigResult {
   std::string name;
-  SlamAlgorithm algorithm = SlamAlgorithm::kParticleFilter;
-  Trajectory estimate;       ///< one pose per processed scan, map frame aligned to truth at t0
-  Trajectory mean_estimate;  ///< weighted-mean particle (PF), else equal to `estimate`
-  std::optional<slam::OccupancyGrid> map;  ///< in the estimator's own frame (its first scan)
-  Pose2 map_from_estimator;                ///< the true pose at the estimator's first scan
-  std::vector<double> neff_time_s;         ///< PF: Neff after each scan (times in seconds)
-  std::vector<double> neff;
-  std::map<std::string, double> metrics;  ///< KnownMetrics() names; NaN when not applicable
+  std::string algorithm;
+  Trajectory estimate;  ///< the final trajectory (revised where the estimator revises its past)
+  Trajectory online;    ///< the poses the estimator reported as it ran
+  Trajectory mean_estimate;  ///< the estimator's second estimate (a PF's mean), else empty
+  slam::EstimatorRun run;    ///< everything it produced, in its own frame (map, traces, stats)
+  Pose2 map_from_estimator;  ///< the reference pose at the estimator's first scan
+  std::map<std::string, double> metrics;  ///< MetricsOf() names; NaN when not applicable
 };
 
 /// One checked expectation.
@@ -35,13 +36,19 @@ struct ExpectationOutcome {
 /// A finished scenario run.
 struct ScenarioResult {
   const ScenarioSpec* spec = nullptr;
-  Trajectory truth;  ///< true pose at every lidar scan time (including dropped scans)
-  std::optional<slam::OccupancyGrid> truth_map;  ///< true poses, noise-free ranges
+  /// The reference: the true pose at every lidar scan time (including dropped scans) of a
+  /// simulation, or a log's own reference (corrected poses, TRUEPOS); empty when it has none.
+  Trajectory truth;
+  std::string reference_kind = "ground truth";  ///< what `truth` is, for legends
+  /// The map to score against: true poses and noise-free ranges (simulation), or the log's
+  /// scans inserted at its reference poses.
+  std::optional<slam::OccupancyGrid> truth_map;
   std::vector<ConfigResult> configs;
-  double sim_time_s = 0.0;
-  int scans = 0;              ///< scans the lidar produced
+  double sim_time_s = 0.0;    ///< simulated seconds, or the log's time span
+  int scans = 0;              ///< scans the lidar produced (or the log holds)
   int scans_blacked_out = 0;  ///< of them, withheld by lidar_blackout faults
   int kidnaps_done = 0;
+  std::vector<std::string> notes;  ///< what the source said (a log's quirks), for the user
   std::vector<ExpectationOutcome> outcomes;
   bool passed = true;
 };

@@ -1,6 +1,5 @@
 #include "scenarios/scenario_runner.h"
 
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -8,151 +7,126 @@
 #include "scenarios/live_view.h"
 #include "sim/simulator.h"
 #include "slam/eval/map_score.h"
+#include "slam/eval/pose_association.h"
+#include "slam/eval/trajectory_error.h"
 #include "slam/eval/trajectory_metrics.h"
-#include "slam/odometry/scan_sync.h"
-#include "slam/pf/particle_filter.h"
+#include "slam/pipeline/estimator_runner.h"
+#include "slam/types/error.h"
 
 namespace slamrig::scenario {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using Runners = std::vector<std::unique_ptr<slam::EstimatorRunner>>;
 
-// One SLAM configuration running alongside the simulator.
-class Estimator {
- public:
-  explicit Estimator(const SlamConfig& config)
-      : config_(config), sync_(config.sync, Resolve(config.sync.source)) {
-    result_.name = config.name;
-    result_.algorithm = config.algorithm;
-    if (config.algorithm == SlamAlgorithm::kParticleFilter) {
-      pf_ = std::make_unique<slam::ParticleFilter>(config.pf);
-    } else {
-      map_.emplace(config.map);
-    }
+Runners MakeRunners(const ScenarioSpec& spec, const std::vector<Record>* log_records) {
+  Runners runners;
+  for (const slam::EstimatorConfig& config : spec.configs) {
+    // A simulated robot always has wheel encoders; a log says what it has.
+    const slam::OdometrySource source =
+        log_records ? slam::ResolveOdometrySource(*log_records, config.odometry.source)
+        : config.odometry.source == slam::OdometrySource::kAuto ? slam::OdometrySource::kWheelTicks
+                                                                : config.odometry.source;
+    runners.push_back(std::make_unique<slam::EstimatorRunner>(config, source, spec.seed));
   }
+  return runners;
+}
 
-  // Feeds one record; `map_from_start` places the estimator's frame (its first scan's pose) in
-  // the map frame, so that trajectories start on the truth.
-  void Add(const Record& record, const std::optional<Pose2>& map_from_start) {
-    const auto start = Clock::now();
-    for (const slam::SyncedScan& s : sync_.Add(record)) Process(s, map_from_start);
-    wall_s_ += std::chrono::duration<double>(Clock::now() - start).count();
-  }
-  void Flush(const std::optional<Pose2>& map_from_start) {
-    const auto start = Clock::now();
-    for (const slam::SyncedScan& s : sync_.Flush()) Process(s, map_from_start);
-    wall_s_ += std::chrono::duration<double>(Clock::now() - start).count();
-  }
-
-  const std::string& name() const { return config_.name; }
-  bool started() const { return started_; }
-  const Pose2& map_from_start() const { return map_from_start_; }
-  bool is_particle_filter() const { return pf_ != nullptr; }
-  const Pose2& pose() const { return last_pose_; }
-  const slam::OccupancyGrid& map() const { return pf_ ? pf_->map() : *map_; }
-  std::vector<Pose2> Particles() const {
-    std::vector<Pose2> poses;
-    if (pf_) {
-      for (const auto& p : pf_->particles()) poses.push_back(map_from_start_ * p.pose);
-    }
-    return poses;
-  }
-  double wall_s() const { return wall_s_; }
-  int resamples() const { return pf_ ? pf_->resample_count() : 0; }
-
-  ConfigResult TakeResult() {
-    result_.map.emplace(map());
-    result_.map_from_estimator = map_from_start_;
-    return std::move(result_);
-  }
-
- private:
-  static slam::OdometrySource Resolve(slam::OdometrySource s) {
-    // The simulated robot always has wheel encoders.
-    return s == slam::OdometrySource::kAuto ? slam::OdometrySource::kWheelTicks : s;
-  }
-
-  void Process(const slam::SyncedScan& s, const std::optional<Pose2>& map_from_start) {
-    if (!started_) {
-      map_from_start_ = map_from_start.value_or(Pose2());
-      started_ = true;
-    }
-    Pose2 estimate, mean;
-    if (pf_) {
-      const slam::ParticleFilterStep step = pf_->AddScan(s.scan, s.increment);
-      estimate = step.best_pose;
-      mean = step.mean_pose;
-      result_.neff_time_s.push_back(s.scan.time.seconds());
-      result_.neff.push_back(step.neff);
-    } else {
-      dead_reckoning_ = dead_reckoning_ * s.increment;
-      estimate = mean = dead_reckoning_;
-      map_->InsertScan(s.scan, dead_reckoning_);
-    }
-    last_pose_ = map_from_start_ * estimate;
-    result_.estimate.Append(s.scan.time, last_pose_);
-    result_.mean_estimate.Append(s.scan.time, map_from_start_ * mean);
-  }
-
-  SlamConfig config_;
-  slam::ScanSynchronizer sync_;
-  std::unique_ptr<slam::ParticleFilter> pf_;
-  std::optional<slam::OccupancyGrid> map_;  // dead reckoning's
-  Pose2 dead_reckoning_;
-  Pose2 map_from_start_;
-  Pose2 last_pose_;
-  bool started_ = false;
-  double wall_s_ = 0.0;
-  ConfigResult result_;
-};
-
-bool InBlackout(const ScenarioSpec& spec, Time t) {
+bool InBlackout(const SimulatedSource& source, Time t) {
   const double s = t.seconds();
-  for (const BlackoutFault& b : spec.blackouts) {
+  for (const BlackoutFault& b : source.blackouts) {
     if (s >= b.from_s && s < b.to_s) return true;
   }
   return false;
 }
 
-void Score(const ScenarioResult& run, double sim_time_s, double wall_s, int resamples,
-           ConfigResult* c) {
-  auto& m = c->metrics;
-  m["scans"] = static_cast<double>(c->estimate.size());
-  m["realtime_factor"] = wall_s > 0.0 ? sim_time_s / wall_s : NAN;
-  if (c->algorithm == SlamAlgorithm::kParticleFilter) {
-    double sum = 0.0;
-    for (const double n : c->neff) sum += n;
-    m["mean_neff"] = c->neff.empty() ? NAN : sum / static_cast<double>(c->neff.size());
-    m["resamples"] = resamples;
+// The live view: the map of the first estimator that has particles (the system under test),
+// else the first one's, with every estimate and the truth.
+void ShowLive(LiveView& view, double now_s, const Runners& runners, const Pose2& map_from_start,
+              bool started, const Pose2& truth) {
+  const slam::EstimatorRunner* shown = runners.front().get();
+  std::vector<LiveEstimate> live;
+  for (const auto& r : runners) {
+    LiveEstimate e;
+    e.name = r->config().name;
+    e.has_pose = started && r->scans() > 0;
+    e.pose = map_from_start * r->pose();
+    const slam::EstimatorView extras = r->estimator().View();
+    for (const slam::WeightedPose& p : extras.particles)
+      e.particles.push_back(map_from_start * p.pose);
+    if (!extras.particles.empty() && shown->estimator().View().particles.empty()) shown = r.get();
+    live.push_back(std::move(e));
   }
-  if (c->estimate.size() < 2) return;
+  view.Update(now_s, shown->estimator().map(), map_from_start, truth, live);
+}
+
+// Scores of one configuration against the reference (NaN where there is none).
+void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
+  auto& m = c->metrics;
+  for (const std::string& name : MetricsOf(slam::DefaultEstimatorConfig(c->name, c->algorithm))) {
+    m[name] = NAN;
+  }
+  m["scans"] = static_cast<double>(c->estimate.size());
+  m["realtime_factor"] = c->run.wall_s > 0.0 ? data_time_s / c->run.wall_s : NAN;
+  for (const auto& [name, value] : c->run.statistics) m[name] = value;
+  if (c->estimate.size() < 2 || run.truth.size() < 2) return;
   const slam::TrajectoryMetrics t = slam::EvaluateTrajectory(c->estimate, run.truth);
   m["ate_rmse_m"] = t.ate.translation_m.rmse;
   m["ate_mean_m"] = t.ate.translation_m.mean;
   m["ate_median_m"] = t.ate.translation_m.median;
   m["ate_max_m"] = t.ate.translation_m.max;
   m["ate_rot_rmse_rad"] = t.ate.rotation_rad.rmse;
+  m["online_ate_rmse_m"] = slam::ComputeAte(c->online, run.truth).translation_m.rmse;
   // Means of the pairs' translation errors; NaN when the run is too short for a spacing.
   const auto mean = [](const slam::ErrorStats& s) { return s.count ? s.mean : NAN; };
   m["rpe_m_per_scan"] = mean(t.rpe_per_scan.translation_m);
   m["rpe_m_per_1m"] = mean(t.rpe_1m.translation_m);
   m["rpe_m_per_10m"] = mean(t.rpe_10m.translation_m);
   m["rpe_rad_per_10m"] = mean(t.rpe_10m.rotation_rad);
-  const StampedPose& last = c->estimate.poses().back();
-  if (const auto truth = run.truth.Interpolate(last.time)) {
-    m["final_error_m"] = (truth->translation() - last.pose.translation()).norm();
+  // The last pose against the reference at the same scan (same start pose, no alignment).
+  const std::vector<slam::PosePair> pairs = slam::AssociatePoses(c->estimate, run.truth);
+  if (!pairs.empty()) {
+    m["final_error_m"] =
+        (pairs.back().reference.translation() - pairs.back().estimate.translation()).norm();
+  }
+  if (run.truth_map) {
+    const slam::MapScore score = slam::ScoreMap(c->run.map, c->map_from_estimator, *run.truth_map);
+    m["map_f1"] = score.f1;
+    m["map_iou"] = score.iou;
+    m["map_precision"] = score.precision;
+    m["map_recall"] = score.recall;
   }
 }
 
-}  // namespace
+Trajectory InMapFrame(const Trajectory& t, const Pose2& map_from_estimator) {
+  Trajectory out;
+  for (const StampedPose& p : t.poses()) out.Append(p.time, map_from_estimator * p.pose);
+  return out;
+}
 
-ScenarioResult RunScenario(const ScenarioSpec& spec, const RunnerOptions& options) {
+void Finish(Runners& runners, const Pose2& map_from_start, double data_time_s,
+            ScenarioResult* result) {
+  for (auto& r : runners) {
+    r->Finish();
+    ConfigResult c;
+    c.name = r->config().name;
+    c.algorithm = r->config().algorithm;
+    c.run = r->TakeResult();
+    c.map_from_estimator = map_from_start;
+    c.estimate = InMapFrame(c.run.final, map_from_start);
+    c.online = InMapFrame(c.run.online, map_from_start);
+    c.mean_estimate = InMapFrame(c.run.mean, map_from_start);
+    Score(*result, data_time_s, &c);
+    result->configs.push_back(std::move(c));
+  }
+  CheckExpectations(result);
+}
+
+ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& options) {
+  const SimulatedSource& source = *spec.simulated;
   ScenarioResult result;
   result.spec = &spec;
-  sim::Simulator simulator(spec.sim);
-  std::vector<std::unique_ptr<Estimator>> estimators;
-  for (const SlamConfig& config : spec.slam)
-    estimators.push_back(std::make_unique<Estimator>(config));
+  sim::Simulator simulator(source.options);
+  Runners runners = MakeRunners(spec, nullptr);
   slam::OccupancyGrid truth_map{slam::OccupancyGridOptions{}};
   std::unique_ptr<LiveView> view;
   if (options.view) view = std::make_unique<LiveView>("slamrig: " + spec.name);
@@ -176,20 +150,20 @@ ScenarioResult RunScenario(const ScenarioSpec& spec, const RunnerOptions& option
         if (sample.true_ranges_m.size() == scan->ranges_m.size())
           truth_scan.ranges_m = sample.true_ranges_m;
         truth_map.InsertScan(truth_scan, truth);
-        if (InBlackout(spec, scan->time)) {
+        if (InBlackout(source, scan->time)) {
           ++result.scans_blacked_out;
           continue;
         }
         if (!map_from_start) map_from_start = truth;
       }
-      for (auto& e : estimators) e->Add(record, map_from_start);
+      for (auto& r : runners) r->Add(record);
     }
   };
 
   while (simulator.time() < end && !simulator.drive_finished()) {
-    if (next_kidnap < spec.kidnaps.size() &&
-        simulator.time().seconds() >= spec.kidnaps[next_kidnap].at_s) {
-      simulator.Teleport(spec.kidnaps[next_kidnap++].to);
+    if (next_kidnap < source.kidnaps.size() &&
+        simulator.time().seconds() >= source.kidnaps[next_kidnap].at_s) {
+      simulator.Teleport(source.kidnaps[next_kidnap++].to);
       ++result.kidnaps_done;
     }
     consume(simulator.Step());
@@ -198,38 +172,75 @@ ScenarioResult RunScenario(const ScenarioSpec& spec, const RunnerOptions& option
       next_progress_s = now_s + 1.0;
       if (options.progress) options.progress(now_s, spec.duration_s);
       if (view) {
-        std::vector<LiveEstimate> live;
-        // The map of the first particle filter (the system under test), else the first one's.
-        const Estimator* shown = estimators.front().get();
-        for (const auto& e : estimators) {
-          live.push_back({e->name(), e->started(), e->pose(), e->Particles()});
-          if (e->is_particle_filter() && !shown->is_particle_filter()) shown = e.get();
-        }
-        view->Update(now_s, shown->map(), shown->map_from_start(), simulator.Truth().map_from_base,
-                     live);
+        ShowLive(*view, now_s, runners, map_from_start.value_or(Pose2()),
+                 map_from_start.has_value(), simulator.Truth().map_from_base);
       }
     }
   }
   consume(simulator.Flush());
-  for (auto& e : estimators) e->Flush(map_from_start);
   result.sim_time_s = simulator.time().seconds();
   result.truth_map.emplace(std::move(truth_map));
-
-  for (auto& e : estimators) {
-    const double wall_s = e->wall_s();
-    const int resamples = e->resamples();
-    ConfigResult c = e->TakeResult();
-    Score(result, result.sim_time_s, wall_s, resamples, &c);
-    // Map scores: the estimate's map against the truth map, in the truth's frame.
-    const slam::MapScore score = slam::ScoreMap(*c.map, c.map_from_estimator, *result.truth_map);
-    c.metrics["map_f1"] = score.f1;
-    c.metrics["map_iou"] = score.iou;
-    c.metrics["map_precision"] = score.precision;
-    c.metrics["map_recall"] = score.recall;
-    result.configs.push_back(std::move(c));
-  }
-  CheckExpectations(&result);
+  Finish(runners, map_from_start.value_or(Pose2()), result.sim_time_s, &result);
   return result;
+}
+
+ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
+  const slam::Dataset data = slam::ReadLog(spec.log->path, spec.log->read);
+  ScenarioResult result;
+  result.spec = &spec;
+  result.notes = data.notes;
+  if (!data.reference_kind.empty()) result.reference_kind = data.reference_kind;
+  Runners runners = MakeRunners(spec, &data.records);
+  std::unique_ptr<LiveView> view;
+  if (options.view) view = std::make_unique<LiveView>("slamrig: " + spec.name);
+
+  // The reference map: the log's scans at its reference poses, one per scan in order.
+  slam::OccupancyGrid truth_map{slam::OccupancyGridOptions{}};
+  std::optional<Pose2> map_from_start;
+  std::optional<Time> first_time, last_time;
+  std::size_t scans = 0;
+  const bool limited = spec.has_duration;
+  for (const Record& record : data.records) {
+    const Time t = RecordTime(record);
+    if (!first_time) first_time = t;
+    if (limited && SecondsBetween(t, *first_time) > spec.duration_s) break;
+    if (const auto* scan = std::get_if<LaserScan>(&record)) {
+      if (scans < data.reference.size()) {
+        const Pose2& reference = data.reference[scans].map_from_base;
+        result.truth.Append(data.reference[scans].time, reference);
+        truth_map.InsertScan(*scan, reference);
+        if (!map_from_start) map_from_start = reference;
+      }
+      ++scans;
+      ++result.scans;
+    }
+    last_time = last_time ? std::max(*last_time, t) : t;
+    for (auto& r : runners) r->Add(record);
+    if (view && std::holds_alternative<LaserScan>(record)) {
+      ShowLive(*view, SecondsBetween(t, *first_time), runners, map_from_start.value_or(Pose2()),
+               true, map_from_start.value_or(Pose2()));
+    }
+    if (options.progress && std::holds_alternative<LaserScan>(record) && scans % 100 == 0) {
+      options.progress(SecondsBetween(t, *first_time), spec.duration_s);
+    }
+  }
+  if (result.scans == 0) throw ParseError(spec.log->path + ": no laser scans to run SLAM on");
+  if (result.truth.out_of_order() > 0) {
+    result.notes.push_back(std::to_string(result.truth.out_of_order()) +
+                           " reference poses are stamped earlier than the one before them; each "
+                           "keeps its own scan's stamp, in scan order");
+  }
+  result.sim_time_s = first_time ? SecondsBetween(*last_time, *first_time) : 0.0;
+  if (!data.reference.empty()) result.truth_map.emplace(std::move(truth_map));
+  // A log without a reference is scored on nothing but its own statistics.
+  Finish(runners, map_from_start.value_or(Pose2()), result.sim_time_s, &result);
+  return result;
+}
+
+}  // namespace
+
+ScenarioResult RunScenario(const ScenarioSpec& spec, const RunnerOptions& options) {
+  return spec.simulated ? RunSimulated(spec, options) : RunLog(spec, options);
 }
 
 }  // namespace slamrig::scenario

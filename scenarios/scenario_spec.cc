@@ -1,12 +1,17 @@
 #include "scenarios/scenario_spec.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
 
+#include "sim/presets.h"
 #include "sim/robot_yaml.h"
 #include "sim/world_yaml.h"
+#include "slam/config/fields.h"
+#include "slam/io/ece276a_reader.h"
 #include "slam/types/error.h"
 
 namespace slamrig::scenario {
@@ -14,11 +19,32 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Resolve(const YamlNode& node, const std::string& scenario_path) {
-  fs::path p = node.As<std::string>();
+// A world or robot given by file name (relative to the scenario), preset name, or inline map.
+YamlNode WorldOrRobot(const YamlNode& node, const std::string& scenario_path, const char* folder) {
+  if (node.IsMap()) return node;
+  const std::string text = node.As<std::string>();
+  fs::path p = text;
   if (p.is_relative()) p = fs::path(scenario_path).parent_path() / p;
-  if (!fs::exists(p)) node.Fail("file '" + p.string() + "' does not exist");
-  return p.lexically_normal().string();
+  if (fs::is_regular_file(p)) return YamlNode::LoadFile(p.lexically_normal().string());
+  try {
+    return YamlNode::LoadFile(sim::FindPresetFile(text, folder));
+  } catch (const ConfigError& e) {
+    node.Fail("file '" + p.lexically_normal().string() +
+              "' does not exist, nor a preset: " + e.what());
+  }
+}
+
+// The log of `source:`: relative to the scenario file, else to SLAMRIG_DATA_DIR.
+std::string ResolveLog(const YamlNode& node, const std::string& scenario_path) {
+  const std::string text = node.As<std::string>();
+  const fs::path beside = fs::path(scenario_path).parent_path() / text;
+  if (fs::path(text).is_relative() && fs::exists(beside)) return beside.lexically_normal().string();
+  const std::string resolved = slam::ResolveLogPath(text);
+  if (!fs::exists(resolved) && !slam::LooksLikeEce276a(resolved)) {
+    node.Fail("no such log '" + text +
+              "' (looked beside the scenario and in SLAMRIG_DATA_DIR = " + slam::DataDir() + ")");
+  }
+  return resolved;
 }
 
 Pose2 ReadPose(const YamlNode& node) {
@@ -85,16 +111,191 @@ std::vector<sim::ObstacleSpec> MakeCrowd(const YamlNode& node, const sim::DriveO
 
 const std::vector<std::string>& KnownMetrics() {
   static const std::vector<std::string> metrics = {
-      "ate_rmse_m",     "ate_mean_m",   "ate_median_m",  "ate_max_m",       "ate_rot_rmse_rad",
-      "rpe_m_per_scan", "rpe_m_per_1m", "rpe_m_per_10m", "rpe_rad_per_10m", "final_error_m",
-      "map_f1",         "map_iou",      "map_precision", "map_recall",      "realtime_factor",
-      "mean_neff",      "resamples",    "scans"};
+      "ate_rmse_m",        "ate_mean_m",     "ate_median_m", "ate_max_m",     "ate_rot_rmse_rad",
+      "online_ate_rmse_m", "rpe_m_per_scan", "rpe_m_per_1m", "rpe_m_per_10m", "rpe_rad_per_10m",
+      "final_error_m",     "map_f1",         "map_iou",      "map_precision", "map_recall",
+      "realtime_factor",   "scans"};
   return metrics;
 }
+
+std::vector<std::string> MetricsOf(const slam::EstimatorConfig& config) {
+  std::vector<std::string> metrics = KnownMetrics();
+  if (const slam::Algorithm* a = slam::FindAlgorithm(config.algorithm)) {
+    metrics.insert(metrics.end(), a->statistics.begin(), a->statistics.end());
+  }
+  return metrics;
+}
+
+std::string FindScenarioFile(const std::string& name_or_path) {
+  return sim::FindPresetFile(name_or_path, "scenarios");
+}
+
+namespace {
+
+void ReadFaults(const YamlNode& faults, SimulatedSource* source) {
+  sim::WorldSpec& world = source->options.world;
+  if (auto patches = faults.Optional("slip_patches")) {
+    for (const YamlNode& z : patches->Elements()) {
+      sim::ZoneSpec zone;
+      zone.name = "slip_patch";
+      z.Read("name", &zone.name);
+      const YamlNode shape = z.Required("shape");
+      const std::string type = shape.Get<std::string>("type");
+      if (type == "box") {
+        zone.shape.type = sim::ShapeType::kBox;
+        const auto c = shape.Required("center_m").Elements();
+        const auto size = shape.Required("size_m").Elements();
+        if (c.size() != 2 || size.size() != 2) shape.Fail("center_m and size_m need 2 numbers");
+        zone.shape.center_m = {c[0].As<double>(), c[1].As<double>()};
+        zone.shape.size_m = {size[0].As<double>(), size[1].As<double>()};
+        shape.Read("angle_rad", &zone.shape.angle_rad);
+      } else if (type == "circle") {
+        zone.shape.type = sim::ShapeType::kCircle;
+        const auto c = shape.Required("center_m").Elements();
+        if (c.size() != 2) shape.Fail("center_m needs 2 numbers");
+        zone.shape.center_m = {c[0].As<double>(), c[1].As<double>()};
+        zone.shape.radius_m = shape.Get<double>("radius_m");
+      } else {
+        shape.Required("type").Fail("slip patches are box or circle, got '" + type + "'");
+      }
+      zone.surface.mu = z.Get<double>("mu");
+      z.Read("rolling_resistance", &zone.surface.rolling_resistance);
+      z.ThrowIfInvalid(zone.Validate());
+      world.zones.push_back(zone);
+    }
+  }
+  if (auto crowd = faults.Optional("crowd")) {
+    for (auto& person : MakeCrowd(*crowd, world.drive)) world.obstacles.push_back(person);
+  }
+  if (auto kidnaps = faults.Optional("kidnap")) {
+    for (const YamlNode& k : kidnaps->Elements()) {
+      KidnapFault fault{k.Get<double>("at_s"), ReadPose(k.Required("to"))};
+      if (!(fault.at_s > 0.0)) k.Required("at_s").Fail("must be > 0");
+      source->kidnaps.push_back(fault);
+    }
+  }
+  if (auto blackouts = faults.Optional("lidar_blackout")) {
+    for (const YamlNode& b : blackouts->Elements()) {
+      BlackoutFault fault{b.Get<double>("from_s"), b.Get<double>("to_s")};
+      if (!(fault.from_s >= 0.0 && fault.to_s > fault.from_s)) {
+        b.Fail("needs 0 <= from_s < to_s");
+      }
+      source->blackouts.push_back(fault);
+    }
+  }
+}
+
+void ReadExpectations(const YamlNode& expect, ScenarioSpec* spec) {
+  for (const std::string& config : expect.Keys()) {
+    const YamlNode block = expect.Required(config);
+    const auto it = std::find_if(spec->configs.begin(), spec->configs.end(),
+                                 [&](const slam::EstimatorConfig& c) { return c.name == config; });
+    if (it == spec->configs.end())
+      block.Fail("no SLAM configuration named '" + config + "' in slam:");
+    const std::vector<std::string> known = MetricsOf(*it);
+    for (const std::string& key : block.Keys()) {
+      const YamlNode value = block.Required(key);
+      Expectation e;
+      e.config = config;
+      const bool is_max = key.size() > 4 && key.substr(key.size() - 4) == "_max";
+      const bool is_min = key.size() > 4 && key.substr(key.size() - 4) == "_min";
+      e.metric = key.substr(0, key.size() - 4);
+      if ((!is_max && !is_min) || std::find(known.begin(), known.end(), e.metric) == known.end()) {
+        std::string names;
+        for (const auto& m : known) names += (names.empty() ? "" : ", ") + m;
+        value.Fail("unknown expectation; use <metric>_max or <metric>_min with a metric of: " +
+                   names);
+      }
+      e.is_max = is_max;
+      e.threshold = value.As<double>();
+      spec->expectations.push_back(e);
+    }
+  }
+}
+
+// The resolved scenario in the input schema: world and robot inline with every field, faults
+// that are not part of the world, every configuration resolved, the expectations.
+std::string ResolvedYaml(const ScenarioSpec& spec, const std::vector<std::string>& overrides) {
+  YAML::Emitter out;
+  std::string comment = "Resolved from " + spec.path;
+  for (const auto& o : overrides) comment += "\n--set " + o;
+  comment += "\n`slamrig run` on this file repeats the run bit for bit.";
+  out << YAML::Comment(comment) << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << spec.name;
+  out << YAML::Key << "description" << YAML::Value << spec.description;
+  out << YAML::Key << "seed" << YAML::Value << spec.seed;
+  if (spec.simulated || spec.has_duration) {
+    out << YAML::Key << "duration_s" << YAML::Value << FormatNumber(spec.duration_s);
+  }
+  if (spec.simulated) {
+    const SimulatedSource& s = *spec.simulated;
+    out << YAML::Key << "world" << YAML::Value << YAML::Load(sim::WorldSpecToYaml(s.options.world));
+    out << YAML::Key << "robot" << YAML::Value << YAML::Load(sim::RobotSpecToYaml(s.options.robot));
+    if (!s.kidnaps.empty() || !s.blackouts.empty()) {
+      out << YAML::Key << "faults" << YAML::Value << YAML::BeginMap;
+      if (!s.kidnaps.empty()) {
+        out << YAML::Key << "kidnap" << YAML::Value << YAML::BeginSeq;
+        for (const KidnapFault& k : s.kidnaps) {
+          out << YAML::Flow << YAML::BeginMap << YAML::Key << "at_s" << YAML::Value
+              << FormatNumber(k.at_s) << YAML::Key << "to" << YAML::Value << YAML::BeginMap
+              << YAML::Key << "x_m" << YAML::Value << FormatNumber(k.to.x()) << YAML::Key << "y_m"
+              << YAML::Value << FormatNumber(k.to.y()) << YAML::Key << "yaw_rad" << YAML::Value
+              << FormatNumber(k.to.theta()) << YAML::EndMap << YAML::EndMap;
+        }
+        out << YAML::EndSeq;
+      }
+      if (!s.blackouts.empty()) {
+        out << YAML::Key << "lidar_blackout" << YAML::Value << YAML::BeginSeq;
+        for (const BlackoutFault& b : s.blackouts) {
+          out << YAML::Flow << YAML::BeginMap << YAML::Key << "from_s" << YAML::Value
+              << FormatNumber(b.from_s) << YAML::Key << "to_s" << YAML::Value
+              << FormatNumber(b.to_s) << YAML::EndMap;
+        }
+        out << YAML::EndSeq;
+      }
+      out << YAML::EndMap;
+    }
+  } else {
+    out << YAML::Key << "source" << YAML::Value << YAML::BeginMap << YAML::Key << "log"
+        << YAML::Value << fs::absolute(spec.log->path).lexically_normal().string() << YAML::Key
+        << "lenient" << YAML::Value << spec.log->read.lenient << YAML::EndMap;
+  }
+  out << YAML::Key << "slam" << YAML::Value << YAML::BeginMap;
+  for (const slam::EstimatorConfig& c : spec.configs) {
+    out << YAML::Key << c.name << YAML::Value;
+    slam::WriteEstimatorConfig(c, &out);
+  }
+  out << YAML::EndMap;
+  if (!spec.expectations.empty()) {
+    // Grouped by configuration in the order the file gave them.
+    std::vector<std::string> order;
+    for (const Expectation& e : spec.expectations) {
+      if (std::find(order.begin(), order.end(), e.config) == order.end()) order.push_back(e.config);
+    }
+    out << YAML::Key << "expect" << YAML::Value << YAML::BeginMap;
+    for (const std::string& config : order) {
+      bool open = false;
+      for (const Expectation& e : spec.expectations) {
+        if (e.config != config) continue;
+        if (!open) out << YAML::Key << config << YAML::Value << YAML::BeginMap;
+        open = true;
+        out << YAML::Key << e.metric + (e.is_max ? "_max" : "_min") << YAML::Value
+            << FormatNumber(e.threshold);
+      }
+      if (open) out << YAML::EndMap;
+    }
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace
 
 ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string>& overrides,
                           std::optional<std::uint64_t> seed) {
   YamlNode root = YamlNode::LoadFile(path);
+  if (!root.IsMap()) root.Fail("a scenario file is a map (name, world, robot, slam, ...)");
   std::vector<std::pair<std::string, std::string>> world_set, robot_set;
   for (const std::string& o : overrides) {
     const std::size_t eq = o.find('=');
@@ -107,7 +308,7 @@ ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string
     } else if (key.rfind("robot.", 0) == 0) {
       robot_set.emplace_back(key.substr(6), value);
     } else {
-      root.Override(key, value);
+      root.Override(key, value, "--set " + o);
     }
   }
 
@@ -116,162 +317,75 @@ ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string
   spec.name = fs::path(path).stem().string();
   root.Read("name", &spec.name);
   root.Read("description", &spec.description);
+  spec.has_duration = root.Has("duration_s");
   root.Read("duration_s", &spec.duration_s);
   if (!(spec.duration_s > 0.0 && spec.duration_s <= 1e6)) {
     root.Required("duration_s").Fail("must be in (0, 1e6] seconds");
   }
-  std::uint64_t file_seed = 1;
-  root.Read("seed", &file_seed);
-  spec.sim.seed = seed.value_or(file_seed);
+  root.Read("seed", &spec.seed);
+  if (seed) spec.seed = *seed;
 
-  // World and robot files, with the scenario's and the command line's overrides.
-  const std::string world_path = Resolve(root.Required("world"), path);
-  const std::string robot_path = Resolve(root.Required("robot"), path);
-  YamlNode world = YamlNode::LoadFile(world_path);
-  YamlNode robot = YamlNode::LoadFile(robot_path);
-  for (const char* section : {"world_overrides", "robot_overrides"}) {
-    if (auto o = root.Optional(section)) {
-      for (const std::string& key : o->Keys()) {
-        const YamlNode value = o->Required(key);
-        if (!value.IsScalar()) value.Fail("override values must be scalars");
-        (section[0] == 'w' ? world : robot).Override(key, value.As<std::string>());
-      }
+  if (const auto source = root.Optional("source")) {
+    // A recorded log.
+    for (const char* key : {"world", "world_overrides", "faults"}) {
+      if (root.Has(key))
+        root.Required(key).Fail("a log scenario (source: {log: ...}) has no " + std::string(key));
     }
-  }
-  for (const auto& [k, v] : world_set) world.Override(k, v);
-  for (const auto& [k, v] : robot_set) robot.Override(k, v);
-  spec.sim.world = sim::ParseWorldSpec(world);
-  world.CheckAllKeysUsed();
-  spec.sim.robot = sim::ParseRobotSpec(robot);
-  robot.CheckAllKeysUsed();
-
-  // Faults.
-  if (auto faults = root.Optional("faults")) {
-    if (auto patches = faults->Optional("slip_patches")) {
-      for (const YamlNode& z : patches->Elements()) {
-        sim::ZoneSpec zone;
-        zone.name = "slip_patch";
-        z.Read("name", &zone.name);
-        const YamlNode shape = z.Required("shape");
-        const std::string type = shape.Get<std::string>("type");
-        if (type == "box") {
-          zone.shape.type = sim::ShapeType::kBox;
-          const auto c = shape.Required("center_m").Elements();
-          const auto s = shape.Required("size_m").Elements();
-          if (c.size() != 2 || s.size() != 2) shape.Fail("center_m and size_m need 2 numbers");
-          zone.shape.center_m = {c[0].As<double>(), c[1].As<double>()};
-          zone.shape.size_m = {s[0].As<double>(), s[1].As<double>()};
-          shape.Read("angle_rad", &zone.shape.angle_rad);
-        } else if (type == "circle") {
-          zone.shape.type = sim::ShapeType::kCircle;
-          const auto c = shape.Required("center_m").Elements();
-          if (c.size() != 2) shape.Fail("center_m needs 2 numbers");
-          zone.shape.center_m = {c[0].As<double>(), c[1].As<double>()};
-          zone.shape.radius_m = shape.Get<double>("radius_m");
-        } else {
-          shape.Required("type").Fail("slip patches are box or circle, got '" + type + "'");
+    if (!world_set.empty())
+      throw ConfigError("--set world." + world_set.front().first + ": a log scenario has no world");
+    LogSource log;
+    log.path = ResolveLog(source->Required("log"), path);
+    source->Read("lenient", &log.read.lenient);
+    if (const auto robot_node = root.Optional("robot")) {
+      YamlNode robot = WorldOrRobot(*robot_node, path, "robots");
+      for (const auto& [k, v] : robot_set) robot.Override(k, v, "--set robot." + k + "=" + v);
+      log.robot = sim::NominalOdometry(sim::ParseRobotSpec(robot));
+      robot.CheckAllKeysUsed();
+    } else if (!robot_set.empty()) {
+      throw ConfigError("--set robot." + robot_set.front().first + ": the scenario has no robot");
+    }
+    spec.log = log;
+  } else {
+    // A simulated world, with the scenario's and the command line's overrides.
+    SimulatedSource sim_source;
+    YamlNode world = WorldOrRobot(root.Required("world"), path, "worlds");
+    YamlNode robot = WorldOrRobot(root.Required("robot"), path, "robots");
+    for (const char* section : {"world_overrides", "robot_overrides"}) {
+      if (auto o = root.Optional(section)) {
+        for (const std::string& key : o->Keys()) {
+          const YamlNode value = o->Required(key);
+          if (!value.IsScalar()) value.Fail("override values must be scalars");
+          (section[0] == 'w' ? world : robot).Override(key, value.As<std::string>());
         }
-        zone.surface.mu = z.Get<double>("mu");
-        z.Read("rolling_resistance", &zone.surface.rolling_resistance);
-        z.ThrowIfInvalid(zone.Validate());
-        spec.sim.world.zones.push_back(zone);
       }
     }
-    if (auto crowd = faults->Optional("crowd")) {
-      for (auto& person : MakeCrowd(*crowd, spec.sim.world.drive))
-        spec.sim.world.obstacles.push_back(person);
-    }
-    if (auto kidnaps = faults->Optional("kidnap")) {
-      for (const YamlNode& k : kidnaps->Elements()) {
-        KidnapFault fault{k.Get<double>("at_s"), ReadPose(k.Required("to"))};
-        if (!(fault.at_s > 0.0)) k.Required("at_s").Fail("must be > 0");
-        spec.kidnaps.push_back(fault);
-      }
-    }
-    if (auto blackouts = faults->Optional("lidar_blackout")) {
-      for (const YamlNode& b : blackouts->Elements()) {
-        BlackoutFault fault{b.Get<double>("from_s"), b.Get<double>("to_s")};
-        if (!(fault.from_s >= 0.0 && fault.to_s > fault.from_s)) {
-          b.Fail("needs 0 <= from_s < to_s");
-        }
-        spec.blackouts.push_back(fault);
-      }
-    }
+    for (const auto& [k, v] : world_set) world.Override(k, v, "--set world." + k + "=" + v);
+    for (const auto& [k, v] : robot_set) robot.Override(k, v, "--set robot." + k + "=" + v);
+    sim_source.options.world = sim::ParseWorldSpec(world);
+    world.CheckAllKeysUsed();
+    sim_source.options.robot = sim::ParseRobotSpec(robot);
+    robot.CheckAllKeysUsed();
+    sim_source.options.seed = spec.seed;
+    if (auto faults = root.Optional("faults")) ReadFaults(*faults, &sim_source);
+    root.ThrowIfInvalid(sim_source.options.Validate());
+    spec.simulated = std::move(sim_source);
   }
-  root.ThrowIfInvalid(spec.sim.Validate());
 
-  // SLAM configurations, in file order.
+  // SLAM configurations, in file order, with the source's wheel geometry.
   const YamlNode slam = root.Required("slam");
+  if (!slam.IsMap()) slam.Fail("expected a map of SLAM configurations (name: {algorithm: ...})");
+  const slam::DiffDriveParams robot =
+      spec.simulated ? sim::NominalOdometry(spec.simulated->options.robot) : spec.log->robot;
   for (const std::string& name : slam.Keys()) {
-    SlamConfig config = ParseSlamConfig(name, slam.Required(name));
-    config.pf.seed = spec.sim.seed;
-    const sim::WheelOptions& wheels = spec.sim.robot.wheels;
-    config.sync.robot = {wheels.radius_m, spec.sim.robot.encoders.ticks_per_revolution,
-                         wheels.track_width_m};
-    spec.slam.push_back(config);
+    slam::EstimatorConfig config = slam::ParseEstimatorConfig(name, slam.Required(name));
+    config.odometry.robot = robot;
+    spec.configs.push_back(std::move(config));
   }
-  if (spec.slam.empty()) slam.Fail("needs at least one SLAM configuration");
+  if (spec.configs.empty()) slam.Fail("needs at least one SLAM configuration");
 
-  // Expectations: `<config>: {<metric>_max: x, <metric>_min: y}`.
-  if (auto expect = root.Optional("expect")) {
-    for (const std::string& config : expect->Keys()) {
-      const YamlNode block = expect->Required(config);
-      if (std::none_of(spec.slam.begin(), spec.slam.end(),
-                       [&](const SlamConfig& c) { return c.name == config; })) {
-        block.Fail("no SLAM configuration named '" + config + "' in slam:");
-      }
-      for (const std::string& key : block.Keys()) {
-        const YamlNode value = block.Required(key);
-        Expectation e;
-        e.config = config;
-        const bool is_max = key.size() > 4 && key.substr(key.size() - 4) == "_max";
-        const bool is_min = key.size() > 4 && key.substr(key.size() - 4) == "_min";
-        e.metric = key.substr(0, key.size() - 4);
-        const auto& known = KnownMetrics();
-        if ((!is_max && !is_min) ||
-            std::find(known.begin(), known.end(), e.metric) == known.end()) {
-          std::string names;
-          for (const auto& m : known) names += (names.empty() ? "" : ", ") + m;
-          value.Fail("unknown expectation; use <metric>_max or <metric>_min with a metric of: " +
-                     names);
-        }
-        e.is_max = is_max;
-        e.threshold = value.As<double>();
-        spec.expectations.push_back(e);
-      }
-    }
-  }
+  if (auto expect = root.Optional("expect")) ReadExpectations(*expect, &spec);
   root.CheckAllKeysUsed();
-
-  // The resolved configuration, for the report folder.
-  std::ostringstream resolved;
-  resolved << "# Resolved configuration of " << path << "\nname: " << spec.name
-           << "\nseed: " << spec.sim.seed << "\nduration_s: " << spec.duration_s << "\n";
-  for (const auto& o : overrides) resolved << "# --set " << o << "\n";
-  resolved << "kidnaps:";
-  for (const auto& k : spec.kidnaps)
-    resolved << "\n  - {at_s: " << k.at_s << ", to: [" << k.to.x() << ", " << k.to.y() << ", "
-             << k.to.theta() << "]}";
-  resolved << (spec.kidnaps.empty() ? " []\n" : "\n") << "lidar_blackouts:";
-  for (const auto& b : spec.blackouts)
-    resolved << "\n  - {from_s: " << b.from_s << ", to_s: " << b.to_s << "}";
-  resolved << (spec.blackouts.empty() ? " []\n" : "\n") << "slam:\n";
-  for (const auto& c : spec.slam) {
-    std::istringstream lines(SlamConfigToYaml(c));
-    for (std::string line; std::getline(lines, line);) resolved << "  " << line << "\n";
-  }
-  resolved << "expect:\n";
-  for (const auto& e : spec.expectations) {
-    resolved << "  - {config: " << e.config << ", metric: " << e.metric << ", "
-             << (e.is_max ? "max: " : "min: ") << e.threshold << "}\n";
-  }
-  resolved << "world:\n";
-  std::istringstream world_lines(sim::WorldSpecToYaml(spec.sim.world));
-  for (std::string line; std::getline(world_lines, line);) resolved << "  " << line << "\n";
-  resolved << "robot:\n";
-  std::istringstream robot_lines(sim::RobotSpecToYaml(spec.sim.robot));
-  for (std::string line; std::getline(robot_lines, line);) resolved << "  " << line << "\n";
-  spec.resolved_yaml = resolved.str();
+  spec.resolved_yaml = ResolvedYaml(spec, overrides);
   return spec;
 }
 

@@ -5,8 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "scenarios/slam_config.h"
 #include "sim/simulator.h"
+#include "slam/io/log_reader.h"
+#include "slam/pipeline/estimator_config.h"
 
 namespace slamrig::scenario {
 
@@ -30,14 +31,29 @@ struct BlackoutFault {
   double to_s = 0.0;
 };
 
-/// A scenario: a world, a robot, how it drives, what goes wrong, which SLAM configurations run,
-/// and what they must achieve. Read from scenarios/*.yaml:
+/// A simulated source: world, robot and seed, and the faults injected while it runs.
+struct SimulatedSource {
+  sim::SimulatorOptions options;  ///< world (slip patches and crowd applied), robot, seed
+  std::vector<KidnapFault> kidnaps;
+  std::vector<BlackoutFault> blackouts;
+};
+
+/// A recorded source: a log file, scored against its own reference (a corrected log's poses,
+/// TRUEPOS lines).
+struct LogSource {
+  std::string path;  ///< as resolved (ResolveLogPath)
+  slam::LogReadOptions read;
+  slam::DiffDriveParams robot;  ///< wheel geometry for logs with encoder ticks (ECE276A default)
+};
+
+/// A scenario: where the records come from (a simulated world or a log), which SLAM
+/// configurations run on them, and what they must achieve. Read from scenarios/*.yaml:
 ///
 /// ```yaml
 /// name: office_loop
 /// description: three laps of the office corridor loop at 0.5 m/s
-/// world: ../worlds/office.yaml       # relative to this file
-/// robot: ../robots/ece276a.yaml
+/// world: ../worlds/office.yaml       # a file (relative to this one), a preset name or a map
+/// robot: ../robots/ece276a.yaml      # likewise
 /// seed: 1
 /// duration_s: 400                    # stop here even if the drive is not finished
 /// world_overrides: {drive.laps: 3}   # key path in the world file -> value
@@ -53,27 +69,42 @@ struct BlackoutFault {
 /// expect:
 ///   pf: {ate_rmse_m_max: 0.10, map_f1_min: 0.8, realtime_factor_min: 5}
 /// ```
+///
+/// or, instead of world/robot/faults, a log: `source: {log:
+/// carmen_corrected/intel-corrected.log.gz}` (relative to this file or to SLAMRIG_DATA_DIR;
+/// `lenient: true` counts malformed lines).
 struct ScenarioSpec {
   std::string path;
   std::string name;
   std::string description;
-  sim::SimulatorOptions sim;  ///< world (with faults applied), robot and seed
-  double duration_s = 600.0;
-  std::vector<KidnapFault> kidnaps;
-  std::vector<BlackoutFault> blackouts;
-  std::vector<SlamConfig> slam;
+  std::uint64_t seed = 1;     ///< the simulator's and every estimator's streams derive from it
+  double duration_s = 600.0;  ///< simulated: stop here; log: use the records up to here
+  bool has_duration = false;  ///< duration_s was given (a log runs whole otherwise)
+  std::optional<SimulatedSource> simulated;  ///< exactly one of simulated and log
+  std::optional<LogSource> log;
+  std::vector<slam::EstimatorConfig> configs;
   std::vector<Expectation> expectations;
-  std::string resolved_yaml;  ///< the whole resolved configuration, written next to results
+  /// The whole resolved scenario, in the input schema (world and robot inline, every field):
+  /// `slamrig run config.yaml` repeats the run bit for bit.
+  std::string resolved_yaml;
 };
 
-/// Metric names a scenario may set expectations on (metrics.json per configuration).
+/// Metric names every configuration has (metrics.json per configuration).
 const std::vector<std::string>& KnownMetrics();
+
+/// The metrics of `config`: KnownMetrics() and its algorithm's statistics.
+std::vector<std::string> MetricsOf(const slam::EstimatorConfig& config);
 
 /// Reads a scenario file strictly. `overrides` are `key=value` texts: keys starting with
 /// `world.` or `robot.` change the world or robot file, others the scenario file itself (e.g.
-/// `slam.pf.particles=30`). `seed`, when given, replaces the file's seed. Every error is a
-/// ConfigError naming the file, line and key.
+/// `slam.pf.particles=30`); errors about an overridden value name the `--set` argument. `seed`,
+/// when given, replaces the file's seed. Every error is a ConfigError naming the file, line and
+/// key.
 ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string>& overrides = {},
                           std::optional<std::uint64_t> seed = std::nullopt);
+
+/// The scenario file `name_or_path`: a path, or a shipped scenario's name ("office_loop") looked
+/// up in scenarios/ of the current folder, of the source tree and of the installed share folder.
+std::string FindScenarioFile(const std::string& name_or_path);
 
 }  // namespace slamrig::scenario

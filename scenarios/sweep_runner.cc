@@ -120,8 +120,8 @@ std::vector<std::string> DefaultMetrics(const SweepSpec& spec) {
   for (const auto& p : spec.parameters) overrides.push_back(p.key + "=" + p.values.front());
   const ScenarioSpec scenario = LoadScenario(spec.scenario_path, overrides);
   std::vector<std::string> metrics;
-  for (const SlamConfig& config : scenario.slam) {
-    for (const std::string& m : KnownMetrics()) {
+  for (const slam::EstimatorConfig& config : scenario.configs) {
+    for (const std::string& m : MetricsOf(config)) {
       if (m != "realtime_factor") metrics.push_back(config.name + "." + m);
     }
   }

@@ -9,10 +9,8 @@
 #include "sim/run_writer.h"
 #include "sim/world_yaml.h"
 #include "slam/eval/trajectory_error.h"
-#include "slam/io/carmen_reader.h"
-#include "slam/io/dataset.h"
-#include "slam/odometry/scan_sync.h"
-#include "slam/pf/slam_run.h"
+#include "slam/io/log_reader.h"
+#include "slam/pipeline/estimator_runner.h"
 #include "tests/util/temp_dir.h"
 
 namespace slamrig {
@@ -27,20 +25,18 @@ TEST(PfOfficeTest, ThreeLapsWithinTenCentimetresAndHalfOfDeadReckoning) {
   ASSERT_EQ(options.world.drive.laps, 3);
   sim::WriteSimulationRun(options, sim::RunOptions{}, dir.path().string());
 
-  const slam::Dataset data = slam::CarmenToDataset(slam::ReadCarmenLog(dir.File("run.log")));
-  const slam::ScanSyncResult synced = slam::SyncToScans(data.records, slam::ScanSyncOptions{});
-  ASSERT_GT(synced.scans.size(), 10000u);
+  const slam::Dataset data = slam::ReadLog(dir.File("run.log"));
   Trajectory truth;
   for (const GroundTruthPose& g : data.reference) truth.Append(g.time, g.map_from_base);
 
-  const double dr =
-      slam::ComputeAte(
-          slam::RunDeadReckoning(synced.scans, slam::OccupancyGridOptions{}).trajectory, truth)
-          .translation_m.rmse;
-  slam::ParticleFilterOptions pf_options;
-  pf_options.num_particles = 100;
+  const slam::EstimatorRun dr_run = slam::RunEstimator(
+      slam::DefaultEstimatorConfig("dead_reckoning", "dead-reckoning"), data.records, 1);
+  ASSERT_GT(dr_run.final.size(), 10000u);
+  const double dr = slam::ComputeAte(dr_run.final, truth).translation_m.rmse;
   const double pf =
-      slam::ComputeAte(slam::RunParticleFilter(synced.scans, pf_options).trajectory, truth)
+      slam::ComputeAte(
+          slam::RunEstimator(slam::DefaultEstimatorConfig("pf", "pf"), data.records, 1).final,
+          truth)
           .translation_m.rmse;
   RecordProperty("dead_reckoning_ate_rmse_m", std::to_string(dr));
   RecordProperty("pf_ate_rmse_m", std::to_string(pf));

@@ -41,6 +41,13 @@ std::string YamlNode::ChildPath(const std::string& key) const {
 }
 
 std::string YamlNode::Where() const {
+  // A value set by an override (or inside one) is located by the override, not the file.
+  for (const auto& [path, origin] : usage_->overridden) {
+    if (path_ == path || (path_.size() > path.size() && path_.compare(0, path.size(), path) == 0 &&
+                          (path_[path.size()] == '.' || path_[path.size()] == '['))) {
+      return origin + ": " + path_;
+    }
+  }
   const std::string location = MarkString(usage_->file, node_.Mark());
   return path_.empty() ? location : location + ": " + path_;
 }
@@ -53,6 +60,17 @@ void YamlNode::ThrowIfInvalid(const std::vector<std::string>& errors) const {
   if (errors.empty()) return;
   std::string joined;
   for (const auto& e : errors) joined += (joined.empty() ? "" : "; ") + e;
+  // A broken rule about a value an override set is located by the override.
+  for (const auto& e : errors) {
+    const std::string field = e.substr(0, e.find(" = "));
+    for (const auto& [path, origin] : usage_->overridden) {
+      if (field == path ||
+          (field.size() > path.size() && field.compare(0, path.size(), path) == 0 &&
+           field[path.size()] == '.')) {
+        throw ConfigError(origin + ": " + joined);
+      }
+    }
+  }
   throw ConfigError(MarkString(usage_->file, node_.Mark()) + ": " + joined);
 }
 
@@ -130,8 +148,11 @@ template float YamlNode::As<float>() const;
 template double YamlNode::As<double>() const;
 template std::string YamlNode::As<std::string>() const;
 
-void YamlNode::Override(const std::string& key_path, const std::string& value) {
-  const std::string where = usage_->file + ": override " + key_path + "=" + value + ": ";
+void YamlNode::Override(const std::string& key_path, const std::string& value,
+                        const std::string& origin) {
+  const std::string label = origin.empty() ? "override " + key_path + "=" + value : origin;
+  const std::string where = origin.empty() ? usage_->file + ": " + label + ": " : label + ": ";
+  usage_->overridden[path_.empty() ? key_path : path_ + "." + key_path] = label;
   // Split "a.b[2].c" into steps: names and indices.
   struct Step {
     std::string key;
@@ -201,8 +222,11 @@ void YamlNode::CheckUsedRecursive(const YAML::Node& node, const std::string& pat
       const std::string key = kv.first.Scalar();
       const std::string child_path = path.empty() ? key : path + "." + key;
       if (used == usage_->used_keys.end() || !used->second.count(key)) {
-        throw ConfigError(MarkString(usage_->file, kv.first.Mark()) + ": " + child_path +
-                          ": unknown key");
+        const auto overridden = usage_->overridden.find(child_path);
+        throw ConfigError((overridden != usage_->overridden.end()
+                               ? overridden->second
+                               : MarkString(usage_->file, kv.first.Mark())) +
+                          ": " + child_path + ": unknown key");
       }
       CheckUsedRecursive(kv.second, child_path);
     }

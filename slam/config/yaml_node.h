@@ -59,7 +59,10 @@ class YamlNode {
   /// Sets the value at dotted `key_path` (`slam.pf.num_particles`, `drive.waypoints[2]`) to the
   /// YAML text `value`, creating missing map keys: command-line overrides of a file. A path
   /// through a scalar, or an index past a list's end, is a ConfigError naming the path.
-  void Override(const std::string& key_path, const std::string& value);
+  /// `origin` names where the override came from (e.g. "--set slam.pf.particles=0"): errors
+  /// about the new value, or anything below it, name it instead of a line of the file.
+  void Override(const std::string& key_path, const std::string& value,
+                const std::string& origin = "");
 
   /// Throws a ConfigError for the first map key, anywhere below this node, that was never read.
   void CheckAllKeysUsed() const;
@@ -79,6 +82,7 @@ class YamlNode {
   struct Usage {
     std::string file;
     std::map<std::string, std::set<std::string>> used_keys;  // by node path
+    std::map<std::string, std::string> overridden;           // node path -> origin
   };
 
   YamlNode(YAML::Node node, std::string path, std::shared_ptr<Usage> usage)

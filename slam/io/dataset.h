@@ -14,6 +14,7 @@ struct Dataset {
   std::vector<Record> records;
   std::vector<GroundTruthPose> reference;
   std::string source;              ///< file it came from
+  std::string format;              ///< its format ("carmen", "ece276a"; see log_reader.h)
   std::string reference_kind;      ///< what `reference` is, e.g. "GMapping-corrected poses"
   std::vector<std::string> notes;  ///< quirks found while reading, for the user
 };

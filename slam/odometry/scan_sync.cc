@@ -19,7 +19,9 @@ double SideMean(const std::vector<std::int32_t>& ticks) {
   return sum / static_cast<double>(ticks.size());
 }
 
-OdometrySource Resolve(const std::vector<Record>& records, OdometrySource wanted) {
+}  // namespace
+
+OdometrySource ResolveOdometrySource(const std::vector<Record>& records, OdometrySource wanted) {
   if (wanted != OdometrySource::kAuto) return wanted;
   bool poses = false;
   for (const Record& r : records) {
@@ -28,6 +30,8 @@ OdometrySource Resolve(const std::vector<Record>& records, OdometrySource wanted
   }
   return poses ? OdometrySource::kOdometryPoses : OdometrySource::kNone;
 }
+
+namespace {
 
 // SE(2) translation Jacobian V(theta) applied to (x, y): the chord of a constant-twist motion.
 Eigen::Vector2d ApplyV(double theta, const Eigen::Vector2d& v) {
@@ -183,7 +187,7 @@ void ScanSynchronizer::CompletePending(const OdometryPose* next, std::vector<Syn
 ScanSyncResult SyncToScans(const std::vector<Record>& records, const ScanSyncOptions& options) {
   SLAMRIG_CHECK(options.Validate().empty(), "invalid ScanSyncOptions");
   ScanSyncResult result;
-  result.source_used = Resolve(records, options.source);
+  result.source_used = ResolveOdometrySource(records, options.source);
   ScanSynchronizer sync(options, result.source_used == OdometrySource::kAuto ? OdometrySource::kNone
                                                                              : result.source_used);
   for (const Record& record : records) {

@@ -30,6 +30,20 @@ struct ScanSyncOptions {
   std::vector<std::string> Validate() const;
 };
 
+/// The field table of ScanSyncOptions (slam/config/fields.h): a configuration's `odometry:` map.
+/// The robot geometry is not a field: it comes from the robot file or the log.
+template <typename V>
+void VisitFields(V& v, ScanSyncOptions& o) {
+  v.Enum("source", o.source,
+         {{OdometrySource::kAuto, "auto"},
+          {OdometrySource::kWheelTicks, "wheel_ticks"},
+          {OdometrySource::kOdometryPoses, "poses"},
+          {OdometrySource::kNone, "none"}});
+  v("use_gyro", o.use_gyro);
+  v.Enum("integration", o.integration,
+         {{DiffDriveIntegration::kExactArc, "exact_arc"}, {DiffDriveIntegration::kEuler, "euler"}});
+}
+
 /// One laser scan with the odometry synchronised to its time stamp.
 struct SyncedScan {
   LaserScan scan;
@@ -98,6 +112,10 @@ class ScanSynchronizer {
 /// in vector order, so a log with a few out-of-order stamps still pairs each scan with the
 /// records written around it.
 ScanSyncResult SyncToScans(const std::vector<Record>& records, const ScanSyncOptions& options);
+
+/// The source `wanted` means for `records`: kAuto becomes wheel ticks if there are any, else
+/// odometry poses if there are any, else kNone; any other value is returned as it is.
+OdometrySource ResolveOdometrySource(const std::vector<Record>& records, OdometrySource wanted);
 
 /// The dead-reckoning trajectory implied by `scans`: poses relative to the first scan.
 std::vector<Pose2> DeadReckoningPoses(const std::vector<SyncedScan>& scans);

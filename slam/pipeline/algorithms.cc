@@ -1,0 +1,48 @@
+// The algorithm table: the one place that lists the estimators. Adding an algorithm is one entry
+// here plus its Estimator; every command, sweep, view and report then runs it.
+
+#include "slam/pipeline/algorithm.h"
+#include "slam/pipeline/dead_reckoning_estimator.h"
+#include "slam/pipeline/particle_filter_estimator.h"
+
+namespace slamrig::slam {
+
+const std::vector<Algorithm>& Algorithms() {
+  static const std::vector<Algorithm> algorithms = {
+      {"dead-reckoning",
+       "odometry alone, the map built along it",
+       {"default"},
+       {},
+       [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
+         return std::make_unique<AlgorithmOptionsFor<DeadReckoningOptions, DeadReckoningEstimator>>(
+             DeadReckoningOptions{});
+       }},
+      {"pf",
+       "particle-filter SLAM on one log-odds map (presets: default, the improved filter; "
+       "reports, the ECE276A reports' method)",
+       {"default", "reports"},
+       {"mean_neff", "resamples", "updates"},
+       [](const std::string& preset) -> std::unique_ptr<AlgorithmOptions> {
+         return std::make_unique<
+             AlgorithmOptionsFor<ParticleFilterOptions, ParticleFilterEstimator>>(
+             preset == "reports" ? ParticleFilterOptions::ReportsPreset()
+                                 : ParticleFilterOptions{});
+       }},
+  };
+  return algorithms;
+}
+
+const Algorithm* FindAlgorithm(const std::string& name) {
+  for (const Algorithm& a : Algorithms()) {
+    if (a.name == name) return &a;
+  }
+  return nullptr;
+}
+
+std::string AlgorithmNames() {
+  std::string names;
+  for (const Algorithm& a : Algorithms()) names += (names.empty() ? "" : ", ") + a.name;
+  return names;
+}
+
+}  // namespace slamrig::slam

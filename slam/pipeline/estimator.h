@@ -1,0 +1,69 @@
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "slam/grid/occupancy_grid.h"
+#include "slam/odometry/scan_sync.h"
+#include "slam/types/pose2.h"
+#include "slam/types/records.h"
+#include "slam/types/trajectory.h"
+
+namespace slamrig::slam {
+
+/// A named number an estimator reports after each scan, for plots over time (e.g. "neff").
+struct TraceValue {
+  std::string name;
+  double value = 0.0;
+};
+
+/// What an estimator says about one scan.
+struct ScanEstimate {
+  Pose2 pose;                      ///< the online estimate of base_link at the scan's time
+  std::optional<Pose2> mean_pose;  ///< a second estimate where there is one (a PF's mean)
+  std::vector<TraceValue> trace;   ///< per-scan values for plots
+};
+
+/// A pose hypothesis with its normalised weight (a particle).
+struct WeightedPose {
+  Pose2 pose;
+  double weight = 0.0;
+};
+
+/// What the live view (and `slamrig slam --clouds`) may show besides the pose and the map, in
+/// the estimator's frame.
+struct EstimatorView {
+  std::vector<WeightedPose> particles;
+};
+
+/// The one interface every SLAM algorithm implements (dead reckoning, the particle filter, and
+/// every algorithm after them). An EstimatorRunner feeds it: every record as it arrives through
+/// AddRecord (for estimators that predict at sensor rates), and each laser scan, synchronised
+/// with the odometry by a ScanSynchronizer, through AddScan; Finish() at the end of the data.
+/// Frames: the estimator's own frame is base_link at the first scan (the identity pose there).
+/// Implementations are deterministic: same records, same options, same bits.
+class Estimator {
+ public:
+  virtual ~Estimator() = default;
+
+  /// Every record in arrival order, before any scan it completes. Default: ignored.
+  virtual void AddRecord(const Record& record) { (void)record; }
+  /// One synchronised scan; returns the online estimate at its time.
+  virtual ScanEstimate AddScan(const SyncedScan& scan) = 0;
+  /// The end of the data (a graph back end runs its final optimisation here).
+  virtual void Finish() {}
+
+  /// The final trajectory when the estimator revises its past (one pose per scan, in AddScan
+  /// order); nullopt when it does not, and the online poses are final.
+  virtual std::optional<std::vector<Pose2>> RevisedPoses() const { return std::nullopt; }
+  /// The map, in the estimator's frame.
+  virtual const OccupancyGrid& map() const = 0;
+  /// Named statistics for metrics.json (e.g. "mean_neff", "resamples", "loop_closures").
+  virtual std::map<std::string, double> Statistics() const { return {}; }
+  /// Extras for the live view.
+  virtual EstimatorView View() const { return {}; }
+};
+
+}  // namespace slamrig::slam

@@ -1,0 +1,96 @@
+#include "slam/pipeline/estimator_runner.h"
+
+#include <chrono>
+
+#include "slam/types/check.h"
+
+namespace slamrig::slam {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+EstimatorRunner::EstimatorRunner(const EstimatorConfig& config, OdometrySource source,
+                                 std::uint64_t run_seed)
+    : config_(config), sync_(config.odometry, source), estimator_(MakeEstimator(config, run_seed)) {
+  run_.name = config.name;
+  run_.algorithm = config.algorithm;
+  run_.odometry_source = source;
+}
+
+void EstimatorRunner::Add(const Record& record) {
+  SLAMRIG_CHECK(!finished_, "EstimatorRunner::Add after Finish");
+  const auto start = Clock::now();
+  estimator_->AddRecord(record);
+  for (const SyncedScan& s : sync_.Add(record)) Process(s);
+  run_.wall_s += SecondsSince(start);
+}
+
+void EstimatorRunner::Finish() {
+  if (finished_) return;
+  const auto start = Clock::now();
+  for (const SyncedScan& s : sync_.Flush()) Process(s);
+  estimator_->Finish();
+  finished_ = true;
+  run_.wall_s += SecondsSince(start);
+}
+
+void EstimatorRunner::Process(const SyncedScan& scan) {
+  const ScanEstimate estimate = estimator_->AddScan(scan);
+  const Time time = scan.scan.time;
+  pose_ = estimate.pose;
+  run_.online.Append(time, estimate.pose);
+  if (estimate.mean_pose) run_.mean.Append(time, *estimate.mean_pose);
+  if (!estimate.trace.empty()) {
+    run_.trace_time_s.push_back(time.seconds());
+    for (const TraceValue& v : estimate.trace) run_.traces[v.name].push_back(v.value);
+  }
+  if (on_scan_) on_scan_(run_.online.size() - 1, scan, estimate);
+}
+
+EstimatorRun EstimatorRunner::TakeResult() {
+  SLAMRIG_CHECK(finished_, "EstimatorRunner::TakeResult before Finish");
+  run_.final = run_.online;
+  if (const auto revised = estimator_->RevisedPoses()) {
+    SLAMRIG_CHECK(revised->size() == run_.online.size(), "revised poses: one per scan");
+    Trajectory final;
+    for (std::size_t i = 0; i < revised->size(); ++i)
+      final.Append(run_.online[i].time, (*revised)[i]);
+    run_.final = std::move(final);
+  }
+  run_.statistics = estimator_->Statistics();
+  run_.map = estimator_->map();
+  run_.gyro_fallbacks = sync_.gyro_fallbacks();
+  run_.scans_without_odometry = sync_.scans_without_odometry();
+  return std::move(run_);
+}
+
+EstimatorRun RunEstimator(
+    const EstimatorConfig& config, const std::vector<Record>& records, std::uint64_t run_seed,
+    const RunLimits& limits,
+    std::function<void(std::size_t, const SyncedScan&, const ScanEstimate&)> on_scan) {
+  const OdometrySource source = ResolveOdometrySource(records, config.odometry.source);
+  // A scan limit: the records up to the one that completes scan max_scans.
+  std::size_t end = records.size();
+  if (limits.max_scans > 0) {
+    std::size_t scans = 0;
+    for (std::size_t i = 0; i < records.size(); ++i) {
+      if (std::holds_alternative<LaserScan>(records[i]) && ++scans > limits.max_scans) {
+        end = i;
+        break;
+      }
+    }
+  }
+  EstimatorRunner runner(config, source, run_seed);
+  runner.SetScanCallback(std::move(on_scan));
+  for (std::size_t i = 0; i < end; ++i) runner.Add(records[i]);
+  runner.Finish();
+  return runner.TakeResult();
+}
+
+}  // namespace slamrig::slam

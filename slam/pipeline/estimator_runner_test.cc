@@ -1,0 +1,118 @@
+#include "slam/pipeline/estimator_runner.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "slam/pf/testing/synthetic_run.h"
+#include "slam/pipeline/particle_filter_estimator.h"
+#include "slam/types/error.h"
+
+namespace slamrig::slam {
+namespace {
+
+const std::vector<Record>& Records() {
+  static const testing::SyntheticRun* run = [] {
+    testing::SyntheticRunOptions options;
+    options.waypoints = testing::OfficeLoop();
+    options.max_duration_s = 20.0;
+    options.scan_rate_hz = 10.0;
+    options.lidar.num_beams = 181;
+    options.lidar.angle_increment_rad = 1.5 * 3.14159265358979 / 180.0;
+    options.right_scale_error = 0.02;
+    return new testing::SyntheticRun(
+        testing::MakeSyntheticRun(testing::SegmentWorld::Office(), options));
+  }();
+  return run->records;
+}
+
+EstimatorConfig SmallPf() {
+  EstimatorConfig config = DefaultEstimatorConfig("pf", "pf");
+  ReadEstimatorFields(YamlNode::LoadString("particles: 20", "test"), &config);
+  return config;
+}
+
+// The streaming runner (records one at a time, as a simulator delivers them) and the estimator
+// fed the whole log's synchronised scans by hand give the same bits.
+TEST(EstimatorRunnerTest, StreamingEqualsTheWholeLogByHand) {
+  const EstimatorConfig config = SmallPf();
+  const EstimatorRun streamed = RunEstimator(config, Records(), 7);
+
+  const ScanSyncResult synced = SyncToScans(Records(), config.odometry);
+  std::unique_ptr<Estimator> estimator = MakeEstimator(config, 7);
+  ASSERT_EQ(streamed.online.size(), synced.scans.size());
+  for (std::size_t i = 0; i < synced.scans.size(); ++i) {
+    const ScanEstimate e = estimator->AddScan(synced.scans[i]);
+    ASSERT_EQ(streamed.online[i].pose, e.pose) << i;
+    ASSERT_EQ(streamed.online[i].time, synced.scans[i].scan.time) << i;
+  }
+  EXPECT_EQ(streamed.map.log_odds(), estimator->map().log_odds());
+  EXPECT_EQ(streamed.traces.at("neff").size(), synced.scans.size());
+  EXPECT_EQ(streamed.statistics.count("mean_neff"), 1u);
+}
+
+TEST(EstimatorRunnerTest, SeedsAreNamedStreamsOfTheRunSeed) {
+  EstimatorConfig a = SmallPf();
+  EstimatorConfig b = a;
+  b.name = "other";
+  const EstimatorRun ra = RunEstimator(a, Records(), 3);
+  const EstimatorRun rb = RunEstimator(b, Records(), 3);
+  const EstimatorRun ra2 = RunEstimator(a, Records(), 3);
+  EXPECT_EQ(ra.final.poses().back().pose, ra2.final.poses().back().pose);
+  EXPECT_NE(ra.final.poses().back().pose, rb.final.poses().back().pose);
+}
+
+TEST(EstimatorRunnerTest, MaxScansStopsThere) {
+  RunLimits limits;
+  limits.max_scans = 25;
+  const EstimatorRun run =
+      RunEstimator(DefaultEstimatorConfig("dr", "dead-reckoning"), Records(), 1, limits);
+  EXPECT_EQ(run.online.size(), 25u);
+}
+
+TEST(EstimatorConfigTest, ReadsWritesAndRereadsEveryField) {
+  const YamlNode node = YamlNode::LoadString(
+      "algorithm: pf\npreset: reports\nparticles: 33\nrefiner: {max_iterations: 4}\n"
+      "odometry: {use_gyro: false}\nmap: {resolution_m: 0.1}\n",
+      "cfg.yaml");
+  const EstimatorConfig config = ParseEstimatorConfig("mine", node);
+  node.CheckAllKeysUsed();
+  YAML::Emitter out;
+  WriteEstimatorConfig(config, &out);
+  const YamlNode again = YamlNode::LoadString(out.c_str(), "again.yaml");
+  const EstimatorConfig reread = ParseEstimatorConfig("mine", again);
+  again.CheckAllKeysUsed();
+  YAML::Emitter out2;
+  WriteEstimatorConfig(reread, &out2);
+  EXPECT_EQ(std::string(out.c_str()), std::string(out2.c_str()));
+  EXPECT_THAT(out.c_str(), ::testing::HasSubstr("particles: 33"));
+  EXPECT_THAT(out.c_str(), ::testing::HasSubstr("motion_noise: gaussian"));  // the preset's
+  EXPECT_FALSE(reread.odometry.use_gyro);
+  JsonWriter json;
+  WriteEstimatorConfigJson(config, &json);
+  EXPECT_THAT(json.Finish(), ::testing::HasSubstr("\"particles\": 33"));
+}
+
+TEST(EstimatorConfigTest, ErrorsNameFileLineAndKey) {
+  const auto error = [](const std::string& text) {
+    try {
+      const YamlNode node = YamlNode::LoadString(text, "s.yaml");
+      ParseEstimatorConfig("pf", node);
+      node.CheckAllKeysUsed();
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_THAT(error("algorithm: nope\n"), ::testing::HasSubstr("s.yaml:1:"));
+  EXPECT_THAT(error("algorithm: nope\n"), ::testing::HasSubstr("unknown algorithm 'nope'"));
+  EXPECT_THAT(error("algorithm: pf\nparticles: 0\n"), ::testing::HasSubstr("particles = 0"));
+  EXPECT_THAT(error("algorithm: pf\nparticle: 3\n"), ::testing::HasSubstr("particle"));
+  EXPECT_THAT(error("algorithm: pf\nmotion_noise: wild\n"),
+              ::testing::HasSubstr("s.yaml:2:15: motion_noise: 'wild' is not one of"));
+  EXPECT_THAT(error("algorithm: pf\npreset: fast\n"), ::testing::HasSubstr("unknown preset"));
+  EXPECT_THAT(error("algorithm: pf\ncorrelation: {xy_half_width_cells: 99}\n"),
+              ::testing::HasSubstr("correlation.xy_half_width_cells = 99"));
+}
+
+}  // namespace
+}  // namespace slamrig::slam

@@ -1,0 +1,32 @@
+#pragma once
+
+#include "slam/pf/particle_filter.h"
+#include "slam/pf/particle_filter_options.h"
+#include "slam/pipeline/algorithm.h"
+#include "slam/pipeline/estimator.h"
+
+namespace slamrig::slam {
+
+/// The particle filter (slam/pf) behind the Estimator interface: the best particle is the
+/// online pose, the weighted mean the second estimate, Neff the per-scan trace.
+class ParticleFilterEstimator final : public Estimator {
+ public:
+  /// `context.seed` replaces `options.seed`.
+  ParticleFilterEstimator(const ParticleFilterOptions& options, const EstimatorContext& context);
+
+  ScanEstimate AddScan(const SyncedScan& scan) override;
+  const OccupancyGrid& map() const override { return filter_.map(); }
+  /// mean_neff (over scans), resamples, updates (scans the filter ran on, not just odometry).
+  std::map<std::string, double> Statistics() const override;
+  EstimatorView View() const override;
+
+ private:
+  static ParticleFilterOptions Seeded(ParticleFilterOptions options, std::uint64_t seed);
+
+  ParticleFilter filter_;
+  double neff_sum_ = 0.0;
+  int scans_ = 0;
+  int updates_ = 0;
+};
+
+}  // namespace slamrig::slam
