@@ -202,8 +202,10 @@ struct RgbdCamera::Impl {
     if (model != nullptr) mj_deleteModel(model);
   }
 
-  // Renders camera `id` and reads the full rendered image into the buffers given.
+  // Renders camera `id` and reads the full rendered image into the buffers given; a depth-only
+  // pass skips the textures (measured: texture sampling is most of llvmpipe's render time).
   void RenderCamera(int id, unsigned char* rgb, float* depth) {
+    option.flags[mjVIS_TEXTURE] = rgb != nullptr ? 1 : 0;
     mjvCamera camera;
     mjv_defaultCamera(&camera);
     camera.type = mjCAMERA_FIXED;

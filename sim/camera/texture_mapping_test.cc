@@ -2,6 +2,9 @@
 // true poses gives a texture map that matches the world's floor.
 #include <gtest/gtest.h>
 
+#include <utility>
+#include <vector>
+
 #include "sim/camera/rgbd_camera.h"
 #include "slam/texture/texture_map.h"
 #include "slam/texture/texture_score.h"
@@ -38,12 +41,14 @@ TEST(TextureMappingTest, StraightDriveWithTruePosesMatchesTheFloor) {
   options.max_m = {6.0, 4.0};
   slam::TextureMap map(options);
   // 0.4 m/s along y = 2 for 8 s at the camera's 10 Hz.
-  int added = 0;
+  std::vector<std::pair<Pose2, RgbdFrame>> frames;
   for (int k = 0; k <= 80; ++k) {
     const double t = k * spec.period_s();
     const Pose2 pose(0.5 + 0.4 * t, 2.0, 0.0);
-    added += map.Insert(camera.Render(pose, Time::FromSeconds(t)), pose);
+    frames.emplace_back(pose, camera.Render(pose, Time::FromSeconds(t)));
   }
+  int added = 0;
+  for (const auto& [pose, frame] : frames) added += map.Insert(frame, pose);
   EXPECT_GT(added, 0);
   const slam::TextureScore score =
       slam::ScoreTexture(map.Colors(), map.Observed(), camera.floor().TruthColors(options),
@@ -57,10 +62,8 @@ TEST(TextureMappingTest, StraightDriveWithTruePosesMatchesTheFloor) {
 
   // The same drive with the poses 0.3 m off: the map no longer matches (the score can fail).
   slam::TextureMap shifted(options);
-  for (int k = 0; k <= 80; ++k) {
-    const double t = k * spec.period_s();
-    const Pose2 pose(0.5 + 0.4 * t, 2.0, 0.0);
-    shifted.Insert(camera.Render(pose, Time::FromSeconds(t)), Pose2(pose.x() + 0.3, 2.1, 0.0));
+  for (const auto& [pose, frame] : frames) {
+    shifted.Insert(frame, Pose2(pose.x() + 0.3, pose.y() + 0.1, 0.0));
   }
   const slam::TextureScore bad =
       slam::ScoreTexture(shifted.Colors(), shifted.Observed(), camera.floor().TruthColors(options),
