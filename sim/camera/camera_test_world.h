@@ -18,7 +18,7 @@ inline void WriteSolidPng(const std::string& dir, const std::string& name, cv::V
 }
 
 /// A 6 m x 4 m room (inner faces x in [-1, 5], y in [-2, 2]) with a red zone x in [2, 3],
-/// y in [-1, 1], as a WorldSpec.
+/// y in [0, 1] (not symmetric, so a mirrored texture shows), as a WorldSpec.
 inline WorldSpec SmallRoom() {
   WorldSpec w;
   w.name = "small_room";
@@ -32,7 +32,7 @@ inline WorldSpec SmallRoom() {
              box(5.1, 0.0, 0.2, 4.0)};
   ZoneSpec zone;
   zone.name = "red rug";
-  zone.shape = box(2.5, 0.0, 1.0, 2.0);
+  zone.shape = box(2.5, 0.5, 1.0, 1.0);
   w.zones = {zone};
   return w;
 }

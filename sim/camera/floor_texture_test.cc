@@ -13,7 +13,8 @@ TEST(FloorTextureTest, ZonesPaintTheirImageOverTheFloorImage) {
   const WorldSpec world = testing::SmallRoom();
   CameraSpec camera = testing::IdealCamera(dir);
   const FloorTexture floor(world, camera);
-  EXPECT_EQ(floor.ColorAt({2.5, 0.0}), cv::Vec3b(200, 30, 30));
+  EXPECT_EQ(floor.ColorAt({2.5, 0.5}), cv::Vec3b(200, 30, 30));
+  EXPECT_EQ(floor.ColorAt({2.5, -0.5}), cv::Vec3b(100, 100, 100));
   EXPECT_EQ(floor.ColorAt({2.5, 1.2}), cv::Vec3b(100, 100, 100));
   EXPECT_EQ(floor.ColorAt({0.0, 0.0}), cv::Vec3b(100, 100, 100));
   // The texture covers the walls (x -1.2..5.2, y -2.2..2.2) plus 1 m.

@@ -6,6 +6,7 @@
 
 #include "sim/camera/camera_test_world.h"
 #include "sim/camera/kinect_disparity.h"
+#include "sim/random_stream.h"
 #include "slam/types/error.h"
 
 namespace slamrig::sim {
@@ -83,10 +84,12 @@ TEST_F(RgbdCameraTest, FloorColoursAreTheTexturesWhereThePinholeModelPutsThem) {
   const Pose2 pose(0.8, 0.1, 0.05);
   const RgbdFrame f = camera.Render(pose, Time());
   // A point on the red zone and one on the grey floor beside it.
-  const Eigen::Vector2d red = Project(f, pose, {2.3, 0.2, 0.0});
-  const Eigen::Vector2d grey = Project(f, pose, {1.7, 0.2, 0.0});
+  const Eigen::Vector2d red = Project(f, pose, {2.3, 0.5, 0.0});
+  const Eigen::Vector2d grey = Project(f, pose, {1.7, 0.5, 0.0});
+  const Eigen::Vector2d mirrored = Project(f, pose, {2.3, -0.5, 0.0});  // beside the zone
   for (const auto& [px, want] :
-       {std::pair{red, cv::Vec3b(200, 30, 30)}, std::pair{grey, cv::Vec3b(100, 100, 100)}}) {
+       {std::pair{red, cv::Vec3b(200, 30, 30)}, std::pair{grey, cv::Vec3b(100, 100, 100)},
+        std::pair{mirrored, cv::Vec3b(100, 100, 100)}}) {
     const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
     ASSERT_TRUE(u >= 0 && u < f.width && v >= 0 && v < f.height) << px.transpose();
     const cv::Vec3b got = RgbAt(f, u, v);
@@ -94,7 +97,7 @@ TEST_F(RgbdCameraTest, FloorColoursAreTheTexturesWhereThePinholeModelPutsThem) {
   }
   // The zone's near edge (x = 2) lies between the two points: the colour changes within a pixel
   // or two of where the model puts it.
-  const Eigen::Vector2d edge = Project(f, pose, {2.0, 0.2, 0.0});
+  const Eigen::Vector2d edge = Project(f, pose, {2.0, 0.5, 0.0});
   const int u = static_cast<int>(std::lround(edge.x()));
   const int v_edge = static_cast<int>(std::lround(edge.y()));
   EXPECT_EQ(RgbAt(f, u, v_edge - 2)[1], 30);   // above the edge: farther, on the zone
@@ -132,6 +135,27 @@ TEST_F(RgbdCameraTest, KinectNoiseIsDeterministicPerSeedAndQuantizedInDisparity)
   EXPECT_EQ(fa.depth_m, fb.depth_m);
   EXPECT_NE(fa.depth_m, fc.depth_m);
   EXPECT_NE(fa.depth_m, q.depth_m);
+}
+
+TEST_F(RgbdCameraTest, DepthNoiseIsTheCamerasOwnStream) {
+  // The noise of pixel after pixel (row-major, pixels that see something) is the camera stream's
+  // Gaussian after Gaussian: RandomStream(seed, "camera"), shared with no other sensor.
+  RgbdCamera ideal(world_, spec_);
+  const RgbdFrame truth = ideal.Render(Pose2(), Time());
+  spec_.depth_model = DepthModel::kKinectDisparity;
+  spec_.disparity_noise_stddev = 1.5;
+  spec_.quantize_disparity = false;
+  RgbdCamera noisy(world_, spec_, 42);
+  const RgbdFrame f = noisy.Render(Pose2(), Time());
+  RandomStream stream(42, "camera");
+  int checked = 0;
+  for (std::size_t i = 0; i < truth.depth_m.size() && checked < 20; ++i) {
+    if (truth.depth_m[i] == 0.0f) continue;
+    const double d = KinectDisparityFromDepth(truth.depth_m[i]) + 1.5 * stream.Gaussian();
+    EXPECT_NEAR(f.depth_m[i], KinectDepthFromDisparity(d), 1e-4) << "pixel " << i;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 20);
 }
 
 TEST_F(RgbdCameraTest, ACameraThatSeesNothingIsAnError) {
