@@ -56,6 +56,33 @@ TEST_F(RgbdCameraTest, WallStraightAheadIsAtItsDistance) {
   EXPECT_NEAR(DepthAt(g, 80, 60), (5.0 - cam_x) / std::cos(0.3), 0.01);
 }
 
+TEST_F(RgbdCameraTest, EveryWallShapeIsDrawnWhereItIs) {
+  // In front of the camera (x = 0.1, looking along +x at 0.5 m height), one shape at a time.
+  ShapeSpec circle;
+  circle.type = ShapeType::kCircle;
+  circle.center_m = {3.0, 0.0};
+  circle.radius_m = 0.3;
+  ShapeSpec polygon;  // a convex triangle with its west edge on x = 2
+  polygon.type = ShapeType::kPolygon;
+  polygon.points_m = {{2.0, -1.0}, {3.0, 0.0}, {2.0, 1.0}};
+  ShapeSpec concave = polygon;  // an arrow head: not convex, drawn as edges
+  concave.points_m = {{2.0, -1.0}, {3.0, 0.0}, {2.0, 1.0}, {2.5, 0.0}};
+  ShapeSpec polyline;  // a thin wall on x = 1.5, drawn 5 cm thick
+  polyline.type = ShapeType::kPolyline;
+  polyline.points_m = {{1.5, -1.0}, {1.5, 1.0}};
+  const std::pair<ShapeSpec, double> cases[] = {{circle, 3.0 - 0.3 - 0.1},
+                                                {polygon, 2.0 - 0.1},
+                                                {concave, 2.5 - 0.025 - 0.1},
+                                                {polyline, 1.5 - 0.025 - 0.1}};
+  for (const auto& [shape, expected] : cases) {
+    WorldSpec world = world_;
+    world.walls.push_back(shape);
+    RgbdCamera camera(world, spec_);
+    const RgbdFrame f = camera.Render(Pose2(), Time());
+    EXPECT_NEAR(DepthAt(f, 80, 60), expected, 0.01) << ShapeTypeName(shape.type);
+  }
+}
+
 TEST_F(RgbdCameraTest, FloorDepthFollowsThePitchRowByRow) {
   // The reports' Kinect: 640 x 480, f = 585.05, off-centre principal point, pitch 0.36 rad.
   CameraSpec spec = spec_;
