@@ -1,0 +1,144 @@
+#include "slam/texture/texture_map.h"
+
+#include <cmath>
+
+#include "slam/types/error.h"
+#include "slam/types/validation.h"
+
+namespace slamrig::slam {
+
+int TextureMapOptions::width() const {
+  return static_cast<int>(std::ceil((max_m.x() - min_m.x()) / resolution_m - 1e-9));
+}
+
+int TextureMapOptions::height() const {
+  return static_cast<int>(std::ceil((max_m.y() - min_m.y()) / resolution_m - 1e-9));
+}
+
+std::vector<std::string> TextureMapOptions::Validate() const {
+  std::vector<std::string> e;
+  if (!(resolution_m > 0.0) || !std::isfinite(resolution_m)) {
+    e.push_back(RuleViolation("texture.resolution_m", resolution_m, "must be > 0"));
+    return e;
+  }
+  if (!(max_m.x() > min_m.x())) {
+    e.push_back(RuleViolation("texture.max_m.x", max_m.x(), "must be > texture.min_m.x"));
+  }
+  if (!(max_m.y() > min_m.y())) {
+    e.push_back(RuleViolation("texture.max_m.y", max_m.y(), "must be > texture.min_m.y"));
+  }
+  if (e.empty() && static_cast<double>(width()) * height() > 1e8) {
+    e.push_back(RuleViolation("texture.resolution_m", resolution_m,
+                              "gives more than 1e8 cells over the extents"));
+  }
+  if (!(floor_height_threshold_m > 0.0)) {
+    e.push_back(
+        RuleViolation("texture.floor_height_threshold_m", floor_height_threshold_m, "must be > 0"));
+  }
+  if (!(max_depth_m > 0.0)) {
+    e.push_back(RuleViolation("texture.max_depth_m", max_depth_m, "must be > 0"));
+  }
+  if (pixel_stride < 1) {
+    e.push_back(RuleViolation("texture.pixel_stride", pixel_stride, "must be >= 1"));
+  }
+  return e;
+}
+
+TextureMap::TextureMap(const TextureMapOptions& options) : options_(options) {
+  const std::vector<std::string> errors = options_.Validate();
+  if (!errors.empty()) throw ConfigError(errors.front());
+  width_ = options_.width();
+  height_ = options_.height();
+  sums_.assign(static_cast<std::size_t>(width_) * height_ * 3, 0);
+  counts_.assign(static_cast<std::size_t>(width_) * height_, 0);
+}
+
+bool TextureMap::CellOf(double x_m, double y_m, int* col, int* row) const {
+  const double fx = std::floor((x_m - options_.min_m.x()) / options_.resolution_m);
+  const double fy = std::floor((options_.max_m.y() - y_m) / options_.resolution_m);
+  if (!(fx >= 0.0 && fx < width_ && fy >= 0.0 && fy < height_)) return false;
+  *col = static_cast<int>(fx);
+  *row = static_cast<int>(fy);
+  return true;
+}
+
+Eigen::Vector2d TextureMap::CellCenter(int col, int row) const {
+  return {options_.min_m.x() + (col + 0.5) * options_.resolution_m,
+          options_.max_m.y() - (row + 0.5) * options_.resolution_m};
+}
+
+int TextureMap::Insert(const RgbdFrame& frame, const Pose2& map_from_base) {
+  const std::size_t pixels = static_cast<std::size_t>(frame.width) * frame.height;
+  if (frame.width <= 0 || frame.height <= 0 || frame.rgb.size() != 3 * pixels ||
+      frame.depth_m.size() != pixels) {
+    throw ConfigError("texture: RGB-D frame of " + std::to_string(frame.width) + " x " +
+                      std::to_string(frame.height) + " has " + std::to_string(frame.rgb.size()) +
+                      " RGB bytes and " + std::to_string(frame.depth_m.size()) + " depths");
+  }
+  // map_from_base in 3D: the robot on the floor plane.
+  Eigen::Isometry3d map_from_base3 = Eigen::Isometry3d::Identity();
+  map_from_base3.translation() = Eigen::Vector3d(map_from_base.x(), map_from_base.y(), 0.0);
+  map_from_base3.linear() =
+      Eigen::AngleAxisd(map_from_base.theta(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Isometry3d map_from_depth = map_from_base3 * frame.BaseFromDepthOptical();
+  const Eigen::Matrix3d rot = map_from_depth.linear();
+  const Eigen::Vector3d trans = map_from_depth.translation();
+  const CameraIntrinsics& k = frame.intrinsics;
+  const double offset = frame.depth_offset_x_m;
+  const int stride = options_.pixel_stride;
+
+  int added = 0;
+  for (int v = 0; v < frame.height; v += stride) {
+    for (int u = 0; u < frame.width; u += stride) {
+      const double z = frame.depth_m[static_cast<std::size_t>(v) * frame.width + u];
+      if (!(z > 0.0) || z > options_.max_depth_m) continue;
+      // Back-project in the depth camera's optical frame, then to the map.
+      const Eigen::Vector3d p_depth((u - k.cx_px) / k.fx_px * z, (v - k.cy_px) / k.fy_px * z, z);
+      const Eigen::Vector3d p_map = rot * p_depth + trans;
+      if (std::abs(p_map.z()) > options_.floor_height_threshold_m) continue;
+      int col = 0, row = 0;
+      if (!CellOf(p_map.x(), p_map.y(), &col, &row)) continue;
+      // The same point in the RGB optical frame (same orientation, origin -offset along x).
+      const double xr = p_depth.x() + offset;
+      const double ur = std::round(k.fx_px * xr / z + k.cx_px);
+      const double vr = std::round(k.fy_px * p_depth.y() / z + k.cy_px);
+      if (!(ur >= 0.0 && ur < frame.width && vr >= 0.0 && vr < frame.height)) continue;
+      const std::size_t src =
+          3 * (static_cast<std::size_t>(vr) * frame.width + static_cast<std::size_t>(ur));
+      const std::size_t cell = static_cast<std::size_t>(row) * width_ + col;
+      sums_[3 * cell] += frame.rgb[src];
+      sums_[3 * cell + 1] += frame.rgb[src + 1];
+      sums_[3 * cell + 2] += frame.rgb[src + 2];
+      ++counts_[cell];
+      ++added;
+    }
+  }
+  return added;
+}
+
+cv::Mat3b TextureMap::Colors() const {
+  cv::Mat3b out(height_, width_, cv::Vec3b(0, 0, 0));
+  for (int row = 0; row < height_; ++row) {
+    for (int col = 0; col < width_; ++col) {
+      const std::size_t cell = static_cast<std::size_t>(row) * width_ + col;
+      const std::uint32_t n = counts_[cell];
+      if (n == 0) continue;
+      for (int c = 0; c < 3; ++c) {
+        out(row, col)[c] = static_cast<std::uint8_t>((sums_[3 * cell + c] + n / 2) / n);
+      }
+    }
+  }
+  return out;
+}
+
+cv::Mat1b TextureMap::Observed() const {
+  cv::Mat1b out(height_, width_, std::uint8_t{0});
+  for (int row = 0; row < height_; ++row) {
+    for (int col = 0; col < width_; ++col) {
+      if (counts_[static_cast<std::size_t>(row) * width_ + col] > 0) out(row, col) = 255;
+    }
+  }
+  return out;
+}
+
+}  // namespace slamrig::slam
