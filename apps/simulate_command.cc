@@ -9,9 +9,9 @@
 
 #include "apps/cli_args.h"
 #include "apps/commands.h"
+#include "scenarios/recording.h"
 #include "sim/presets.h"
 #include "sim/robot_yaml.h"
-#include "sim/run_writer.h"
 #include "sim/world_yaml.h"
 #include "slam/types/error.h"
 
@@ -51,7 +51,7 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
   options.physics_rate_hz = physics_rate_hz;
   if (laps != 0) options.world.drive.laps = laps;
   for (const std::string& e : options.Validate()) throw ConfigError("slamrig simulate: " + e);
-  sim::RunOptions run;
+  scenario::RunOptions run;
   run.duration_s = duration_s;
   for (const std::string& e : run.Validate()) throw ConfigError("slamrig simulate: --" + e);
   if (duration_s == 0.0 && options.world.drive.mode == sim::DriveMode::kIdle) {
@@ -60,7 +60,7 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
   }
 
   const auto start = std::chrono::steady_clock::now();
-  const sim::RunSummary summary = sim::WriteSimulationRun(options, run, out_dir);
+  const scenario::RunSummary summary = scenario::RecordSimulation(options, run, out_dir);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const Pose2 error = summary.final_truth.Between(options.world.spawn * summary.final_odometry);

@@ -4,9 +4,9 @@
 // truth and at most half of dead reckoning's on the same odometry.
 #include <gtest/gtest.h>
 
+#include "scenarios/recording.h"
 #include "sim/presets.h"
 #include "sim/robot_yaml.h"
-#include "sim/run_writer.h"
 #include "sim/world_yaml.h"
 #include "slam/eval/trajectory_error.h"
 #include "slam/io/log_reader.h"
@@ -23,7 +23,7 @@ TEST(PfOfficeTest, ThreeLapsWithinTenCentimetresAndHalfOfDeadReckoning) {
   options.robot = sim::LoadRobotSpec(sim::FindPresetFile("ece276a", "robots"));
   options.seed = 1;
   ASSERT_EQ(options.world.drive.laps, 3);
-  sim::WriteSimulationRun(options, sim::RunOptions{}, dir.path().string());
+  scenario::RecordSimulation(options, scenario::RunOptions{}, dir.path().string());
 
   const slam::Dataset data = slam::ReadLog(dir.File("run.log"));
   Trajectory truth;

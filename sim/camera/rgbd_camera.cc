@@ -15,8 +15,8 @@
 
 #include "sim/camera/egl_context.h"
 #include "sim/camera/kinect_disparity.h"
-#include "sim/random_stream.h"
 #include "slam/types/error.h"
+#include "slam/types/random_stream.h"
 
 namespace slamrig::sim {
 namespace {

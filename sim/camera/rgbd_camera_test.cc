@@ -6,8 +6,8 @@
 
 #include "sim/camera/camera_test_world.h"
 #include "sim/camera/kinect_disparity.h"
-#include "sim/random_stream.h"
 #include "slam/types/error.h"
+#include "slam/types/random_stream.h"
 
 namespace slamrig::sim {
 namespace {

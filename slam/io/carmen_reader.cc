@@ -80,15 +80,23 @@ class Fields {
                  Number(i + 2, field + ".theta"));
   }
 
+  // Parsed straight into floats (what a scan holds), so the shortest float text slamrig writes
+  // reads back bit for bit; the field name is only built for an error.
   std::vector<float> Ranges(std::size_t first, int n) const {
     std::vector<float> ranges(static_cast<std::size_t>(n));
     for (int k = 0; k < n; ++k) {
-      const double r =
-          Number(first + static_cast<std::size_t>(k), "range[" + std::to_string(k) + "]");
-      if (r < 0.0) {
-        throw LineError{"range[" + std::to_string(k) + "]", "negative range " + std::to_string(r)};
+      const std::string_view t = tokens_[first + static_cast<std::size_t>(k)];
+      float r = 0.0f;
+      const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), r);
+      if (ec != std::errc() || end != t.data() + t.size() || !std::isfinite(r) || r < 0.0f) {
+        const std::string field = "range[" + std::to_string(k) + "]";
+        Number(first + static_cast<std::size_t>(k), field);  // names a non-number or NaN
+        if (ec == std::errc::result_out_of_range) {
+          throw LineError{field, "out of range for a float: '" + std::string(t) + "'"};
+        }
+        throw LineError{field, "negative range " + std::string(t)};
       }
-      ranges[static_cast<std::size_t>(k)] = static_cast<float>(r);
+      ranges[static_cast<std::size_t>(k)] = r;
     }
     return ranges;
   }

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -11,10 +12,14 @@
 namespace slamrig::slam {
 namespace {
 
-void Append(std::string* out, double value) {
+// Numbers are written in their shortest form that reads back exactly (std::to_chars): a log
+// read back gives bit-identical records, and formatting costs a fraction of printf's.
+template <typename T>
+void Append(std::string* out, T value) {
   char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), " %.17g", value);
-  *out += buffer;
+  buffer[0] = ' ';
+  const auto end = std::to_chars(buffer + 1, buffer + sizeof(buffer), value).ptr;
+  out->append(buffer, end);
 }
 
 void AppendPose(std::string* out, const Pose2& p) {
@@ -24,6 +29,7 @@ void AppendPose(std::string* out, const Pose2& p) {
 }
 
 constexpr const char* kHost = "slamrig";
+constexpr std::size_t kFlushBytes = 1 << 20;
 
 }  // namespace
 
@@ -32,8 +38,9 @@ CarmenWriter::CarmenWriter(std::string path)
   std::FILE* f = std::fopen(tmp_path_.c_str(), "wb");
   if (f == nullptr) throw std::runtime_error(path_ + ": cannot write: " + std::strerror(errno));
   file_ = f;
-  WriteLine("# CARMEN log written by slamrig");
-  WriteLine("# message formats defined: PARAM ODOM ROBOTLASER1 TRUEPOS");
+  buffer_.reserve(2 * kFlushBytes);
+  buffer_ += "# CARMEN log written by slamrig\n";
+  buffer_ += "# message formats defined: PARAM ODOM ROBOTLASER1 TRUEPOS\n";
 }
 
 CarmenWriter::~CarmenWriter() {
@@ -43,66 +50,73 @@ CarmenWriter::~CarmenWriter() {
   }
 }
 
-void CarmenWriter::WriteLine(const std::string& line) {
+void CarmenWriter::EndLine() {
+  if (file_ == nullptr) throw std::logic_error("CarmenWriter used after Commit()");
+  buffer_ += '\n';
+  if (buffer_.size() >= kFlushBytes) Flush();
+}
+
+void CarmenWriter::Flush() {
   auto* f = static_cast<std::FILE*>(file_);
-  if (f == nullptr) throw std::logic_error("CarmenWriter used after Commit()");
-  if (std::fwrite(line.data(), 1, line.size(), f) != line.size() || std::fputc('\n', f) == EOF) {
+  if (std::fwrite(buffer_.data(), 1, buffer_.size(), f) != buffer_.size()) {
     throw std::runtime_error(path_ + ": write failed: " + std::strerror(errno));
   }
+  buffer_.clear();
 }
 
 void CarmenWriter::Stamp(Time time) {
-  char buffer[96];
   const double t = time.seconds();
-  std::snprintf(buffer, sizeof(buffer), " %.17g %s %.17g", t, kHost, t);
-  pending_ += buffer;
+  Append(&buffer_, t);
+  buffer_ += ' ';
+  buffer_ += kHost;
+  Append(&buffer_, t);
 }
 
 void CarmenWriter::WriteParam(const std::string& key, const std::string& value) {
-  WriteLine("PARAM " + key + " " + value + " " + kHost + " 0");
+  buffer_ += "PARAM " + key + " " + value + " " + kHost + " 0";
+  EndLine();
 }
 
 void CarmenWriter::WriteOdometry(const OdometryPose& odom, double tv_m_s, double rv_rad_s) {
-  pending_ = "ODOM";
-  AppendPose(&pending_, odom.odom_from_base);
-  Append(&pending_, tv_m_s);
-  Append(&pending_, rv_rad_s);
-  Append(&pending_, 0.0);
+  buffer_ += "ODOM";
+  AppendPose(&buffer_, odom.odom_from_base);
+  Append(&buffer_, tv_m_s);
+  Append(&buffer_, rv_rad_s);
+  Append(&buffer_, 0.0);
   Stamp(odom.time);
-  WriteLine(pending_);
+  EndLine();
 }
 
 void CarmenWriter::WriteLaser(const LaserScan& scan, const Pose2& odom_from_base_at_scan) {
-  pending_ = "ROBOTLASER1 0";
+  buffer_ += "ROBOTLASER1 0";
   const double n = static_cast<double>(scan.ranges_m.size());
-  Append(&pending_, scan.angle_min_rad);
-  Append(&pending_, scan.angle_increment_rad * (n > 0 ? n - 1 : 0));  // field of view
-  Append(&pending_, scan.angle_increment_rad);
-  Append(&pending_, scan.range_max_m);
-  pending_ += " 0.01 0 " + std::to_string(scan.ranges_m.size());
-  char buffer[24];
-  for (const float r : scan.ranges_m) {
-    std::snprintf(buffer, sizeof(buffer), " %.9g", static_cast<double>(r));
-    pending_ += buffer;
-  }
-  pending_ += " 0";  // no remissions
-  AppendPose(&pending_, odom_from_base_at_scan * scan.base_from_laser);
-  AppendPose(&pending_, odom_from_base_at_scan);
-  pending_ += " 0 0 0 0 0";  // tv rv forward_safety side_safety turn_axis
+  Append(&buffer_, scan.angle_min_rad);
+  Append(&buffer_, scan.angle_increment_rad * (n > 0 ? n - 1 : 0));  // field of view
+  Append(&buffer_, scan.angle_increment_rad);
+  Append(&buffer_, scan.range_max_m);
+  buffer_ += " 0.01 0";
+  Append(&buffer_, scan.ranges_m.size());
+  for (const float r : scan.ranges_m) Append(&buffer_, r);
+  buffer_ += " 0";  // no remissions
+  AppendPose(&buffer_, odom_from_base_at_scan * scan.base_from_laser);
+  AppendPose(&buffer_, odom_from_base_at_scan);
+  buffer_ += " 0 0 0 0 0";  // tv rv forward_safety side_safety turn_axis
   Stamp(scan.time);
-  WriteLine(pending_);
+  EndLine();
 }
 
 void CarmenWriter::WriteTruePos(const GroundTruthPose& truth, const Pose2& odom_from_base) {
-  pending_ = "TRUEPOS";
-  AppendPose(&pending_, truth.map_from_base);
-  AppendPose(&pending_, odom_from_base);
+  buffer_ += "TRUEPOS";
+  AppendPose(&buffer_, truth.map_from_base);
+  AppendPose(&buffer_, odom_from_base);
   Stamp(truth.time);
-  WriteLine(pending_);
+  EndLine();
 }
 
 void CarmenWriter::Commit() {
   auto* f = static_cast<std::FILE*>(file_);
+  if (f == nullptr) throw std::logic_error("CarmenWriter committed twice");
+  Flush();
   file_ = nullptr;
   const bool ok = std::fflush(f) == 0;
   const bool closed = std::fclose(f) == 0;

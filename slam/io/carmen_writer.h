@@ -7,9 +7,10 @@
 namespace slamrig::slam {
 
 /// Writes a CARMEN log that ReadCarmenLog and other CARMEN tools read: PARAM, ODOM, ROBOTLASER1
-/// and TRUEPOS lines, in the order they are written, with full double precision (so a log read
-/// back gives bit-identical records). Nothing appears at `path` until Commit() renames the
-/// temporary file into place; destroying an uncommitted writer removes it.
+/// and TRUEPOS lines, in the order they are written, every number in its shortest exact form (so
+/// a log read back gives bit-identical records), buffered in large blocks. Nothing appears at
+/// `path` until Commit() renames the temporary file into place; destroying an uncommitted writer
+/// removes it.
 class CarmenWriter {
  public:
   explicit CarmenWriter(std::string path);
@@ -29,12 +30,13 @@ class CarmenWriter {
   void Commit();
 
  private:
-  void WriteLine(const std::string& line);
+  void EndLine();
+  void Flush();
   void Stamp(Time time);
 
   std::string path_;
   std::string tmp_path_;
-  std::string pending_;
+  std::string buffer_;    // lines not yet written
   void* file_ = nullptr;  // FILE*
 };
 

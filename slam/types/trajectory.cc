@@ -27,9 +27,10 @@ std::optional<Pose2> Trajectory::Interpolate(Time time) const {
   if (after->time == time || after == poses_.begin()) return after->pose;
   const auto before = after - 1;
   const double span = SecondsBetween(after->time, before->time);
-  const double s = SecondsBetween(time, before->time) / span;
-  const Pose2& a = before->pose;
-  const Pose2& b = after->pose;
+  return InterpolatePoses(before->pose, after->pose, SecondsBetween(time, before->time) / span);
+}
+
+Pose2 InterpolatePoses(const Pose2& a, const Pose2& b, double s) {
   return Pose2(a.x() + s * (b.x() - a.x()), a.y() + s * (b.y() - a.y()),
                a.theta() + s * NormalizeAngle(b.theta() - a.theta()));
 }

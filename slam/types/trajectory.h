@@ -15,6 +15,10 @@ struct StampedPose {
   friend bool operator==(const StampedPose&, const StampedPose&) = default;
 };
 
+/// The pose a fraction `s` of the way from `a` to `b`: linear in x and y, the angle along the
+/// shorter arc (s = 0 gives a, s = 1 gives b's position and an angle equal to b's modulo 2 pi).
+Pose2 InterpolatePoses(const Pose2& a, const Pose2& b, double s);
+
 /// A sequence of stamped poses (an estimate or a reference), in the order they were produced
 /// (one per scan, say). Stamps are normally non-decreasing; a real log's stamps may go backwards
 /// in places, and then each pose still keeps its own stamp (`time_ordered()` is false) rather than

@@ -1,4 +1,4 @@
-#include "sim/run_writer.h"
+#include "scenarios/recording.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include "slam/io/carmen_reader.h"
 #include "slam/io/tum_io.h"
 
-namespace slamrig::sim {
+namespace slamrig::scenario {
 namespace {
 
 std::string Slurp(const std::string& path) {
@@ -21,9 +21,9 @@ std::string Slurp(const std::string& path) {
   return s.str();
 }
 
-SimulatorOptions Office(std::uint64_t seed) {
-  SimulatorOptions o;
-  o.world = LoadWorldSpec(FindPresetFile("office", "worlds"));
+sim::SimulatorOptions Office(std::uint64_t seed) {
+  sim::SimulatorOptions o;
+  o.world = sim::LoadWorldSpec(sim::FindPresetFile("office", "worlds"));
   o.seed = seed;
   return o;
 }
@@ -31,7 +31,7 @@ SimulatorOptions Office(std::uint64_t seed) {
 RunSummary WriteRun(std::uint64_t seed, const std::string& name) {
   RunOptions run;
   run.duration_s = 3.0;
-  return WriteSimulationRun(Office(seed), run, testing::TempDir() + "/" + name);
+  return RecordSimulation(Office(seed), run, testing::TempDir() + "/" + name);
 }
 
 TEST(RunWriterTest, SameSeedByteIdenticalFilesOtherSeedOtherNoise) {
@@ -72,4 +72,4 @@ TEST(RunWriterTest, OurCarmenReaderReadsTheLogBack) {
 }
 
 }  // namespace
-}  // namespace slamrig::sim
+}  // namespace slamrig::scenario

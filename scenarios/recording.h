@@ -6,7 +6,7 @@
 #include "sim/simulator.h"
 #include "slam/types/pose2.h"
 
-namespace slamrig::sim {
+namespace slamrig::scenario {
 
 /// How long a written run lasts.
 struct RunOptions {
@@ -32,16 +32,17 @@ struct RunSummary {
   std::vector<std::string> files;  ///< paths written
 };
 
-/// Runs a simulation and writes it into `out_dir` (created if missing), every file atomically:
-///  - run.log: a CARMEN log (PARAM, ODOM, ROBOTLASER1, TRUEPOS). ODOM is the robot's own
-///    odometry, slam::WheelOdometry on the encoder ticks and gyro with the nominal radius and
-///    track; each scan carries the odometry pose interpolated to its time, and a TRUEPOS line
-///    follows it with the ground truth.
+/// Runs a simulation and records it into `out_dir` (created if missing), every file atomically.
+/// The simulator only emits records and the truth; what is written is the sinks' business:
+///  - run.log: a CARMEN log through slam::CarmenSink (PARAM, ODOM, ROBOTLASER1, TRUEPOS). ODOM
+///    is the robot's own odometry, computed there from the encoder ticks and gyro with the
+///    nominal radius and track; each scan carries the odometry pose interpolated to its time,
+///    and a TRUEPOS line follows it with the ground truth.
 ///  - truth.tum: ground truth at every scan time (TUM format).
 ///  - world.yaml, robot.yaml: the resolved world and robot; sim.yaml: seed, rates, duration.
 /// Equal options give byte-identical files. Throws std::runtime_error when a file cannot be
 /// written.
-RunSummary WriteSimulationRun(const SimulatorOptions& options, const RunOptions& run,
-                              const std::string& out_dir);
+RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptions& run,
+                            const std::string& out_dir);
 
-}  // namespace slamrig::sim
+}  // namespace slamrig::scenario
