@@ -16,6 +16,10 @@ std::vector<std::string> PoseGraphOptimizerOptions::Validate() const {
     errors.push_back(
         RuleViolation("graph.robust_loss_scale", robust_loss_scale, "must be finite and > 0"));
   }
+  if (!(initial_trust_region_radius > 0.0) || !std::isfinite(initial_trust_region_radius)) {
+    errors.push_back(RuleViolation("graph.initial_trust_region_radius", initial_trust_region_radius,
+                                   "must be finite and > 0"));
+  }
   if (num_threads < 1) {
     errors.push_back(RuleViolation("graph.num_threads", num_threads, "must be >= 1"));
   }
