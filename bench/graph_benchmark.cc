@@ -32,10 +32,11 @@ slam::PoseGraph Initialised(const std::string& name, const std::string& init) {
 }
 
 void Optimize(benchmark::State& state, const std::string& name, const std::string& init,
-              slam::TrustRegion strategy) {
+              slam::TrustRegion strategy, bool autodiff) {
   const slam::PoseGraph start = Initialised(name, init);
   slam::PoseGraphOptimizerOptions options;
   options.trust_region = strategy;
+  options.autodiff_jacobians = autodiff;
   const slam::PoseGraphOptimizer optimizer(options);
   slam::PoseGraphSummary summary;
   for (auto _ : state) {
@@ -71,10 +72,17 @@ void RegisterAll() {
            {slam::TrustRegion::kLevenbergMarquardt, slam::TrustRegion::kDogleg}) {
         const std::string label =
             std::string("BM_Optimize/") + name + "/" + init + "/" + slam::TrustRegionName(strategy);
-        benchmark::RegisterBenchmark(label.c_str(), Optimize, name, init, strategy)
-            ->Unit(benchmark::kMillisecond)
-            ->MeasureProcessCPUTime()
-            ->UseRealTime();
+        for (const bool autodiff : {false, true}) {
+          // Autodiff only where it is compared: Levenberg-Marquardt from chordal.
+          const bool compared =
+              strategy == slam::TrustRegion::kLevenbergMarquardt && init == std::string("chordal");
+          if (autodiff && !compared) continue;
+          benchmark::RegisterBenchmark((label + (autodiff ? "/autodiff" : "")).c_str(), Optimize,
+                                       name, init, strategy, autodiff)
+              ->Unit(benchmark::kMillisecond)
+              ->MeasureProcessCPUTime()
+              ->UseRealTime();
+        }
       }
     }
   }

@@ -5,6 +5,7 @@
 #include <Eigen/Cholesky>
 #include <array>
 #include <memory>
+#include <numbers>
 #include <vector>
 
 #include "slam/graph/edge_error.h"
@@ -39,6 +40,37 @@ class EdgeCost final : public ceres::SizedCostFunction<3, 3, 3> {
         j = sqrt_information_ * e.d_error_d_xj;
       }
     }
+    return true;
+  }
+
+ private:
+  Pose2 measurement_;
+  Eigen::Matrix3d sqrt_information_;
+};
+
+// The same residual, templated for Ceres's automatic differentiation (the cross-check of the
+// analytic Jacobians, and their benchmark baseline).
+class EdgeResidual {
+ public:
+  EdgeResidual(const Pose2& measurement, const Eigen::Matrix3d& information)
+      : measurement_(measurement),
+        sqrt_information_(Eigen::LLT<Eigen::Matrix3d>(information).matrixU()) {}
+
+  template <typename T>
+  bool operator()(const T* xi, const T* xj, T* residuals) const {
+    using std::cos, std::sin;
+    const T ci = cos(xi[2]), si = sin(xi[2]);
+    const T dx = xj[0] - xi[0], dy = xj[1] - xi[1];
+    const T ux = ci * dx + si * dy - measurement_.x();
+    const T uy = -si * dx + ci * dy - measurement_.y();
+    const double cz = std::cos(measurement_.theta()), sz = std::sin(measurement_.theta());
+    // Wrapped into [-pi, pi); the derivative of the wrap is 1 wherever it is defined.
+    const T angle = xj[2] - xi[2] - measurement_.theta();
+    const double two_pi = 2.0 * std::numbers::pi;
+    const T wrapped = angle - two_pi * ceres::floor((angle + std::numbers::pi) / two_pi);
+    const Eigen::Matrix<T, 3, 1> e(cz * ux + sz * uy, -sz * ux + cz * uy, wrapped);
+    Eigen::Map<Eigen::Matrix<T, 3, 1>> r(residuals);
+    r = sqrt_information_.cast<T>() * e;
     return true;
   }
 
@@ -138,8 +170,12 @@ PoseGraphSummary PoseGraphOptimizer::Optimize(PoseGraph* graph) const {
   ceres::Problem problem(problem_options);
   for (const PoseGraphEdge& e : graph->edges()) {
     const bool robust = options_.robust_loss_on_all_edges || e.kind == EdgeKind::kLoopClosure;
-    problem.AddResidualBlock(new EdgeCost(e.measurement, e.information),
-                             robust ? loss.get() : nullptr, x[graph->IndexOf(e.from)].data(),
+    ceres::CostFunction* cost = options_.autodiff_jacobians
+                                    ? static_cast<ceres::CostFunction*>(
+                                          new ceres::AutoDiffCostFunction<EdgeResidual, 3, 3, 3>(
+                                              new EdgeResidual(e.measurement, e.information)))
+                                    : new EdgeCost(e.measurement, e.information);
+    problem.AddResidualBlock(cost, robust ? loss.get() : nullptr, x[graph->IndexOf(e.from)].data(),
                              x[graph->IndexOf(e.to)].data());
   }
   if (problem.NumResidualBlocks() == 0) {

@@ -29,6 +29,9 @@ struct PoseGraphOptimizerOptions {
   double robust_loss_scale = 1.0;
   /// Apply the robust loss to every edge instead of loop closures only.
   bool robust_loss_on_all_edges = false;
+  /// Differentiate the residual with Ceres's automatic differentiation instead of the analytic
+  /// Jacobians (edge_error.h): same optimum, slower; for cross-checks and benchmarks.
+  bool autodiff_jacobians = false;
   /// Ceres threads for evaluation and linear algebra. 1 keeps results bit-identical.
   int num_threads = 1;
   /// Stop when the relative decrease of the cost falls below this (Ceres function_tolerance).

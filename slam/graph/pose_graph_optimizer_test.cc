@@ -165,6 +165,72 @@ TEST(PoseGraphOptimizerTest, DoglegReachesTheSameOptimum) {
   EXPECT_NEAR(chi2_dogleg, chi2_lm, 1e-6 * chi2_lm);
 }
 
+TEST(PoseGraphOptimizerTest, AutodiffJacobiansReachTheSameOptimum) {
+  testing::RandomPoseGraph r = testing::MakeRandomPoseGraph({.num_poses = 60, .seed = 15});
+  InitializeFromOdometry(&r.graph);
+  PoseGraph analytic = r.graph, autodiff = r.graph;
+  PoseGraphOptimizerOptions options;
+  options.autodiff_jacobians = true;
+  const PoseGraphSummary a = PoseGraphOptimizer({}).Optimize(&analytic);
+  const PoseGraphSummary b = PoseGraphOptimizer(options).Optimize(&autodiff);
+  EXPECT_EQ(a.iterations, b.iterations);
+  EXPECT_NEAR(a.final_chi2, b.final_chi2, 1e-9 * a.final_chi2);
+  for (std::size_t i = 0; i < analytic.vertices().size(); ++i) {
+    EXPECT_NEAR(analytic.vertices()[i].pose.x(), autodiff.vertices()[i].pose.x(), 1e-9);
+    EXPECT_NEAR(analytic.vertices()[i].pose.y(), autodiff.vertices()[i].pose.y(), 1e-9);
+  }
+}
+
+TEST(PoseGraphOptimizerTest, IncrementalUseEndsAtTheBatchOptimum) {
+  // A front end adds one pose and its edges at a time and re-optimises from where it left off.
+  const testing::RandomPoseGraph r =
+      testing::MakeRandomPoseGraph({.num_poses = 50, .loop_closure_probability = 0.4, .seed = 16});
+  PoseGraph online;
+  const PoseGraphOptimizer optimizer({});
+  online.AddVertex(0, Pose2());
+  std::size_t next_edge = 0;
+  for (int id = 1; id < 50; ++id) {
+    const PoseGraphEdge* odometry = nullptr;
+    for (const PoseGraphEdge& e : r.graph.edges()) {
+      if (e.kind == EdgeKind::kOdometry && e.to == id) odometry = &e;
+    }
+    online.AddVertex(id, online.pose(id - 1) * odometry->measurement);
+    bool loop_closed = false;
+    for (; next_edge < r.graph.edges().size(); ++next_edge) {
+      const PoseGraphEdge& e = r.graph.edges()[next_edge];
+      if (e.kind == EdgeKind::kOdometry) {
+        if (e.to > id) break;
+        online.AddEdge(e);
+      }
+    }
+    for (const PoseGraphEdge& e : r.graph.edges()) {
+      if (e.kind == EdgeKind::kLoopClosure && e.to == id) {
+        online.AddEdge(e);
+        loop_closed = true;
+      }
+    }
+    if (loop_closed) optimizer.Optimize(&online);
+  }
+  optimizer.Optimize(&online);
+  PoseGraph batch = r.graph;
+  InitializeFromOdometry(&batch);
+  const double batch_chi2 = optimizer.Optimize(&batch).final_chi2;
+  EXPECT_EQ(online.edges().size(), batch.edges().size());
+  EXPECT_NEAR(Chi2(online), batch_chi2, 1e-6 * batch_chi2);
+}
+
+TEST(PoseGraphOptimizerTest, EmptyAndEdgelessGraphsAreNoOps) {
+  PoseGraph empty;
+  EXPECT_TRUE(PoseGraphOptimizer({}).Optimize(&empty).converged);
+  PoseGraph lonely;
+  lonely.AddVertex(3, Pose2(1, 2, 3));
+  lonely.AddVertex(4, Pose2(4, 5, 6));
+  const PoseGraphSummary s = PoseGraphOptimizer({}).Optimize(&lonely);
+  EXPECT_TRUE(s.converged);
+  EXPECT_EQ(s.final_chi2, 0.0);
+  EXPECT_EQ(lonely.pose(4), Pose2(4, 5, 6));
+}
+
 TEST(PoseGraphOptimizerOptionsTest, ValidateNamesFieldValueAndRule) {
   PoseGraphOptimizerOptions o;
   EXPECT_TRUE(o.Validate().empty());
