@@ -1,11 +1,11 @@
 #include "slam/graph/g2o_io.h"
 
 #include <Eigen/Cholesky>
-#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <set>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "slam/io/atomic_file.h"

@@ -1,5 +1,7 @@
 #include "slam/graph/pose_graph.h"
 
+#include <Eigen/Cholesky>
+
 #include "slam/types/check.h"
 
 namespace slamrig::slam {
@@ -14,6 +16,10 @@ void PoseGraph::AddEdge(const PoseGraphEdge& edge) {
   SLAMRIG_CHECK(HasVertex(edge.from) && HasVertex(edge.to),
                 "PoseGraph::AddEdge: edge to a vertex that was never added");
   SLAMRIG_CHECK(edge.from != edge.to, "PoseGraph::AddEdge: edge from a vertex to itself");
+  SLAMRIG_CHECK(edge.information.allFinite() &&
+                    edge.information.isApprox(edge.information.transpose()) &&
+                    Eigen::LLT<Eigen::Matrix3d>(edge.information).info() == Eigen::Success,
+                "PoseGraph::AddEdge: information is not symmetric positive definite");
   edges_.push_back(edge);
 }
 

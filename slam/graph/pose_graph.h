@@ -39,8 +39,9 @@ class PoseGraph {
  public:
   /// Adds a vertex. `id` must be new (SLAMRIG_CHECK): callers check HasVertex() for input data.
   void AddVertex(int id, const Pose2& pose, bool fixed = false);
-  /// Adds an edge. Both ends must exist (SLAMRIG_CHECK) and differ; the information matrix
-  /// must be symmetric positive definite (checked by the readers, where data enters).
+  /// Adds an edge. Both ends must exist and differ, and the information matrix must be
+  /// symmetric positive definite (SLAMRIG_CHECK; the readers reject such input with a
+  /// ParseError before it gets here).
   void AddEdge(const PoseGraphEdge& edge);
 
   bool HasVertex(int id) const { return index_.count(id) != 0; }

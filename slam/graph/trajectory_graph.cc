@@ -1,16 +1,9 @@
 #include "slam/graph/trajectory_graph.h"
 
-#include <Eigen/Cholesky>
-
-#include "slam/types/check.h"
-
 namespace slamrig::slam {
 
 void AddRelativePoseEdge(PoseGraph* graph, int from, int to, const Pose2& from_T_to,
                          const Eigen::Matrix3d& information) {
-  SLAMRIG_CHECK(information.isApprox(information.transpose()) &&
-                    Eigen::LLT<Eigen::Matrix3d>(information).info() == Eigen::Success,
-                "AddRelativePoseEdge: information is not symmetric positive definite");
   const int gap = to - from;
   graph->AddEdge({.from = from,
                   .to = to,

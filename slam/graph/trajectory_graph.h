@@ -11,12 +11,13 @@ namespace slamrig::slam {
 /// to hand a front end's output to another back end): vertex i at trajectory[i].pose (ids
 /// 0..n-1, the first fixed) and an odometry edge i -> i+1 measuring the relative pose
 /// trajectory[i]^-1 * trajectory[i+1] with `odometry_information` (3x3, symmetric positive
-/// definite, SLAMRIG_CHECKed). Add loop closures or other relative-pose edges with
+/// definite). Add loop closures or other relative-pose edges with
 /// AddRelativePoseEdge, then write with WriteG2o.
 PoseGraph PoseGraphFromTrajectory(const Trajectory& trajectory,
                                   const Eigen::Matrix3d& odometry_information);
 
-/// Adds the edge `from` -> `to` that measures `from_T_to`, with `information` (SPD, checked).
+/// Adds the edge `from` -> `to` that measures `from_T_to`, with `information` (SPD; checked by
+/// PoseGraph::AddEdge).
 /// Its kind is odometry when |to - from| = 1, a loop closure otherwise, as for g2o files.
 void AddRelativePoseEdge(PoseGraph* graph, int from, int to, const Pose2& from_T_to,
                          const Eigen::Matrix3d& information);
