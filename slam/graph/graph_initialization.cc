@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <utility>
 #include <vector>
 
 #include "slam/types/check.h"
@@ -12,8 +13,8 @@
 namespace slamrig::slam {
 namespace {
 
-// Sparse linear least squares over 2-vectors: sum over terms of |A_a x_a + A_b x_b - b|^2_W,
-// where some x are known (their columns move to the right-hand side).
+// Sparse linear least squares over 2-vectors: the sum over terms of |J_a x_a + J_b x_b - r|^2_W,
+// where some x are known (their columns move to the right-hand side r).
 class BlockLeastSquares {
  public:
   // `unknown[i]` is the unknown's index of vertex i, or -1 when vertex i is known = known[i].
@@ -22,18 +23,18 @@ class BlockLeastSquares {
     g_.setZero();
   }
 
-  void Add(std::size_t a, const Eigen::Matrix2d& A_a, std::size_t b, const Eigen::Matrix2d& A_b,
+  void Add(std::size_t a, const Eigen::Matrix2d& j_a, std::size_t b, const Eigen::Matrix2d& j_b,
            Eigen::Vector2d rhs, const Eigen::Matrix2d& w) {
     const int ua = unknown_[a], ub = unknown_[b];
-    if (ua < 0) rhs -= A_a * known_[a];
-    if (ub < 0) rhs -= A_b * known_[b];
-    const std::pair<int, const Eigen::Matrix2d*> blocks[] = {{ua, &A_a}, {ub, &A_b}};
-    for (const auto& [r, Ar] : blocks) {
+    if (ua < 0) rhs -= j_a * known_[a];
+    if (ub < 0) rhs -= j_b * known_[b];
+    const std::pair<int, const Eigen::Matrix2d*> blocks[] = {{ua, &j_a}, {ub, &j_b}};
+    for (const auto& [r, j_r] : blocks) {
       if (r < 0) continue;
-      g_.segment<2>(2 * r) += Ar->transpose() * w * rhs;
-      for (const auto& [c, Ac] : blocks) {
+      g_.segment<2>(2 * r) += j_r->transpose() * w * rhs;
+      for (const auto& [c, j_c] : blocks) {
         if (c < 0) continue;
-        const Eigen::Matrix2d h = Ar->transpose() * w * *Ac;
+        const Eigen::Matrix2d h = j_r->transpose() * w * *j_c;
         for (int k = 0; k < 2; ++k) {
           for (int l = 0; l < 2; ++l) triplets_.emplace_back(2 * r + k, 2 * c + l, h(k, l));
         }

@@ -1,9 +1,10 @@
 #pragma once
 
-// Initial guesses for pose-graph optimisation. Chordal initialisation follows Carlone, Tron,
-// Daniilidis and Dellaert, "Initialization techniques for 3D SLAM: a survey on rotation
-// estimation and its use in pose graph optimization", ICRA 2015, Sec. IV (chordal relaxation,
-// eq. 12-13) and Sec. V (translations with the rotations fixed), in 2D.
+// Initial guesses for pose-graph optimisation. Chordal initialisation is the 2D case of the
+// chordal relaxation in Carlone, Tron, Daniilidis and Dellaert, "Initialization techniques for
+// 3D SLAM: a survey on rotation estimation and its use in pose graph optimization", ICRA 2015:
+// rotations first (relaxed, linear, then projected onto SO(2)), then the translations by linear
+// least squares with those rotations fixed.
 
 #include "slam/graph/pose_graph.h"
 

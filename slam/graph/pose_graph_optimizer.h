@@ -1,8 +1,10 @@
 #pragma once
 
-// Least-squares pose-graph optimisation with Ceres: minimises g2o's chi2 (edge_error.h),
-// each edge's error whitened by the Cholesky factor of its information matrix, poses on
-// R^2 x SO(2) (the angle wrapped after every step), sparse Cholesky on the normal equations.
+// Least-squares pose-graph optimisation with Ceres: minimises F(x) = sum e_ij^T Omega_ij e_ij
+// (Kümmerle et al., "g2o: A general framework for graph optimization", ICRA 2011, eq. 1-2; the
+// error in edge_error.h), each edge's error whitened by the Cholesky factor of its information
+// matrix, poses on R^2 x SO(2) (the angle wrapped after every step), sparse Cholesky on the
+// normal equations.
 
 #include <string>
 
