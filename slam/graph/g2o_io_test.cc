@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <ostream>
 #include <string>
 
 #include "slam/graph/testing/random_graph.h"
@@ -98,6 +99,8 @@ struct BadCase {
   const char* text;
   const char* message;  // expected after "<path>:"
 };
+
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.name; }
 
 class G2oBadInputTest : public ::testing::TestWithParam<BadCase> {};
 

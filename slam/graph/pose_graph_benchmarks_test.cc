@@ -3,6 +3,7 @@
 // certifies globally optimal, within 0.1 %.
 #include <gtest/gtest.h>
 
+#include <ostream>
 #include <string>
 
 #include "slam/graph/g2o_io.h"
@@ -20,6 +21,10 @@ struct Benchmark {
   double optimal_chi2;  // SE-Sync's certified optimum, in g2o's chi2
   bool chordal;
 };
+
+void PrintTo(const Benchmark& b, std::ostream* os) {
+  *os << b.name << (b.chordal ? " from chordal" : " from odometry");
+}
 
 class PoseGraphBenchmarksTest : public ::testing::TestWithParam<Benchmark> {};
 
