@@ -18,17 +18,18 @@ namespace {
 class BlockLeastSquares {
  public:
   // `unknown[i]` is the unknown's index of vertex i, or -1 when vertex i is known = known[i].
-  BlockLeastSquares(std::vector<int> unknown, std::vector<Eigen::Vector2d> known, int num_unknowns)
+  BlockLeastSquares(std::vector<Eigen::Index> unknown, std::vector<Eigen::Vector2d> known,
+                    Eigen::Index num_unknowns)
       : unknown_(std::move(unknown)), known_(std::move(known)), g_(2 * num_unknowns) {
     g_.setZero();
   }
 
   void Add(std::size_t a, const Eigen::Matrix2d& j_a, std::size_t b, const Eigen::Matrix2d& j_b,
            Eigen::Vector2d rhs, const Eigen::Matrix2d& w) {
-    const int ua = unknown_[a], ub = unknown_[b];
+    const Eigen::Index ua = unknown_[a], ub = unknown_[b];
     if (ua < 0) rhs -= j_a * known_[a];
     if (ub < 0) rhs -= j_b * known_[b];
-    const std::pair<int, const Eigen::Matrix2d*> blocks[] = {{ua, &j_a}, {ub, &j_b}};
+    const std::pair<Eigen::Index, const Eigen::Matrix2d*> blocks[] = {{ua, &j_a}, {ub, &j_b}};
     for (const auto& [r, j_r] : blocks) {
       if (r < 0) continue;
       g_.segment<2>(2 * r) += j_r->transpose() * w * rhs;
@@ -52,7 +53,7 @@ class BlockLeastSquares {
   }
 
  private:
-  std::vector<int> unknown_;
+  std::vector<Eigen::Index> unknown_;
   std::vector<Eigen::Vector2d> known_;
   Eigen::VectorXd g_;
   std::vector<Eigen::Triplet<double>> triplets_;
@@ -133,8 +134,8 @@ InitializationSummary InitializeChordal(PoseGraph* graph) {
   const std::vector<bool> reached = ReachableFromAnchors(*graph);
   std::vector<bool> anchor(n, false);
   for (const std::size_t a : graph->AnchorIndices()) anchor[a] = true;
-  std::vector<int> unknown(n, -1);
-  int num_unknowns = 0;
+  std::vector<Eigen::Index> unknown(n, -1);
+  Eigen::Index num_unknowns = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (reached[i] && !anchor[i]) unknown[i] = num_unknowns++;
     if (!reached[i]) ++summary.vertices_kept;
