@@ -19,6 +19,7 @@ int RunSlamCommand(const std::vector<std::string>& args);
 int RunEvalCommand(const std::vector<std::string>& args);
 int RunRunCommand(const std::vector<std::string>& args);
 int RunSweepCommand(const std::vector<std::string>& args);
+int RunOptimizeCommand(const std::vector<std::string>& args);
 
 /// All subcommands, in the order `slamrig --help` lists them.
 const std::vector<Command>& Commands();

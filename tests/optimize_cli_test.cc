@@ -1,0 +1,99 @@
+// `slamrig optimize` as a user runs it: one summary line, the written graph is the library's
+// result bit for bit, and bad input gives one error line, a non-zero exit and no output file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "slam/graph/edge_error.h"
+#include "slam/graph/g2o_io.h"
+#include "slam/graph/graph_initialization.h"
+#include "slam/graph/pose_graph_optimizer.h"
+#include "slam/graph/testing/random_graph.h"
+#include "tests/util/dataset.h"
+#include "tests/util/run_command.h"
+#include "tests/util/temp_dir.h"
+
+namespace slamrig {
+namespace {
+
+using testing::RunCommand;
+
+const std::string kBinary = SLAMRIG_BINARY;
+
+std::string Slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+int CountLines(const std::string& text) {
+  int n = 0;
+  for (const char c : text) n += c == '\n';
+  return n;
+}
+
+TEST(OptimizeCliTest, WritesTheLibrarysOptimumAndPrintsOneLine) {
+  testing::TempDir dir;
+  const slam::testing::RandomPoseGraph r =
+      slam::testing::MakeRandomPoseGraph({.num_poses = 80, .seed = 21});
+  const std::string in = dir.File("graph.g2o"), out = dir.File("optimised.g2o");
+  slam::WriteG2o(in, r.graph);
+  const auto result = RunCommand(kBinary + " optimize " + in + " --init chordal --out " + out);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(CountLines(result.output), 1) << result.output;
+  EXPECT_NE(result.output.find("80 vertices, " + std::to_string(r.graph.edges().size()) +
+                               " edges; init chordal"),
+            std::string::npos)
+      << result.output;
+
+  slam::PoseGraph expected = slam::ReadG2o(in);
+  slam::InitializeChordal(&expected);
+  const slam::PoseGraphSummary s = slam::PoseGraphOptimizer({}).Optimize(&expected);
+  EXPECT_EQ(Slurp(out), slam::FormatG2o(expected));
+  char chi2[32];
+  std::snprintf(chi2, sizeof(chi2), "-> %.6g in", slam::Chi2(slam::ReadG2o(out)));
+  EXPECT_NE(result.output.find(chi2), std::string::npos) << result.output << " vs " << chi2;
+  EXPECT_LT(s.final_chi2, s.initial_chi2);
+}
+
+TEST(OptimizeCliTest, BadGraphIsOneErrorLineAndNoOutput) {
+  testing::TempDir dir;
+  const std::string in = dir.Write("bad.g2o",
+                                   "VERTEX_SE2 0 0 0 0\n"
+                                   "VERTEX_SE2 1 1 0 0\n"
+                                   "EDGE_SE2 0 1 1 0 0 1 0 0 1 0 -1\n");
+  const std::string out = dir.File("out.g2o");
+  const auto result = RunCommand(kBinary + " optimize " + in + " --out " + out);
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_EQ(result.output, "slamrig: error: " + in +
+                               ":3: EDGE_SE2.information: the matrix (I11 I12 I13 I22 I23 I33) "
+                               "is not positive definite\n");
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(OptimizeCliTest, BadFlagsAreUsageErrors) {
+  testing::TempDir dir;
+  slam::WriteG2o(dir.File("g.g2o"), slam::testing::MakeRandomPoseGraph({.num_poses = 5}).graph);
+  for (const std::string flags : {"--init nope", "--robust nope", "--trust-region nope",
+                                  "--max-iterations 0", "--robust-scale -2", "--bogus"}) {
+    const auto result = RunCommand(kBinary + " optimize " + dir.File("g.g2o") + " " + flags +
+                                   " --out " + dir.File("out.g2o"));
+    EXPECT_EQ(result.exit_code, 2) << flags << ": " << result.output;
+    EXPECT_EQ(CountLines(result.output), 1) << flags << ": " << result.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.File("out.g2o"))) << flags;
+  }
+}
+
+TEST(OptimizeCliTest, IntelFromChordalReachesTheCertifiedOptimum) {
+  SLAMRIG_REQUIRE_DATASET(path, "pose_graphs_2d/intel.g2o.gz");
+  const auto result = RunCommand(kBinary + " optimize " + path + " --init chordal");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("1728 vertices, 2512 edges"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("-> 45.004"), std::string::npos) << result.output;
+}
+
+}  // namespace
+}  // namespace slamrig
