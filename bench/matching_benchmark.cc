@@ -1,18 +1,26 @@
 // Scan matcher speed (issue 9): the correlative matcher's loop-closure search (a window of +-7 m
 // and +-pi at 5 cm, a 1081-beam Hokuyo scan decimated to a few hundred points) and ICP, on the
-// SegmentWorld office mapped from scans round its corridor loop (built once, outside the timing).
+// SegmentWorld office mapped from scans round its corridor loop (built once, outside the timing);
+// then both on the real intel-corrected log (skipped with a message when the dataset is absent):
+// the loop-closure search on the map of its corrected poses, and IcpOdometry over the whole log.
 //
 //   build/bench/matching_benchmark --benchmark_repetitions=5
 //   --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <filesystem>
 #include <numbers>
 
+#include "slam/io/carmen_reader.h"
+#include "slam/io/dataset.h"
 #include "slam/matching/correlative_matcher.h"
 #include "slam/matching/icp_matcher.h"
+#include "slam/matching/icp_odometry.h"
 #include "slam/matching/scan_points.h"
 #include "slam/matching/testing/segment_world.h"
+#include "slam/odometry/scan_sync.h"
 
 namespace slamrig::slam {
 namespace {
@@ -121,6 +129,114 @@ void BM_IcpScanToScan(benchmark::State& state) {
   state.counters["iterations"] = iterations;
 }
 BENCHMARK(BM_IcpScanToScan)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+struct Intel {
+  std::vector<CarmenScan> scans;   // corrected poses: the reference
+  std::vector<SyncedScan> synced;  // with the recovered raw odometry
+  OccupancyGrid grid{OccupancyGridOptions{}};
+};
+
+// The intel-corrected log, read once; nullptr when the dataset is missing.
+const Intel* TheIntel() {
+  static const Intel* intel = []() -> Intel* {
+    const char* env = std::getenv("SLAMRIG_DATA_DIR");
+    const std::filesystem::path dir =
+        env != nullptr ? std::filesystem::path(env)
+                       : std::filesystem::path(SLAMRIG_SOURCE_DIR) / ".." / "shared" / "datasets";
+    const std::filesystem::path path = dir / "carmen_corrected" / "intel-corrected.log.gz";
+    if (!std::filesystem::exists(path)) return nullptr;
+    const CarmenLog log = ReadCarmenLog(path.string());
+    auto* i = new Intel;
+    i->scans = log.scans;
+    i->synced = SyncToScans(CarmenToDataset(log).records, ScanSyncOptions{}).scans;
+    for (const CarmenScan& s : log.scans) i->grid.InsertScan(s.scan, s.logged_pose);
+    return i;
+  }();
+  return intel;
+}
+
+// Loop-closure search on the intel map: scan 400 from 5 m and 1.5 rad off, +-7 m, +-pi.
+void BM_CorrelativeSearchIntel(benchmark::State& state) {
+  const Intel* intel = TheIntel();
+  if (intel == nullptr) {
+    state.SkipWithError("intel-corrected.log.gz not found (set SLAMRIG_DATA_DIR)");
+    return;
+  }
+  CorrelativeMatcherOptions options;
+  options.min_score = 0.4;
+  const CorrelativeMatcher matcher(options, intel->grid);
+  ScanPointsOptions points;
+  points.voxel_size_m = static_cast<double>(state.range(0)) / 1000.0;
+  const CarmenScan& scan = intel->scans[400];
+  const std::vector<Eigen::Vector2d> cloud = ScanToBasePoints(scan.scan, points);
+  const Pose2 truth = scan.logged_pose;
+  const Pose2 initial(truth.x() + 4.0, truth.y() - 3.0, truth.theta() + 1.5);
+  double error_m = -1.0;
+  for (auto _ : state) {
+    const std::optional<MatchResult> m = matcher.Match(cloud, initial);
+    error_m = m ? (m->pose.translation() - truth.translation()).norm() : -1.0;
+    benchmark::DoNotOptimize(m);
+  }
+  state.counters["points"] = static_cast<double>(cloud.size());
+  state.counters["error_m"] = error_m;
+}
+BENCHMARK(BM_CorrelativeSearchIntel)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond);
+
+// IcpOdometry over all intel scans with the recovered raw odometry as the prior. Counters: the
+// position RMSE against the corrected poses (both anchored at the first scan) of ICP odometry and
+// of dead reckoning.
+void BM_IcpOdometryIntel(benchmark::State& state) {
+  const Intel* intel = TheIntel();
+  if (intel == nullptr) {
+    state.SkipWithError("intel-corrected.log.gz not found (set SLAMRIG_DATA_DIR)");
+    return;
+  }
+  if (intel->synced.size() != intel->scans.size()) {
+    state.SkipWithError("synchronised scans do not pair with the log's scans");
+    return;
+  }
+  std::vector<Pose2> estimate(intel->synced.size());
+  IcpOdometryCounts counts;
+  for (auto _ : state) {
+    IcpOdometry icp{IcpOdometryOptions{}};
+    for (std::size_t k = 0; k < intel->synced.size(); ++k) {
+      estimate[k] = icp.Add(intel->synced[k].scan, intel->synced[k].increment).pose;
+    }
+    counts = icp.counts();
+  }
+  const std::vector<Pose2> dead_reckoning = DeadReckoningPoses(intel->synced);
+  const Pose2 anchor = intel->scans.front().logged_pose;
+  auto rmse = [&](const std::vector<Pose2>& poses) {
+    double sum = 0.0;
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      sum += ((anchor * poses[k]).translation() - intel->scans[k].logged_pose.translation())
+                 .squaredNorm();
+    }
+    return std::sqrt(sum / static_cast<double>(poses.size()));
+  };
+  state.counters["scans"] = static_cast<double>(counts.scans);
+  state.counters["matched"] = counts.matched;
+  state.counters["degenerate"] = counts.degenerate;
+  state.counters["failed"] = counts.failed;
+  // Relative pose error per scan step: translation (m) and yaw (rad), means.
+  auto rpe = [&](const std::vector<Pose2>& poses, bool yaw) {
+    double sum = 0.0;
+    for (std::size_t k = 1; k < poses.size(); ++k) {
+      const Pose2 e = intel->scans[k - 1]
+                          .logged_pose.Between(intel->scans[k].logged_pose)
+                          .Between(poses[k - 1].Between(poses[k]));
+      sum += yaw ? std::abs(e.theta()) : e.translation().norm();
+    }
+    return sum / static_cast<double>(poses.size() - 1);
+  };
+  state.counters["icp_rpe_m"] = rpe(estimate, false);
+  state.counters["odometry_rpe_m"] = rpe(dead_reckoning, false);
+  state.counters["icp_rpe_rad"] = rpe(estimate, true);
+  state.counters["odometry_rpe_rad"] = rpe(dead_reckoning, true);
+  state.counters["icp_rmse_m"] = rmse(estimate);
+  state.counters["odometry_rmse_m"] = rmse(dead_reckoning);
+}
+BENCHMARK(BM_IcpOdometryIntel)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace slamrig::slam
