@@ -15,7 +15,10 @@ namespace slamrig::slam {
 
 /// Parameters of scan-to-local-map ICP odometry.
 struct IcpOdometryOptions {
-  IcpOptions icp = {.trim_fraction = 0.9, .kernel = RobustKernel::kCauchy};
+  /// Point-to-line ICP with a wider gate than IcpOptions' own, for logs whose scans are far apart
+  /// (intel: up to ~0.5 m), light trimming and a Cauchy weight.
+  IcpOptions icp = {
+      .max_correspondence_distance_m = 1.0, .trim_fraction = 0.95, .kernel = RobustKernel::kCauchy};
   ScanPointsOptions points = {.voxel_size_m = 0.05};  ///< scan to points
   int local_map_keyframes = 10;      ///< the local map holds the points of the last N keyframes ...
   double local_map_voxel_m = 0.05;   ///< ... thinned to one point (the newest) per voxel
