@@ -45,6 +45,131 @@ Eigen::Matrix3d FlooredInverse(const Eigen::Matrix3d& h) {
   return eig.eigenvectors() * values.asDiagonal() * eig.eigenvectors().transpose();
 }
 
+// What a match aligns to: the options, the reference's k-d tree and its normals.
+struct Reference {
+  const IcpOptions& options;
+  const PointKdTree& tree;
+  const std::vector<Eigen::Vector2d>& normals;
+  bool to_line() const { return options.metric == IcpMetric::kPointToLine; }
+};
+
+// Gauss-Newton normal equations in (x, y, yaw) and the weighted squared residuals.
+struct NormalEquations {
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d g = Eigen::Vector3d::Zero();
+  double weighted_squares = 0.0;
+  int num_residuals = 0;  // scalar residuals: 1 per pair (point-to-line) or 2 (point-to-point)
+};
+
+// The pairs of `source` seen from `pose`: nearest neighbours within the gate (with a normal, for
+// point-to-line), then trimmed to the best trim_fraction (ties at the threshold kept), in source
+// order. Returns the number that passed the gate, before trimming.
+int Associate(const Reference& reference, std::span<const Eigen::Vector2d> source,
+              const Pose2& pose, std::vector<Pair>* pairs, std::vector<double>* scratch) {
+  const IcpOptions& options = reference.options;
+  const double max_d2 =
+      options.max_correspondence_distance_m * options.max_correspondence_distance_m;
+  const auto& ref = reference.tree.points();
+  pairs->clear();
+  const double c = std::cos(pose.theta()), s = std::sin(pose.theta());
+  for (const Eigen::Vector2d& p : source) {
+    Pair pair;
+    pair.rotated = Eigen::Vector2d(c * p.x() - s * p.y(), s * p.x() + c * p.y());
+    pair.world = pair.rotated + pose.translation();
+    double d2 = 0.0;
+    if (!reference.tree.Nearest(pair.world, &pair.ref, &d2) || d2 > max_d2) continue;
+    if (reference.to_line()) {
+      const Eigen::Vector2d& n = reference.normals[pair.ref];
+      if (n.isZero()) continue;
+      pair.residual = n.dot(pair.world - ref[pair.ref]);
+    } else {
+      pair.residual = std::sqrt(d2);
+    }
+    pairs->push_back(pair);
+  }
+  const int gated = static_cast<int>(pairs->size());
+  if (options.trim_fraction < 1.0 && !pairs->empty()) {
+    const auto keep = static_cast<std::size_t>(
+        std::ceil(options.trim_fraction * static_cast<double>(pairs->size())));
+    scratch->clear();
+    for (const Pair& pair : *pairs) scratch->push_back(std::abs(pair.residual));
+    std::nth_element(scratch->begin(), scratch->begin() + static_cast<std::ptrdiff_t>(keep - 1),
+                     scratch->end());
+    const double threshold = (*scratch)[keep - 1];
+    std::erase_if(*pairs, [&](const Pair& pair) { return std::abs(pair.residual) > threshold; });
+  }
+  return gated;
+}
+
+// The robustly weighted normal equations of `pairs` (Jacobians with respect to (x, y, yaw) of the
+// pose, d(R p)/d yaw = perp(R p)).
+NormalEquations Accumulate(const Reference& reference, const std::vector<Pair>& pairs) {
+  NormalEquations eq;
+  const auto& ref = reference.tree.points();
+  for (const Pair& pair : pairs) {
+    const double w = RobustWeight(reference.options, pair.residual);
+    const Eigen::Vector2d dyaw = Perp(pair.rotated);
+    if (reference.to_line()) {
+      const Eigen::Vector2d& n = reference.normals[pair.ref];
+      const Eigen::Vector3d j(n.x(), n.y(), n.dot(dyaw));
+      eq.h += w * j * j.transpose();
+      eq.g += w * j * pair.residual;
+      eq.weighted_squares += w * pair.residual * pair.residual;
+      eq.num_residuals += 1;
+    } else {
+      const Eigen::Vector2d e = pair.world - ref[pair.ref];
+      Eigen::Matrix<double, 2, 3> j;
+      j << 1.0, 0.0, dyaw.x(), 0.0, 1.0, dyaw.y();
+      eq.h += w * j.transpose() * j;
+      eq.g += w * j.transpose() * e;
+      eq.weighted_squares += w * e.squaredNorm();
+      eq.num_residuals += 2;
+    }
+  }
+  return eq;
+}
+
+// One Gauss-Newton step of the linearised point-to-line problem (Censi 2008, Eq. 4), solved with
+// the pseudo-inverse: no motion along directions the pairs do not constrain.
+Pose2 PointToLineStep(const NormalEquations& eq, const Pose2& pose) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(eq.h);
+  const Eigen::Vector3d values = eig.eigenvalues();
+  const Eigen::Vector3d rhs = eig.eigenvectors().transpose() * (-eq.g);
+  Eigen::Vector3d step_eig = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 3; ++i) {
+    if (values[i] > 0.0 && values[i] > 1e-9 * values.maxCoeff()) step_eig[i] = rhs[i] / values[i];
+  }
+  const Eigen::Vector3d step = eig.eigenvectors() * step_eig;
+  return Pose2(pose.x() + step.x(), pose.y() + step.y(), pose.theta() + step.z());
+}
+
+// The weighted closed-form alignment of the pairs (Besl and McKay 1992, Sec. III-C; in 2D the SVD
+// of the cross-covariance reduces to one atan2), applied on top of `pose`.
+Pose2 PointToPointStep(const Reference& reference, const std::vector<Pair>& pairs,
+                       const Pose2& pose) {
+  const auto& ref = reference.tree.points();
+  double sw = 0.0;
+  Eigen::Vector2d mean_p = Eigen::Vector2d::Zero(), mean_q = Eigen::Vector2d::Zero();
+  for (const Pair& pair : pairs) {
+    const double w = RobustWeight(reference.options, pair.residual);
+    sw += w;
+    mean_p += w * pair.world;
+    mean_q += w * ref[pair.ref];
+  }
+  mean_p /= sw;
+  mean_q /= sw;
+  double sin_sum = 0.0, cos_sum = 0.0;
+  for (const Pair& pair : pairs) {
+    const double w = RobustWeight(reference.options, pair.residual);
+    const Eigen::Vector2d a = pair.world - mean_p, b = ref[pair.ref] - mean_q;
+    sin_sum += w * (a.x() * b.y() - a.y() * b.x());
+    cos_sum += w * (a.x() * b.x() + a.y() * b.y());
+  }
+  const double dyaw = std::atan2(sin_sum, cos_sum);
+  const Eigen::Vector2d dt = mean_q - Pose2(0.0, 0.0, dyaw) * mean_p;
+  return Pose2(dt.x(), dt.y(), dyaw) * pose;
+}
+
 }  // namespace
 
 std::vector<std::string> IcpOptions::Validate() const {
@@ -107,126 +232,18 @@ IcpMatcher::IcpMatcher(const IcpOptions& options, std::vector<Eigen::Vector2d> r
 
 std::optional<MatchResult> IcpMatcher::Match(std::span<const Eigen::Vector2d> source,
                                              const Pose2& reference_from_source_guess) const {
-  const bool to_line = options_.metric == IcpMetric::kPointToLine;
-  const double max_d2 =
-      options_.max_correspondence_distance_m * options_.max_correspondence_distance_m;
-  const auto& ref = tree_.points();
+  const Reference reference{options_, tree_, normals_};
   std::vector<Pair> pairs;
   pairs.reserve(source.size());
-  std::vector<double> sorted;
-
-  // Pairs at `pose`, gated, trimmed; returns the number that passed the gate.
-  auto associate = [&](const Pose2& pose) {
-    pairs.clear();
-    const double c = std::cos(pose.theta()), s = std::sin(pose.theta());
-    for (const Eigen::Vector2d& p : source) {
-      Pair pair;
-      pair.rotated = Eigen::Vector2d(c * p.x() - s * p.y(), s * p.x() + c * p.y());
-      pair.world = pair.rotated + pose.translation();
-      double d2 = 0.0;
-      if (!tree_.Nearest(pair.world, &pair.ref, &d2) || d2 > max_d2) continue;
-      if (to_line) {
-        const Eigen::Vector2d& n = normals_[pair.ref];
-        if (n.isZero()) continue;
-        pair.residual = n.dot(pair.world - ref[pair.ref]);
-      } else {
-        pair.residual = std::sqrt(d2);
-      }
-      pairs.push_back(pair);
-    }
-    const int gated = static_cast<int>(pairs.size());
-    if (options_.trim_fraction < 1.0 && !pairs.empty()) {
-      const auto keep = static_cast<std::size_t>(
-          std::ceil(options_.trim_fraction * static_cast<double>(pairs.size())));
-      sorted.clear();
-      for (const Pair& pair : pairs) sorted.push_back(std::abs(pair.residual));
-      std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(keep - 1),
-                       sorted.end());
-      const double threshold = sorted[keep - 1];
-      // Keep everything up to the threshold (ties included), in source order.
-      std::erase_if(pairs, [&](const Pair& pair) { return std::abs(pair.residual) > threshold; });
-    }
-    return gated;
-  };
-
-  // Normal equations of the kept pairs at the current pose, parameters (x, y, yaw).
-  auto normal_equations = [&](Eigen::Matrix3d* h, Eigen::Vector3d* g, double* weighted_sq,
-                              int* num_residuals) {
-    h->setZero();
-    g->setZero();
-    *weighted_sq = 0.0;
-    *num_residuals = 0;
-    for (const Pair& pair : pairs) {
-      const double w = RobustWeight(options_, pair.residual);
-      const Eigen::Vector2d dyaw = Perp(pair.rotated);
-      if (to_line) {
-        const Eigen::Vector2d& n = normals_[pair.ref];
-        const Eigen::Vector3d j(n.x(), n.y(), n.dot(dyaw));
-        *h += w * j * j.transpose();
-        *g += w * j * pair.residual;
-        *weighted_sq += w * pair.residual * pair.residual;
-        *num_residuals += 1;
-      } else {
-        const Eigen::Vector2d e = pair.world - ref[pair.ref];
-        Eigen::Matrix<double, 2, 3> j;
-        j << 1.0, 0.0, dyaw.x(), 0.0, 1.0, dyaw.y();
-        *h += w * j.transpose() * j;
-        *g += w * j.transpose() * e;
-        *weighted_sq += w * e.squaredNorm();
-        *num_residuals += 2;
-      }
-    }
-  };
-
+  std::vector<double> scratch;
   Pose2 pose = reference_from_source_guess;
   MatchResult result;
   for (int iteration = 1; iteration <= options_.max_iterations; ++iteration) {
-    associate(pose);
+    Associate(reference, source, pose, &pairs, &scratch);
     if (static_cast<int>(pairs.size()) < options_.min_correspondences) return std::nullopt;
     result.iterations = iteration;
-    Pose2 next;
-    if (to_line) {
-      Eigen::Matrix3d h;
-      Eigen::Vector3d g;
-      double unused_sq = 0.0;
-      int unused_n = 0;
-      normal_equations(&h, &g, &unused_sq, &unused_n);
-      // Pseudo-inverse step: no motion along directions the pairs do not constrain.
-      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(h);
-      const Eigen::Vector3d values = eig.eigenvalues();
-      const Eigen::Vector3d rhs = eig.eigenvectors().transpose() * (-g);
-      Eigen::Vector3d step_eig = Eigen::Vector3d::Zero();
-      for (int i = 0; i < 3; ++i) {
-        if (values[i] > 1e-9 * values.maxCoeff() && values[i] > 0.0)
-          step_eig[i] = rhs[i] / values[i];
-      }
-      const Eigen::Vector3d step = eig.eigenvectors() * step_eig;
-      next = Pose2(pose.x() + step.x(), pose.y() + step.y(), pose.theta() + step.z());
-    } else {
-      // Weighted closed-form 2D alignment of the pairs (Besl and McKay 1992, Sec. III-C; in 2D
-      // the SVD of the cross-covariance reduces to one atan2).
-      double sw = 0.0;
-      Eigen::Vector2d mean_p = Eigen::Vector2d::Zero(), mean_q = Eigen::Vector2d::Zero();
-      for (const Pair& pair : pairs) {
-        const double w = RobustWeight(options_, pair.residual);
-        sw += w;
-        mean_p += w * pair.world;
-        mean_q += w * ref[pair.ref];
-      }
-      mean_p /= sw;
-      mean_q /= sw;
-      double sin_sum = 0.0, cos_sum = 0.0;
-      for (const Pair& pair : pairs) {
-        const double w = RobustWeight(options_, pair.residual);
-        const Eigen::Vector2d a = pair.world - mean_p, b = ref[pair.ref] - mean_q;
-        sin_sum += w * (a.x() * b.y() - a.y() * b.x());
-        cos_sum += w * (a.x() * b.x() + a.y() * b.y());
-      }
-      const double dyaw = std::atan2(sin_sum, cos_sum);
-      const Pose2 rotation(0.0, 0.0, dyaw);
-      const Eigen::Vector2d dt = mean_q - rotation * mean_p;
-      next = Pose2(dt.x(), dt.y(), dyaw) * pose;
-    }
+    const Pose2 next = reference.to_line() ? PointToLineStep(Accumulate(reference, pairs), pose)
+                                           : PointToPointStep(reference, pairs, pose);
     const double moved = (next.translation() - pose.translation()).norm();
     const double turned = std::abs(NormalizeAngle(next.theta() - pose.theta()));
     pose = next;
@@ -237,16 +254,13 @@ std::optional<MatchResult> IcpMatcher::Match(std::span<const Eigen::Vector2d> so
   }
 
   // Final pairs and covariance at the estimate.
-  const int gated = associate(pose);
+  const int gated = Associate(reference, source, pose, &pairs, &scratch);
   if (static_cast<int>(pairs.size()) < options_.min_correspondences) return std::nullopt;
-  Eigen::Matrix3d h;
-  Eigen::Vector3d g;
-  double weighted_sq = 0.0;
-  int num_residuals = 0;
-  normal_equations(&h, &g, &weighted_sq, &num_residuals);
-  const double variance = weighted_sq / std::max(1, num_residuals - 3);
+  const NormalEquations final_equations = Accumulate(reference, pairs);
+  const double variance =
+      final_equations.weighted_squares / std::max(1, final_equations.num_residuals - 3);
   result.pose = pose;
-  result.covariance = variance * FlooredInverse(h);
+  result.covariance = variance * FlooredInverse(final_equations.h);
   result.correspondences = static_cast<int>(pairs.size());
   result.score = source.empty() ? 0.0 : gated / static_cast<double>(source.size());
   return result;
