@@ -104,6 +104,26 @@ TEST(IcpOdometryTest, FallsBackToOdometryAlongADegenerateCorridor) {
   EXPECT_NEAR(estimate.x() - start.x(), 1.03 * (truth.x() - start.x()), 0.05);
 }
 
+// Same scans and increments, same bits.
+TEST(IcpOdometryTest, SameInputSameBits) {
+  const SegmentWorld world = SegmentWorld::Office();
+  const std::vector<Pose2> truth = OfficeLoop();
+  std::vector<LaserScan> scans;
+  std::vector<Pose2> increments;
+  RandomEngine rng(29);
+  for (std::size_t k = 0; k < 40; ++k) {
+    scans.push_back(world.Scan(truth[k], Time(), RangeFinderSpec{}, &rng));
+    increments.push_back(k == 0 ? Pose2() : NoisyIncrement(truth[k - 1].Between(truth[k]), rng));
+  }
+  IcpOdometry a{IcpOdometryOptions{}}, b{IcpOdometryOptions{}};
+  for (std::size_t k = 0; k < scans.size(); ++k) {
+    const IcpOdometryStep sa = a.Add(scans[k], increments[k]);
+    const IcpOdometryStep sb = b.Add(scans[k], increments[k]);
+    ASSERT_EQ(sa.pose, sb.pose) << k;
+    ASSERT_EQ(sa.covariance, sb.covariance) << k;
+  }
+}
+
 // A scan without a single return keeps the odometry prior and is counted.
 TEST(IcpOdometryTest, ScanWithoutPointsKeepsThePrior) {
   const SegmentWorld world = SegmentWorld::Office();
