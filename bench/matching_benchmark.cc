@@ -156,6 +156,7 @@ const Intel* TheIntel() {
 }
 
 // Loop-closure search on the intel map: scan 400 from 5 m and 1.5 rad off, +-7 m, +-pi.
+// Args: voxel size in mm, branch-and-bound depth.
 void BM_CorrelativeSearchIntel(benchmark::State& state) {
   const Intel* intel = TheIntel();
   if (intel == nullptr) {
@@ -164,6 +165,7 @@ void BM_CorrelativeSearchIntel(benchmark::State& state) {
   }
   CorrelativeMatcherOptions options;
   options.min_score = 0.4;
+  options.branch_and_bound_depth = static_cast<int>(state.range(1));
   const CorrelativeMatcher matcher(options, intel->grid);
   ScanPointsOptions points;
   points.voxel_size_m = static_cast<double>(state.range(0)) / 1000.0;
@@ -179,8 +181,15 @@ void BM_CorrelativeSearchIntel(benchmark::State& state) {
   }
   state.counters["points"] = static_cast<double>(cloud.size());
   state.counters["error_m"] = error_m;
+  state.counters["yaw_step_mrad"] = 1000.0 * matcher.AngularStep(cloud);
 }
-BENCHMARK(BM_CorrelativeSearchIntel)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_CorrelativeSearchIntel)
+    ->Args({50, 7})
+    ->Args({100, 7})
+    ->Args({100, 6})
+    ->Args({100, 8})
+    ->Args({100, 9})
+    ->Unit(benchmark::kMillisecond);
 
 // IcpOdometry over all intel scans with the recovered raw odometry as the prior. Counters: the
 // position RMSE against the corrected poses (both anchored at the first scan) of ICP odometry and
