@@ -36,8 +36,8 @@ std::vector<std::string> CorrelativeMatcherOptions::Validate() const {
     add("angular_window_rad", angular_window_rad, "must be in [0, pi]");
   }
   if (!(angular_step_rad >= 0.0)) add("angular_step_rad", angular_step_rad, "must be >= 0");
-  if (branch_and_bound_depth < 1 || branch_and_bound_depth > 16) {
-    add("branch_and_bound_depth", branch_and_bound_depth, "must be in [1, 16]");
+  if (branch_and_bound_depth < 1 || branch_and_bound_depth > 12) {
+    add("branch_and_bound_depth", branch_and_bound_depth, "must be in [1, 12]");
   }
   if (!std::isfinite(min_score)) add("min_score", min_score, "must be finite");
   if (covariance_half_cells < 1) {

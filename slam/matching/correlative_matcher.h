@@ -21,7 +21,7 @@ struct CorrelativeMatcherOptions {
   /// between steps: acos(1 - r^2 / (2 d_max^2)) (Hess et al. 2016, Eq. 7).
   double angular_step_rad = 0.0;
   /// Levels of precomputation grids: the coarsest branch-and-bound nodes span 2^(depth-1) cells
-  /// in x and y. 1 = exhaustive search.
+  /// in x and y. 1 = exhaustive search; at most 12 (each level is a padded copy of the raster).
   int branch_and_bound_depth = 7;
   /// A pose is only accepted when the mean raster value over the points reaches this; no pose in
   /// the window does: the match fails.

@@ -159,6 +159,24 @@ TEST(IcpMatcherTest, CovarianceIsLargestAlongACorridorsAxis) {
   }
 }
 
+// In the office, with walls in every direction, the same covariance is nearly isotropic: the
+// contrast that makes the corridor's ratio a degeneracy test.
+TEST(IcpMatcherTest, CovarianceIsNearlyIsotropicWhereWallsFaceEveryWay) {
+  const SegmentWorld world = SegmentWorld::Office();
+  RandomEngine rng(19);
+  ScanPointsOptions points;
+  points.voxel_size_m = 0.05;
+  for (int trial = 0; trial < 10; ++trial) {
+    const Pose2 a = RandomCorridorPose(rng);
+    const std::optional<MatchResult> m = IcpMatcher::MatchScans(
+        IcpOptions{}, points, world.Scan(a, Time(), RangeFinderSpec{}, &rng),
+        world.Scan(a * Pose2(0.02, 0.01, 0.01), Time(), RangeFinderSpec{}, &rng), Pose2());
+    ASSERT_TRUE(m.has_value());
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(m->covariance.topLeftCorner<2, 2>());
+    EXPECT_LT(eig.eigenvalues()[1], 30.0 * eig.eigenvalues()[0]) << trial;
+  }
+}
+
 // The predicted covariance matches the spread of estimates over noise draws (within a factor 3).
 TEST(IcpMatcherTest, CovarianceMatchesTheSpreadOverNoiseDraws) {
   const SegmentWorld world = SegmentWorld::Office();
