@@ -80,7 +80,7 @@ CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
 void CorrelativeMatcher::Precompute(std::vector<float> values, int width, int height) {
   levels_.resize(static_cast<std::size_t>(options_.branch_and_bound_depth));
   levels_[0] = Level{0, width, height, std::move(values)};
-  // Level h from level h-1: the max of four blocks of 2^(h-1) (Hess 2016, Eq. 14, by doubling).
+  // Level h from level h-1: the max of four blocks of 2^(h-1) (Hess 2016, Sec. V-C, by doubling).
   for (std::size_t h = 1; h < levels_.size(); ++h) {
     const Level& prev = levels_[h - 1];
     const int half = 1 << (h - 1);
@@ -163,7 +163,7 @@ std::optional<MatchResult> CorrelativeMatcher::Match(std::span<const Eigen::Vect
            (best_index >= 0 && node.bound == best_sum && node.index >= best_index);
   };
 
-  // Depth-first branch and bound (Hess 2016, Algorithm 3), recursive over the levels.
+  // Depth-first branch and bound (Hess 2016, Sec. V-A), recursive over the levels.
   auto descend = [&](auto&& self, const Node& node, int level) -> void {
     if (level == 0) {
       if (node.bound > best_sum ||
@@ -222,7 +222,7 @@ std::optional<MatchResult> CorrelativeMatcher::Match(std::span<const Eigen::Vect
   result.correspondences = n;
   result.converged = true;
 
-  // Covariance from the score-weighted spread around the best (Olson 2009, Eqs. 15-17), with the
+  // Covariance from the score-weighted spread around the best (Olson 2009), with the
   // offsets relative to the best pose so the sums stay well conditioned.
   const int cc = options_.covariance_half_cells, cs = options_.covariance_half_steps;
   Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();

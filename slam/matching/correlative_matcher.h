@@ -18,7 +18,7 @@ struct CorrelativeMatcherOptions {
   double linear_window_m = 7.0;  ///< search x and y within +-this of the initial guess
   double angular_window_rad = 3.14159265358979;  ///< search yaw within +-this
   /// Yaw step; 0 = from the scan's farthest point d_max so that no point moves more than a cell
-  /// between steps: acos(1 - r^2 / (2 d_max^2)) (Hess et al. 2016, Eq. 7).
+  /// between steps: acos(1 - r^2 / (2 d_max^2)) (Hess et al. 2016, Sec. V).
   double angular_step_rad = 0.0;
   /// Levels of precomputation grids: the coarsest branch-and-bound nodes span 2^(depth-1) cells
   /// in x and y. 1 = exhaustive search; at most 12 (each level is a padded copy of the raster).
@@ -39,23 +39,24 @@ struct CorrelativeMatcherOptions {
 
 /// Real-time correlative scan matching (Olson, "Real-Time Correlative Scan Matching", ICRA 2009)
 /// with the exact multi-resolution search of Hess et al., "Real-Time Loop Closure in 2D LIDAR
-/// SLAM", ICRA 2016, Sec. V: precomputation grids (Eq. 14: each cell of level h holds the maximum
+/// SLAM", ICRA 2016, Sec. V: precomputation grids (Sec. V-C: each cell of level h holds the maximum
 /// of the 2^h x 2^h raster cells above and right of it) bound the score of a whole block of
-/// translations, and a depth-first branch and bound (Algorithm 3) visits the blocks best bound
+/// translations, and a depth-first branch and bound (Sec. V-A) visits the blocks best bound
 /// first and prunes every block whose bound cannot beat the best pose so far.
 ///
 /// The search is over the discrete poses (x0 + i r, y0 + j r, yaw0 + k s) of the window, with r the
 /// raster's resolution and s the yaw step. The scan at yaw index k is discretised once: point p's
 /// cell is c_k(p) = floor((Pose2(x0, y0, yaw0 + k s) * p - origin) / r), and the pose (i, j, k)
-/// scores sum_p raster(c_k(p) + (i, j)) / n in float, in point order, cells outside reading 0 (Hess
-/// Eq. 11). The result is exactly the exhaustive search's best pose and score; ties go to the
-/// smallest (k, j, i), the order in which the exhaustive search lists them.
+/// scores sum_p raster(c_k(p) + (i, j)) / n in float, in point order, cells outside reading 0. The
+/// result is exactly the exhaustive search's best pose and score; ties go to the smallest (k, j,
+/// i), the order in which the exhaustive search lists them.
 ///
-/// Covariance (Olson 2009, Sec. IV-B, Eqs. 15-17): the weighted mean and spread of the poses in a
-/// small window around the best, each weighted by exp((score - best) / covariance_score_scale),
-/// a softmax that treats the score as a log-likelihood up to scale; r^2 / 12 and s^2 / 12 are added
-/// for the discretisation. Along a direction where the score is flat (a corridor's axis) the
-/// variance reaches the window's (2n + 1)^2 r^2 / 12: read it as "at least that".
+/// Covariance (Olson 2009's estimate from the score distribution): the weighted mean and spread of
+/// the poses in a small window around the best, each weighted by exp((score - best) /
+/// covariance_score_scale), a softmax that treats the score as a log-likelihood up to scale; r^2 /
+/// 12 and s^2 / 12 are added for the discretisation. Along a direction where the score is flat (a
+/// corridor's axis) the variance reaches the window's (2n + 1)^2 r^2 / 12: read it as "at least
+/// that".
 ///
 /// The raster is copied; values should be >= 0 (probabilities, a likelihood field). Deterministic
 /// and thread-safe.

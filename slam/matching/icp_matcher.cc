@@ -129,7 +129,7 @@ NormalEquations Accumulate(const Reference& reference, const std::vector<Pair>& 
   return eq;
 }
 
-// One Gauss-Newton step of the linearised point-to-line problem (Censi 2008, Eq. 4), solved with
+// One Gauss-Newton step of the linearised point-to-line problem (Censi 2008), solved with
 // the pseudo-inverse: no motion along directions the pairs do not constrain.
 Pose2 PointToLineStep(const NormalEquations& eq, const Pose2& pose) {
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(eq.h);
@@ -143,7 +143,7 @@ Pose2 PointToLineStep(const NormalEquations& eq, const Pose2& pose) {
   return Pose2(pose.x() + step.x(), pose.y() + step.y(), pose.theta() + step.z());
 }
 
-// The weighted closed-form alignment of the pairs (Besl and McKay 1992, Sec. III-C; in 2D the SVD
+// The weighted closed-form alignment of the pairs (Besl and McKay 1992; in 2D the SVD
 // of the cross-covariance reduces to one atan2), applied on top of `pose`.
 Pose2 PointToPointStep(const Reference& reference, const std::vector<Pair>& pairs,
                        const Pose2& pose) {
@@ -201,7 +201,7 @@ IcpMatcher::IcpMatcher(const IcpOptions& options, std::vector<Eigen::Vector2d> r
     : options_(options), tree_(std::move(reference)) {
   SLAMRIG_CHECK(options_.Validate().empty(), "invalid IcpOptions");
   if (options_.metric != IcpMetric::kPointToLine) return;
-  // Normals: the minor principal axis of each point's neighbourhood (Censi 2008, Sec. IV-A).
+  // Normals: the minor principal axis of each point's neighbourhood.
   const auto& points = tree_.points();
   normals_.assign(points.size(), Eigen::Vector2d::Zero());
   std::vector<std::uint32_t> indices;

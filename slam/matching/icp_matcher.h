@@ -17,10 +17,12 @@ namespace slamrig::slam {
 /// The error ICP minimises.
 enum class IcpMetric {
   /// Sum of squared point distances, solved in closed form per iteration (Besl and McKay, "A
-  /// Method for Registration of 3-D Shapes", PAMI 1992, Sec. III-C; the 2D SVD/Kabsch step).
+  /// Method for Registration of 3-D Shapes", PAMI 1992; in 2D the SVD/Kabsch step is one atan2).
   kPointToPoint,
   /// Sum of squared distances to the reference's local lines (Censi, "An ICP variant using a
-  /// point-to-line metric", ICRA 2008, Eq. 4), linearised and solved by Gauss-Newton per iteration.
+  /// point-to-line metric", ICRA 2008: the squared distance to the segment through the two nearest
+  /// reference points, here the line fitted to the neighbours), linearised and solved by
+  /// Gauss-Newton per iteration.
   kPointToLine,
 };
 
@@ -64,13 +66,15 @@ struct IcpOptions {
 /// Covariance: the Gauss-Newton approximation of the final residuals' Hessian,
 /// Sigma = sigma^2 (J^T W J)^-1, with J the Jacobian of every kept residual with respect to
 /// (x, y, yaw) at the final pose and sigma^2 = sum w r^2 / (m - 3) the residual variance over the m
-/// scalar residuals (Censi, "An accurate closed-form estimate of ICP's covariance", ICRA 2007,
-/// gives the exact form; this is its first term, which ignores the correspondences' sensitivity
-/// to the measurements). Eigenvalues of J^T W J below 1e-9 of the largest are raised to that
-/// floor, so a degenerate direction (a corridor's axis under point-to-line) shows as a huge but
-/// finite variance. Point-to-point's Hessian does not see such degeneracy: use point-to-line when
-/// the covariance matters.
-/// Deterministic; Match is thread-safe.
+/// scalar residuals. This is Censi's closed form ("An accurate closed-form estimate of ICP's
+/// covariance", ICRA 2007: (d2J/dx2)^-1 d2J/dzdx cov(z) (d2J/dzdx)^T (d2J/dx2)^-1) for isotropic
+/// noise on the source points with the terms in the residuals themselves dropped (they vanish at a
+/// perfect fit), and with the reference taken as exact: against a reference as noisy as the source,
+/// the true spread is up to twice as large. Eigenvalues of J^T W J below 1e-9 of the largest are
+/// raised to that floor, so a degenerate direction (a corridor's axis under point-to-line) shows as
+/// a huge but finite variance, or, when noise in the normals keeps it finite, as a large ratio to
+/// the other direction's. Point-to- point's Hessian does not see such degeneracy: use point-to-line
+/// when the covariance matters. Deterministic; Match is thread-safe.
 class IcpMatcher {
  public:
   /// Indexes `reference` (points in the reference frame) for matching.
