@@ -97,11 +97,13 @@ TEST(IcpMatcherTest, TrimmedIcpIgnoresTwentyPercentOutliers) {
   const RangeFinderSpec spec;
   ScanPointsOptions points;
   points.voxel_size_m = 0.05;
-  for (const IcpMetric metric : {IcpMetric::kPointToPoint, IcpMetric::kPointToLine}) {
+  for (const auto& [metric, kernel] : {std::pair{IcpMetric::kPointToPoint, RobustKernel::kCauchy},
+                                       {IcpMetric::kPointToLine, RobustKernel::kCauchy},
+                                       {IcpMetric::kPointToLine, RobustKernel::kHuber}}) {
     IcpOptions trimmed;
     trimmed.metric = metric;
     trimmed.trim_fraction = 0.9;
-    trimmed.kernel = RobustKernel::kCauchy;
+    trimmed.kernel = kernel;
     IcpOptions plain;
     plain.metric = metric;
     const bool to_line = metric == IcpMetric::kPointToLine;
@@ -124,7 +126,8 @@ TEST(IcpMatcherTest, TrimmedIcpIgnoresTwentyPercentOutliers) {
       trimmed_error_sum += t_err;
       plain_error_sum += (p->pose.translation() - offset.translation()).norm();
     }
-    EXPECT_LT(trimmed_error_sum, plain_error_sum) << static_cast<int>(metric);
+    EXPECT_LT(trimmed_error_sum, plain_error_sum)
+        << static_cast<int>(metric) << " " << static_cast<int>(kernel);
   }
 }
 
