@@ -174,14 +174,17 @@ void BM_CorrelativeSearchIntel(benchmark::State& state) {
   const Pose2 truth = scan.logged_pose;
   const Pose2 initial(truth.x() + 4.0, truth.y() - 3.0, truth.theta() + 1.5);
   double error_m = -1.0;
+  int nodes = 0;
   for (auto _ : state) {
     const std::optional<MatchResult> m = matcher.Match(cloud, initial);
     error_m = m ? (m->pose.translation() - truth.translation()).norm() : -1.0;
+    nodes = m ? m->iterations : -1;
     benchmark::DoNotOptimize(m);
   }
   state.counters["points"] = static_cast<double>(cloud.size());
   state.counters["error_m"] = error_m;
   state.counters["yaw_step_mrad"] = 1000.0 * matcher.AngularStep(cloud);
+  state.counters["nodes"] = nodes;
 }
 BENCHMARK(BM_CorrelativeSearchIntel)
     ->Args({50, 7})
