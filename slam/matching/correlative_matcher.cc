@@ -1,6 +1,7 @@
 #include "slam/matching/correlative_matcher.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdint>
 
@@ -125,21 +126,39 @@ std::optional<MatchResult> CorrelativeMatcher::Match(std::span<const Eigen::Vect
   const std::int64_t side = 2 * wxy + 1;
 
   // The discretised scan at every yaw (cells relative to the raster's cell (0, 0)).
+  // The discretised scan at every yaw (cells relative to the raster's cell (0, 0)), with the
+  // cells' bounding box per yaw.
   std::vector<Eigen::Array2i> cells(static_cast<std::size_t>(num_angles) * n);
+  std::vector<Eigen::Array4i> boxes(static_cast<std::size_t>(num_angles));  // min x, y, max x, y
   for (int k = -wk; k <= wk; ++k) {
     const Pose2 pose(initial.x(), initial.y(), initial.theta() + k * step);
     Eigen::Array2i* out = &cells[static_cast<std::size_t>(k + wk) * n];
+    Eigen::Array4i box(INT_MAX, INT_MAX, INT_MIN, INT_MIN);
     for (int p = 0; p < n; ++p) {
       const Eigen::Vector2d w = pose * points_base[static_cast<std::size_t>(p)];
       out[p] = Eigen::Array2i(static_cast<int>(std::floor((w.x() - origin_.x()) / resolution_)),
                               static_cast<int>(std::floor((w.y() - origin_.y()) / resolution_)));
+      box = Eigen::Array4i(std::min(box[0], out[p].x()), std::min(box[1], out[p].y()),
+                           std::max(box[2], out[p].x()), std::max(box[3], out[p].y()));
     }
+    boxes[static_cast<std::size_t>(k + wk)] = box;
   }
+  // Sum of level `level` over the scan at yaw k shifted by (i, j), in point order; the bounds
+  // check is skipped when the whole shifted box lies inside the level (same sum either way).
   auto score = [&](int level, int k, int i, int j) {
     const Level& l = levels_[static_cast<std::size_t>(level)];
     const Eigen::Array2i* c = &cells[static_cast<std::size_t>(k + wk) * n];
+    const Eigen::Array4i& box = boxes[static_cast<std::size_t>(k + wk)];
     const int dx = i + l.offset, dy = j + l.offset;
     float sum = 0.0f;
+    if (box[0] + dx >= 0 && box[1] + dy >= 0 && box[2] + dx < l.width && box[3] + dy < l.height) {
+      const std::ptrdiff_t shift = static_cast<std::ptrdiff_t>(dy) * l.width + dx;
+      const float* values = l.values.data();
+      for (int p = 0; p < n; ++p) {
+        sum += values[shift + static_cast<std::ptrdiff_t>(c[p].y()) * l.width + c[p].x()];
+      }
+      return sum;
+    }
     for (int p = 0; p < n; ++p) {
       const int x = c[p].x() + dx, y = c[p].y() + dy;
       if (static_cast<unsigned>(x) < static_cast<unsigned>(l.width) &&
