@@ -1,0 +1,272 @@
+#include "slam/matching/correlative_matcher.h"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+
+#include "slam/types/check.h"
+#include "slam/types/validation.h"
+
+namespace slamrig::slam {
+namespace {
+
+// A block of 2^level x 2^level translations at one yaw, by its lowest corner (i, j).
+struct Node {
+  int k = 0;
+  int i = 0;
+  int j = 0;
+  float bound = 0.0f;
+  std::int64_t index = 0;  // of its corner in the exhaustive search's (k, j, i) order
+};
+
+// Higher bound first; ties by the search order, so the visiting order is fixed.
+bool BetterFirst(const Node& a, const Node& b) {
+  return a.bound > b.bound || (a.bound == b.bound && a.index < b.index);
+}
+
+}  // namespace
+
+std::vector<std::string> CorrelativeMatcherOptions::Validate() const {
+  std::vector<std::string> errors;
+  auto add = [&](const char* field, double value, const char* rule) {
+    errors.push_back(RuleViolation(std::string("correlative.") + field, value, rule));
+  };
+  if (!(linear_window_m >= 0.0)) add("linear_window_m", linear_window_m, "must be >= 0");
+  if (!(angular_window_rad >= 0.0 && angular_window_rad <= 3.14159265358979 + 1e-9)) {
+    add("angular_window_rad", angular_window_rad, "must be in [0, pi]");
+  }
+  if (!(angular_step_rad >= 0.0)) add("angular_step_rad", angular_step_rad, "must be >= 0");
+  if (branch_and_bound_depth < 1 || branch_and_bound_depth > 12) {
+    add("branch_and_bound_depth", branch_and_bound_depth, "must be in [1, 12]");
+  }
+  if (!std::isfinite(min_score)) add("min_score", min_score, "must be finite");
+  if (covariance_half_cells < 1) {
+    add("covariance_half_cells", covariance_half_cells, "must be >= 1");
+  }
+  if (covariance_half_steps < 1) {
+    add("covariance_half_steps", covariance_half_steps, "must be >= 1");
+  }
+  if (!(covariance_score_scale > 0.0)) {
+    add("covariance_score_scale", covariance_score_scale, "must be > 0");
+  }
+  return errors;
+}
+
+CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
+                                       const GridView& raster)
+    : options_(options), origin_(raster.origin), resolution_(raster.resolution) {
+  SLAMRIG_CHECK(options_.Validate().empty(), "invalid CorrelativeMatcherOptions");
+  std::vector<float> values(static_cast<std::size_t>(raster.width) * raster.height);
+  for (int y = 0; y < raster.height; ++y) {
+    for (int x = 0; x < raster.width; ++x) {
+      values[static_cast<std::size_t>(y) * raster.width + x] = raster.At(x, y);
+    }
+  }
+  Precompute(std::move(values), raster.width, raster.height);
+}
+
+CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
+                                       const OccupancyGrid& grid)
+    : options_(options), origin_(grid.origin()), resolution_(grid.resolution()) {
+  SLAMRIG_CHECK(options_.Validate().empty(), "invalid CorrelativeMatcherOptions");
+  std::vector<float> values(grid.log_odds().size());
+  for (std::size_t c = 0; c < values.size(); ++c) {
+    const double l = grid.log_odds()[c];
+    values[c] = l > 0.0 ? static_cast<float>(1.0 - 1.0 / (1.0 + std::exp(l))) : 0.0f;
+  }
+  Precompute(std::move(values), grid.width(), grid.height());
+}
+
+void CorrelativeMatcher::Precompute(std::vector<float> values, int width, int height) {
+  levels_.resize(static_cast<std::size_t>(options_.branch_and_bound_depth));
+  levels_[0] = Level{0, width, height, std::move(values)};
+  // Level h from level h-1: the max of four blocks of 2^(h-1) (Hess 2016, Sec. V-C, by doubling).
+  for (std::size_t h = 1; h < levels_.size(); ++h) {
+    const Level& prev = levels_[h - 1];
+    const int half = 1 << (h - 1);
+    Level& level = levels_[h];
+    level.offset = (1 << h) - 1;
+    level.width = width + level.offset;
+    level.height = height + level.offset;
+    level.values.assign(static_cast<std::size_t>(level.width) * level.height, 0.0f);
+    auto prev_at = [&](int x, int y) {  // raster cell coordinates
+      const int px = x + prev.offset, py = y + prev.offset;
+      if (px < 0 || py < 0 || px >= prev.width || py >= prev.height) return 0.0f;
+      return prev.values[static_cast<std::size_t>(py) * prev.width + px];
+    };
+    for (int ly = 0; ly < level.height; ++ly) {
+      const int y = ly - level.offset;
+      for (int lx = 0; lx < level.width; ++lx) {
+        const int x = lx - level.offset;
+        level.values[static_cast<std::size_t>(ly) * level.width + lx] =
+            std::max(std::max(prev_at(x, y), prev_at(x + half, y)),
+                     std::max(prev_at(x, y + half), prev_at(x + half, y + half)));
+      }
+    }
+  }
+}
+
+double CorrelativeMatcher::AngularStep(std::span<const Eigen::Vector2d> points_base) const {
+  if (options_.angular_step_rad > 0.0) return options_.angular_step_rad;
+  double d_max = 0.0;
+  for (const Eigen::Vector2d& p : points_base) d_max = std::max(d_max, p.norm());
+  if (d_max <= resolution_) return std::max(options_.angular_window_rad, 1e-3);
+  return std::acos(1.0 - resolution_ * resolution_ / (2.0 * d_max * d_max));
+}
+
+std::optional<MatchResult> CorrelativeMatcher::Match(std::span<const Eigen::Vector2d> points_base,
+                                                     const Pose2& initial) const {
+  if (points_base.empty()) return std::nullopt;
+  const int n = static_cast<int>(points_base.size());
+  const double step = AngularStep(points_base);
+  const int wk = static_cast<int>(std::ceil(options_.angular_window_rad / step - 1e-9));
+  const int wxy = static_cast<int>(std::ceil(options_.linear_window_m / resolution_ - 1e-9));
+  const int num_angles = 2 * wk + 1;
+  const std::int64_t side = 2 * wxy + 1;
+
+  // The discretised scan at every yaw (cells relative to the raster's cell (0, 0)).
+  // The discretised scan at every yaw (cells relative to the raster's cell (0, 0)), with the
+  // cells' bounding box per yaw.
+  std::vector<Eigen::Array2i> cells(static_cast<std::size_t>(num_angles) * n);
+  std::vector<Eigen::Array4i> boxes(static_cast<std::size_t>(num_angles));  // min x, y, max x, y
+  for (int k = -wk; k <= wk; ++k) {
+    const Pose2 pose(initial.x(), initial.y(), initial.theta() + k * step);
+    Eigen::Array2i* out = &cells[static_cast<std::size_t>(k + wk) * n];
+    Eigen::Array4i box(INT_MAX, INT_MAX, INT_MIN, INT_MIN);
+    for (int p = 0; p < n; ++p) {
+      const Eigen::Vector2d w = pose * points_base[static_cast<std::size_t>(p)];
+      out[p] = Eigen::Array2i(static_cast<int>(std::floor((w.x() - origin_.x()) / resolution_)),
+                              static_cast<int>(std::floor((w.y() - origin_.y()) / resolution_)));
+      box = Eigen::Array4i(std::min(box[0], out[p].x()), std::min(box[1], out[p].y()),
+                           std::max(box[2], out[p].x()), std::max(box[3], out[p].y()));
+    }
+    boxes[static_cast<std::size_t>(k + wk)] = box;
+  }
+  // Sum of level `level` over the scan at yaw k shifted by (i, j), in point order; the bounds
+  // check is skipped when the whole shifted box lies inside the level (same sum either way).
+  auto score = [&](int level, int k, int i, int j) {
+    const Level& l = levels_[static_cast<std::size_t>(level)];
+    const Eigen::Array2i* c = &cells[static_cast<std::size_t>(k + wk) * n];
+    const Eigen::Array4i& box = boxes[static_cast<std::size_t>(k + wk)];
+    const int dx = i + l.offset, dy = j + l.offset;
+    float sum = 0.0f;
+    if (box[0] + dx >= 0 && box[1] + dy >= 0 && box[2] + dx < l.width && box[3] + dy < l.height) {
+      const std::ptrdiff_t shift = static_cast<std::ptrdiff_t>(dy) * l.width + dx;
+      const float* values = l.values.data();
+      for (int p = 0; p < n; ++p) {
+        sum += values[shift + static_cast<std::ptrdiff_t>(c[p].y()) * l.width + c[p].x()];
+      }
+      return sum;
+    }
+    for (int p = 0; p < n; ++p) {
+      const int x = c[p].x() + dx, y = c[p].y() + dy;
+      if (static_cast<unsigned>(x) < static_cast<unsigned>(l.width) &&
+          static_cast<unsigned>(y) < static_cast<unsigned>(l.height)) {
+        sum += l.values[static_cast<std::size_t>(y) * l.width + x];
+      }
+    }
+    return sum;
+  };
+  auto index_of = [&](int k, int i, int j) {
+    return (static_cast<std::int64_t>(k + wk) * side + (j + wxy)) * side + (i + wxy);
+  };
+
+  // Best so far: the sum to beat (min_score until a pose reaches it) and its search index.
+  float best_sum = static_cast<float>(options_.min_score * n);
+  std::int64_t best_index = -1;
+  Node best;
+  std::int64_t nodes_scored = 0;
+  auto pruned = [&](const Node& node) {
+    return node.bound < best_sum ||
+           (best_index >= 0 && node.bound == best_sum && node.index >= best_index);
+  };
+
+  // Depth-first branch and bound (Hess 2016, Sec. V-A), recursive over the levels.
+  auto descend = [&](auto&& self, const Node& node, int level) -> void {
+    if (level == 0) {
+      if (node.bound > best_sum ||
+          (node.bound == best_sum && (best_index < 0 || node.index < best_index))) {
+        best_sum = node.bound;
+        best_index = node.index;
+        best = node;
+      }
+      return;
+    }
+    const int half = 1 << (level - 1);
+    Node children[4];
+    int count = 0;
+    for (const int dj : {0, half}) {
+      for (const int di : {0, half}) {
+        const int i = node.i + di, j = node.j + dj;
+        if (i > wxy || j > wxy) continue;
+        children[count++] =
+            Node{node.k, i, j, score(level - 1, node.k, i, j), index_of(node.k, i, j)};
+      }
+    }
+    nodes_scored += count;
+    for (int a = 1; a < count; ++a) {  // insertion sort of at most four
+      for (int b = a; b > 0 && BetterFirst(children[b], children[b - 1]); --b) {
+        std::swap(children[b], children[b - 1]);
+      }
+    }
+    for (int c = 0; c < count; ++c) {
+      if (!pruned(children[c])) self(self, children[c], level - 1);
+    }
+  };
+
+  const int top = options_.branch_and_bound_depth - 1;
+  const int block = 1 << top;
+  std::vector<Node> roots;
+  for (int k = -wk; k <= wk; ++k) {
+    for (int j = -wxy; j <= wxy; j += block) {
+      for (int i = -wxy; i <= wxy; i += block) {
+        roots.push_back(Node{k, i, j, score(top, k, i, j), index_of(k, i, j)});
+      }
+    }
+  }
+  nodes_scored += static_cast<std::int64_t>(roots.size());
+  std::sort(roots.begin(), roots.end(), BetterFirst);
+  for (const Node& root : roots) {
+    if (root.bound < best_sum) break;  // sorted: every later root is bounded lower still
+    if (!pruned(root)) descend(descend, root, top);
+  }
+  if (best_index < 0) return std::nullopt;
+
+  MatchResult result;
+  result.pose = Pose2(initial.x() + best.i * resolution_, initial.y() + best.j * resolution_,
+                      initial.theta() + best.k * step);
+  result.score = static_cast<double>(best_sum) / n;
+  result.iterations = static_cast<int>(std::min<std::int64_t>(nodes_scored, 1 << 30));
+  result.correspondences = n;
+  result.converged = true;
+
+  // Covariance from the score-weighted spread around the best (Olson 2009), with the
+  // offsets relative to the best pose so the sums stay well conditioned.
+  const int cc = options_.covariance_half_cells, cs = options_.covariance_half_steps;
+  Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  double total = 0.0;
+  for (int dk = -cs; dk <= cs; ++dk) {
+    const int k = best.k + dk;
+    if (k < -wk || k > wk) continue;
+    for (int dj = -cc; dj <= cc; ++dj) {
+      for (int di = -cc; di <= cc; ++di) {
+        const double s = static_cast<double>(score(0, k, best.i + di, best.j + dj)) / n;
+        const double w = std::exp((s - result.score) / options_.covariance_score_scale);
+        const Eigen::Vector3d x(di * resolution_, dj * resolution_, dk * step);
+        total += w;
+        mean += w * x;
+        moment += w * x * x.transpose();
+      }
+    }
+  }
+  mean /= total;
+  result.covariance = moment / total - mean * mean.transpose();
+  result.covariance(0, 0) += resolution_ * resolution_ / 12.0;
+  result.covariance(1, 1) += resolution_ * resolution_ / 12.0;
+  result.covariance(2, 2) += step * step / 12.0;
+  return result;
+}
+
+}  // namespace slamrig::slam

@@ -1,0 +1,98 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "slam/grid/occupancy_grid.h"
+#include "slam/matching/grid_view.h"
+#include "slam/matching/match_result.h"
+#include "slam/types/pose2.h"
+
+namespace slamrig::slam {
+
+/// The search window and acceptance of the correlative scan matcher.
+struct CorrelativeMatcherOptions {
+  double linear_window_m = 7.0;  ///< search x and y within +-this of the initial guess
+  double angular_window_rad = 3.14159265358979;  ///< search yaw within +-this
+  /// Yaw step; 0 = from the scan's farthest point d_max so that no point moves more than a cell
+  /// between steps: acos(1 - r^2 / (2 d_max^2)) (Hess et al. 2016, Sec. V).
+  double angular_step_rad = 0.0;
+  /// Levels of precomputation grids: the coarsest branch-and-bound nodes span 2^(depth-1) cells
+  /// in x and y. 1 = exhaustive search; at most 12 (each level is a padded copy of the raster).
+  int branch_and_bound_depth = 7;
+  /// A pose is only accepted when the mean raster value over the points reaches this; no pose in
+  /// the window does: the match fails.
+  double min_score = 0.5;
+  /// Covariance: the window of finest-level poses around the best (+-cells in x and y, +-yaw
+  /// steps) whose scores are weighted ...
+  int covariance_half_cells = 5;
+  int covariance_half_steps = 5;
+  /// ... by exp((score - best score) / covariance_score_scale).
+  double covariance_score_scale = 0.02;
+
+  /// One message per broken rule (prefixed "correlative.").
+  std::vector<std::string> Validate() const;
+};
+
+/// Real-time correlative scan matching (Olson, "Real-Time Correlative Scan Matching", ICRA 2009)
+/// with the exact multi-resolution search of Hess et al., "Real-Time Loop Closure in 2D LIDAR
+/// SLAM", ICRA 2016, Sec. V: precomputation grids (Sec. V-C: each cell of level h holds the maximum
+/// of the 2^h x 2^h raster cells above and right of it) bound the score of a whole block of
+/// translations, and a depth-first branch and bound (Sec. V-A) visits the blocks best bound
+/// first and prunes every block whose bound cannot beat the best pose so far.
+///
+/// The search is over the discrete poses (x0 + i r, y0 + j r, yaw0 + k s) of the window, with r the
+/// raster's resolution and s the yaw step. The scan at yaw index k is discretised once: point p's
+/// cell is c_k(p) = floor((Pose2(x0, y0, yaw0 + k s) * p - origin) / r), and the pose (i, j, k)
+/// scores sum_p raster(c_k(p) + (i, j)) / n in float, in point order, cells outside reading 0. The
+/// result is exactly the exhaustive search's best pose and score; ties go to the smallest (k, j,
+/// i), the order in which the exhaustive search lists them.
+///
+/// Covariance (Olson 2009's estimate from the score distribution): the weighted mean and spread of
+/// the poses in a small window around the best, each weighted by exp((score - best) /
+/// covariance_score_scale), a softmax that treats the score as a log-likelihood up to scale; r^2 /
+/// 12 and s^2 / 12 are added for the discretisation. Along a direction where the score is flat (a
+/// corridor's axis) the variance reaches the window's (2n + 1)^2 r^2 / 12: read it as "at least
+/// that".
+///
+/// The raster is copied; values should be >= 0 (probabilities, a likelihood field). Deterministic
+/// and thread-safe.
+class CorrelativeMatcher {
+ public:
+  /// Precomputes the search grids of `raster`.
+  CorrelativeMatcher(const CorrelativeMatcherOptions& options, const GridView& raster);
+  /// Searches an occupancy grid: a cell's value is its occupancy probability when it is more
+  /// likely occupied than not (log-odds > 0), else 0.
+  CorrelativeMatcher(const CorrelativeMatcherOptions& options, const OccupancyGrid& grid);
+
+  const CorrelativeMatcherOptions& options() const { return options_; }
+
+  /// The best pose of `points_base` (points in the base frame) in the window around `initial`,
+  /// or std::nullopt when no pose reaches min_score (or there are no points). `iterations` counts
+  /// the branch-and-bound nodes scored.
+  std::optional<MatchResult> Match(std::span<const Eigen::Vector2d> points_base,
+                                   const Pose2& initial) const;
+
+  /// The yaw step Match uses for `points_base`.
+  double AngularStep(std::span<const Eigen::Vector2d> points_base) const;
+
+ private:
+  // One precomputation grid: covers cells [-offset, width - offset) of the raster in x (and y).
+  struct Level {
+    int offset = 0;
+    int width = 0;
+    int height = 0;
+    std::vector<float> values;
+  };
+  void Precompute(std::vector<float> values, int width, int height);
+
+  CorrelativeMatcherOptions options_;
+  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
+  double resolution_ = 1.0;
+  std::vector<Level> levels_;  // levels_[h]: blocks of 2^h cells
+};
+
+}  // namespace slamrig::slam

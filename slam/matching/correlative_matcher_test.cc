@@ -1,0 +1,223 @@
+#include "slam/matching/correlative_matcher.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <numbers>
+
+#include "slam/matching/scan_points.h"
+#include "slam/matching/testing/segment_world.h"
+
+namespace slamrig::slam {
+namespace {
+
+using testing::RangeFinderSpec;
+using testing::SegmentWorld;
+
+// Independent exhaustive search over the window, as CorrelativeMatcher's header defines it: every
+// yaw k, every (j, i) in order, the float sum of the raster at the discretised points; the first
+// strictly better pose wins, so ties go to the smallest (k, j, i).
+std::optional<MatchResult> ExhaustiveSearch(const GridView& raster,
+                                            const std::vector<Eigen::Vector2d>& points,
+                                            const Pose2& initial, int wxy, int wk, double step,
+                                            double min_score) {
+  const int n = static_cast<int>(points.size());
+  std::optional<MatchResult> best;
+  float best_sum = 0.0f;
+  for (int k = -wk; k <= wk; ++k) {
+    const Pose2 rotated(initial.x(), initial.y(), initial.theta() + k * step);
+    std::vector<Eigen::Array2i> cells;
+    for (const Eigen::Vector2d& p : points) {
+      const Eigen::Vector2d w = rotated * p;
+      cells.emplace_back(
+          static_cast<int>(std::floor((w.x() - raster.origin.x()) / raster.resolution)),
+          static_cast<int>(std::floor((w.y() - raster.origin.y()) / raster.resolution)));
+    }
+    for (int j = -wxy; j <= wxy; ++j) {
+      for (int i = -wxy; i <= wxy; ++i) {
+        float sum = 0.0f;
+        for (const Eigen::Array2i& c : cells) sum += raster.At(c.x() + i, c.y() + j);
+        if (static_cast<double>(sum) < min_score * n) continue;
+        if (best && !(sum > best_sum)) continue;
+        best_sum = sum;
+        best = MatchResult{};
+        best->pose = Pose2(initial.x() + i * raster.resolution, initial.y() + j * raster.resolution,
+                           initial.theta() + k * step);
+        best->score = static_cast<double>(sum) / n;
+      }
+    }
+  }
+  return best;
+}
+
+OccupancyGrid MapFromScans(const SegmentWorld& world, const std::vector<Pose2>& poses,
+                           RandomEngine& rng) {
+  OccupancyGrid grid{OccupancyGridOptions{}};
+  for (const Pose2& pose : poses)
+    grid.InsertScan(world.Scan(pose, Time(), RangeFinderSpec{}, &rng), pose);
+  return grid;
+}
+
+// Poses round the office's corridor loop every 0.5 m, facing along it.
+std::vector<Pose2> OfficeLoopPoses() {
+  std::vector<Pose2> poses;
+  for (double x = 1.5; x <= 18.5; x += 0.5) poses.emplace_back(x, 1.5, 0.0);
+  for (double y = 1.5; y <= 10.5; y += 0.5) poses.emplace_back(18.5, y, 1.57);
+  for (double x = 18.5; x >= 1.5; x -= 0.5) poses.emplace_back(x, 10.5, 3.14);
+  for (double y = 10.5; y >= 1.5; y -= 0.5) poses.emplace_back(1.5, y, -1.57);
+  return poses;
+}
+
+// Branch and bound returns exactly the exhaustive search's best pose and score, on random rasters
+// with continuous values and with three levels only (many ties), at every depth.
+TEST(CorrelativeMatcherTest, BranchAndBoundEqualsExhaustiveSearch) {
+  RandomEngine rng(21);
+  int found = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const int width = 30 + static_cast<int>(20 * Uniform01(rng));
+    const int height = 30 + static_cast<int>(20 * Uniform01(rng));
+    std::vector<float> values(static_cast<std::size_t>(width) * height);
+    const bool ties = trial % 2 == 1;
+    for (float& v : values) {
+      const double u = Uniform01(rng);
+      v = ties ? static_cast<float>(std::floor(3.0 * u) / 2.0) : static_cast<float>(u * u);
+    }
+    const GridView raster{values.data(), width, height, Eigen::Vector2d(-1.0, -0.9), 0.05};
+    std::vector<Eigen::Vector2d> points;
+    for (int p = 0; p < 25; ++p)
+      points.emplace_back(1.6 * Uniform01(rng) - 0.8, 1.6 * Uniform01(rng) - 0.8);
+    CorrelativeMatcherOptions options;
+    options.linear_window_m = 0.3 + 0.2 * Uniform01(rng);
+    options.angular_window_rad = 0.2;
+    options.angular_step_rad = 0.04;
+    options.branch_and_bound_depth = 1 + trial % 6;
+    options.min_score = trial % 3 == 0 ? 0.75 : 0.0;
+    const CorrelativeMatcher matcher(options, raster);
+    const Pose2 initial(0.3 * Uniform01(rng), 0.3 * Uniform01(rng), 6.0 * Uniform01(rng));
+    const std::optional<MatchResult> fast = matcher.Match(points, initial);
+    const int wxy = static_cast<int>(std::ceil(options.linear_window_m / 0.05 - 1e-9));
+    const std::optional<MatchResult> slow =
+        ExhaustiveSearch(raster, points, initial, wxy, 5, 0.04, options.min_score);
+    ASSERT_EQ(fast.has_value(), slow.has_value()) << trial;
+    if (!slow) continue;
+    ++found;
+    EXPECT_EQ(fast->pose, slow->pose) << trial;
+    EXPECT_EQ(fast->score, slow->score) << trial;
+  }
+  EXPECT_GT(found, 30);
+}
+
+// On a map of the office, a decimated scan is found from an initial guess metres and up to pi off.
+TEST(CorrelativeMatcherTest, RecoversLargeOffsetsOnAnOccupancyGrid) {
+  const SegmentWorld world = SegmentWorld::Office();
+  RandomEngine rng(4);
+  const OccupancyGrid grid = MapFromScans(world, OfficeLoopPoses(), rng);
+  CorrelativeMatcherOptions options;
+  options.linear_window_m = 2.5;
+  options.branch_and_bound_depth = 6;
+  options.min_score = 0.3;
+  const CorrelativeMatcher matcher(options, grid);
+  ScanPointsOptions points;
+  points.voxel_size_m = 0.15;
+  for (int trial = 0; trial < 8; ++trial) {
+    const std::vector<Pose2> loop = OfficeLoopPoses();
+    const Pose2 base =
+        loop[static_cast<std::size_t>(Uniform01(rng) * static_cast<double>(loop.size()))];
+    const Pose2 truth(base.x() + 0.4 * Uniform01(rng) - 0.2, base.y() + 0.4 * Uniform01(rng) - 0.2,
+                      6.28 * Uniform01(rng));
+    const std::vector<Eigen::Vector2d> scan =
+        ScanToBasePoints(world.Scan(truth, Time(), RangeFinderSpec{}, &rng), points);
+    const Pose2 initial(truth.x() + 4.0 * Uniform01(rng) - 2.0,
+                        truth.y() + 4.0 * Uniform01(rng) - 2.0,
+                        truth.theta() + (2.0 * Uniform01(rng) - 1.0) * 3.0);
+    const std::optional<MatchResult> m = matcher.Match(scan, initial);
+    ASSERT_TRUE(m.has_value()) << trial;
+    EXPECT_LT((m->pose.translation() - truth.translation()).norm(), 0.08) << trial;
+    EXPECT_LT(std::abs(NormalizeAngle(m->pose.theta() - truth.theta())), 0.02) << trial;
+    EXPECT_GT(m->score, 0.5) << trial;
+    // Walls in every direction: no direction is much less certain than another (the contrast
+    // the corridor test below relies on).
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(m->covariance.topLeftCorner<2, 2>());
+    EXPECT_LT(eig.eigenvalues()[1], 5.0 * eig.eigenvalues()[0]) << trial;
+  }
+}
+
+// A scan from another building scores below min_score everywhere in the window: a failure, while
+// a scan of the mapped place at the same spot is accepted.
+TEST(CorrelativeMatcherTest, MinScoreRejectsAScanFromAnotherPlace) {
+  const SegmentWorld office = SegmentWorld::Office();
+  RandomEngine rng(8);
+  const OccupancyGrid grid = MapFromScans(office, OfficeLoopPoses(), rng);
+  CorrelativeMatcherOptions options;
+  options.linear_window_m = 1.0;
+  options.min_score = 0.5;
+  const CorrelativeMatcher matcher(options, grid);
+  SegmentWorld hall({});
+  for (int s = 0; s < 7; ++s) {  // a heptagonal hall, 6 m across
+    const double a0 = 2.0 * std::numbers::pi * s / 7.0, a1 = 2.0 * std::numbers::pi * (s + 1) / 7.0;
+    hall = SegmentWorld([&] {
+      std::vector<testing::Segment> walls = hall.walls();
+      walls.push_back({Eigen::Vector2d(3.0 * std::cos(a0), 3.0 * std::sin(a0)),
+                       Eigen::Vector2d(3.0 * std::cos(a1), 3.0 * std::sin(a1))});
+      return walls;
+    }());
+  }
+  ScanPointsOptions points;
+  points.voxel_size_m = 0.1;
+  const Pose2 here(9.0, 1.6, 0.2);
+  const std::vector<Eigen::Vector2d> foreign =
+      ScanToBasePoints(hall.Scan(Pose2(0.5, 0.0, 0.0), Time(), RangeFinderSpec{}, &rng), points);
+  EXPECT_FALSE(matcher.Match(foreign, here).has_value());
+  const std::vector<Eigen::Vector2d> local =
+      ScanToBasePoints(office.Scan(here, Time(), RangeFinderSpec{}, &rng), points);
+  const std::optional<MatchResult> m = matcher.Match(local, Pose2(9.3, 1.4, 0.0));
+  ASSERT_TRUE(m.has_value());
+  EXPECT_GE(m->score, 0.5);
+  EXPECT_FALSE(matcher.Match(std::vector<Eigen::Vector2d>{}, here).has_value());
+}
+
+// Two parallel walls: the score is flat along the corridor, so the covariance is far larger along
+// its axis than across it, and yaw stays well determined.
+TEST(CorrelativeMatcherTest, CovarianceIsLargestAlongACorridorsAxis) {
+  const SegmentWorld corridor({{{-60.0, 1.0}, {60.0, 1.0}}, {{-60.0, -1.0}, {60.0, -1.0}}});
+  RandomEngine rng(2);
+  std::vector<Pose2> poses;
+  for (double x = -10.0; x <= 10.0; x += 1.0) poses.emplace_back(x, 0.0, 0.0);
+  const OccupancyGrid grid = MapFromScans(corridor, poses, rng);
+  CorrelativeMatcherOptions options;
+  options.linear_window_m = 0.5;
+  options.angular_window_rad = 0.1;
+  options.min_score = 0.3;
+  const CorrelativeMatcher matcher(options, grid);
+  ScanPointsOptions points;
+  points.voxel_size_m = 0.1;
+  for (int trial = 0; trial < 5; ++trial) {
+    const Pose2 truth(2.0 * Uniform01(rng) - 1.0, 0.4 * Uniform01(rng) - 0.2,
+                      0.2 * Uniform01(rng) - 0.1);
+    const std::vector<Eigen::Vector2d> scan =
+        ScanToBasePoints(corridor.Scan(truth, Time(), RangeFinderSpec{}, &rng), points);
+    const std::optional<MatchResult> m =
+        matcher.Match(scan, Pose2(truth.x() + 0.2, truth.y() - 0.15, truth.theta() + 0.05));
+    ASSERT_TRUE(m.has_value()) << trial;
+    EXPECT_GT(m->covariance(0, 0), 20.0 * m->covariance(1, 1)) << trial;
+    EXPECT_LT(std::abs(m->pose.y() - truth.y()), 0.06) << trial;
+    EXPECT_LT(std::abs(NormalizeAngle(m->pose.theta() - truth.theta())), 0.01) << trial;
+  }
+}
+
+TEST(CorrelativeMatcherOptionsTest, ValidateNamesEveryBrokenField) {
+  CorrelativeMatcherOptions options;
+  EXPECT_TRUE(options.Validate().empty());
+  options.linear_window_m = -1.0;
+  options.branch_and_bound_depth = 0;
+  options.covariance_score_scale = 0.0;
+  const std::vector<std::string> errors = options.Validate();
+  ASSERT_EQ(errors.size(), 3u);
+  EXPECT_EQ(errors[0], "correlative.linear_window_m = -1; must be >= 0");
+  EXPECT_EQ(errors[1], "correlative.branch_and_bound_depth = 0; must be in [1, 12]");
+  EXPECT_EQ(errors[2], "correlative.covariance_score_scale = 0; must be > 0");
+}
+
+}  // namespace
+}  // namespace slamrig::slam

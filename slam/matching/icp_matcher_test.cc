@@ -1,0 +1,241 @@
+#include "slam/matching/icp_matcher.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "slam/matching/testing/segment_world.h"
+
+namespace slamrig::slam {
+namespace {
+
+using testing::RangeFinderSpec;
+using testing::SegmentWorld;
+
+// A random pose in the office's lower corridor, clear of walls and pillars.
+Pose2 RandomCorridorPose(RandomEngine& rng) {
+  return Pose2(2.0 + 15.5 * Uniform01(rng), 1.4 + 1.2 * Uniform01(rng), 6.28 * Uniform01(rng));
+}
+
+Pose2 RandomOffset(RandomEngine& rng, double xy_m, double yaw_rad) {
+  return Pose2(xy_m * (2.0 * Uniform01(rng) - 1.0), xy_m * (2.0 * Uniform01(rng) - 1.0),
+               yaw_rad * (2.0 * Uniform01(rng) - 1.0));
+}
+
+double YawError(const Pose2& a, const Pose2& b) {
+  return std::abs(NormalizeAngle(a.theta() - b.theta()));
+}
+
+class IcpRecoveryTest : public ::testing::TestWithParam<IcpMetric> {};
+
+// Scan-to-scan: two noisy scans a random offset apart (a few cm and degrees) are aligned from
+// the identity guess to well below the offset. Point-to-point is limited by the sampling (the
+// two scans' points are not the same wall points), point-to-line by the range noise.
+TEST_P(IcpRecoveryTest, RecoversRandomOffsetsBetweenScans) {
+  const SegmentWorld world = SegmentWorld::Office();
+  RandomEngine rng(7);
+  IcpOptions options;
+  options.metric = GetParam();
+  ScanPointsOptions points;
+  points.voxel_size_m = 0.05;
+  const RangeFinderSpec spec;
+  const bool to_line = GetParam() == IcpMetric::kPointToLine;
+  const double xy_tolerance = to_line ? 0.01 : 0.02, yaw_tolerance = to_line ? 0.003 : 0.008;
+  int converged = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const Pose2 a = RandomCorridorPose(rng);
+    const Pose2 offset = RandomOffset(rng, 0.08, 0.06);
+    const LaserScan ref = world.Scan(a, Time(), spec, &rng);
+    const LaserScan src = world.Scan(a * offset, Time(), spec, &rng);
+    const std::optional<MatchResult> m = IcpMatcher::MatchScans(options, points, ref, src, Pose2());
+    ASSERT_TRUE(m.has_value()) << trial;
+    EXPECT_LT((m->pose.translation() - offset.translation()).norm(), xy_tolerance) << trial;
+    EXPECT_LT(YawError(m->pose, offset), yaw_tolerance) << trial;
+    EXPECT_GT(m->score, 0.8) << trial;
+    converged += m->converged ? 1 : 0;
+  }
+  EXPECT_GE(converged, 36);  // the rest hit the cap oscillating between near-equal pairings
+}
+
+INSTANTIATE_TEST_SUITE_P(Metrics, IcpRecoveryTest,
+                         ::testing::Values(IcpMetric::kPointToPoint, IcpMetric::kPointToLine));
+
+// Scan-to-point-set: a local map made of two scans from other poses, in the world frame.
+TEST(IcpMatcherTest, AlignsAScanToALocalMapOfOtherScans) {
+  const SegmentWorld world = SegmentWorld::Office();
+  RandomEngine rng(3);
+  const RangeFinderSpec spec;
+  ScanPointsOptions points;
+  points.voxel_size_m = 0.05;
+  for (int trial = 0; trial < 20; ++trial) {
+    const Pose2 truth = RandomCorridorPose(rng);
+    std::vector<Eigen::Vector2d> map;
+    for (const Pose2& key : {truth * Pose2(-0.5, 0.1, 0.2), truth * Pose2(-1.0, -0.1, -0.1)}) {
+      for (const Eigen::Vector2d& p :
+           ScanToBasePoints(world.Scan(key, Time(), spec, &rng), points)) {
+        map.push_back(key * p);
+      }
+    }
+    const IcpMatcher matcher(IcpOptions{}, std::move(map));
+    const std::vector<Eigen::Vector2d> scan =
+        ScanToBasePoints(world.Scan(truth, Time(), spec, &rng), points);
+    const Pose2 guess = truth * RandomOffset(rng, 0.08, 0.05);
+    const std::optional<MatchResult> m = matcher.Match(scan, guess);
+    ASSERT_TRUE(m.has_value());
+    EXPECT_LT((m->pose.translation() - truth.translation()).norm(), 0.01) << trial;
+    EXPECT_LT(YawError(m->pose, truth), 0.003) << trial;
+  }
+}
+
+// 20 % of the source's beams return short at a random range (the beam model's random and short
+// readings: clutter, people): trimmed ICP with a robust kernel still converges to the truth, and
+// no worse than without them.
+TEST(IcpMatcherTest, TrimmedIcpIgnoresTwentyPercentOutliers) {
+  const SegmentWorld world = SegmentWorld::Office();
+  RandomEngine rng(5);
+  const RangeFinderSpec spec;
+  ScanPointsOptions points;
+  points.voxel_size_m = 0.05;
+  for (const auto& [metric, kernel] : {std::pair{IcpMetric::kPointToPoint, RobustKernel::kCauchy},
+                                       {IcpMetric::kPointToLine, RobustKernel::kCauchy},
+                                       {IcpMetric::kPointToLine, RobustKernel::kHuber}}) {
+    IcpOptions trimmed;
+    trimmed.metric = metric;
+    trimmed.trim_fraction = 0.9;
+    trimmed.kernel = kernel;
+    IcpOptions plain;
+    plain.metric = metric;
+    const bool to_line = metric == IcpMetric::kPointToLine;
+    const double xy_tolerance = to_line ? 0.012 : 0.025, yaw_tolerance = to_line ? 0.004 : 0.01;
+    double plain_error_sum = 0.0, trimmed_error_sum = 0.0;
+    for (int trial = 0; trial < 25; ++trial) {
+      const Pose2 a = RandomCorridorPose(rng);
+      const Pose2 offset = RandomOffset(rng, 0.05, 0.05);
+      const std::vector<Eigen::Vector2d> ref =
+          ScanToBasePoints(world.Scan(a, Time(), spec, &rng), points);
+      std::vector<Eigen::Vector2d> src =
+          ScanToBasePoints(world.Scan(a * offset, Time(), spec, &rng), points);
+      for (std::size_t i = 0; i < src.size(); i += 5) src[i] *= 0.05 + 0.95 * Uniform01(rng);
+      const std::optional<MatchResult> t = IcpMatcher(trimmed, ref).Match(src, Pose2());
+      const std::optional<MatchResult> p = IcpMatcher(plain, ref).Match(src, Pose2());
+      ASSERT_TRUE(t.has_value() && p.has_value());
+      const double t_err = (t->pose.translation() - offset.translation()).norm();
+      EXPECT_LT(t_err, xy_tolerance) << trial;
+      EXPECT_LT(YawError(t->pose, offset), yaw_tolerance) << trial;
+      trimmed_error_sum += t_err;
+      plain_error_sum += (p->pose.translation() - offset.translation()).norm();
+    }
+    EXPECT_LT(trimmed_error_sum, plain_error_sum)
+        << static_cast<int>(metric) << " " << static_cast<int>(kernel);
+  }
+}
+
+// Two parallel walls along a direction at 30 degrees: the point-to-line covariance's major axis
+// lies along the corridor and is far larger than across it.
+TEST(IcpMatcherTest, CovarianceIsLargestAlongACorridorsAxis) {
+  const double axis = 0.5236;
+  const Eigen::Vector2d u(std::cos(axis), std::sin(axis)), n(-std::sin(axis), std::cos(axis));
+  const SegmentWorld world({{-100.0 * u + n, 100.0 * u + n}, {-100.0 * u - n, 100.0 * u - n}});
+  RandomEngine rng(9);
+  const RangeFinderSpec spec;
+  ScanPointsOptions points;
+  points.voxel_size_m = 0.05;
+  for (int trial = 0; trial < 10; ++trial) {
+    const Pose2 a(0.0, 0.0, 6.28 * Uniform01(rng));
+    const Pose2 offset = RandomOffset(rng, 0.03, 0.03);
+    const std::optional<MatchResult> m =
+        IcpMatcher::MatchScans(IcpOptions{}, points, world.Scan(a, Time(), spec, &rng),
+                               world.Scan(a * offset, Time(), spec, &rng), Pose2());
+    ASSERT_TRUE(m.has_value());
+    // The covariance in the world frame: rotate the (x, y) block of the base-frame estimate.
+    const Eigen::Matrix2d r = Eigen::Rotation2Dd(a.theta()).toRotationMatrix();
+    const Eigen::Matrix2d cov = r * m->covariance.topLeftCorner<2, 2>() * r.transpose();
+    const double along = u.dot(cov * u), across = n.dot(cov * n);
+    EXPECT_GT(along, 100.0 * across) << trial;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+    EXPECT_GT(std::abs(eig.eigenvectors().col(1).dot(u)), 0.999) << trial;
+    // Across the corridor and in yaw the match is still exact.
+    const Eigen::Vector2d error = r * (m->pose.translation() - offset.translation());
+    EXPECT_LT(std::abs(n.dot(error)), 0.005) << trial;
+    EXPECT_LT(YawError(m->pose, offset), 0.003) << trial;
+  }
+}
+
+// In the office, with walls in every direction, the same covariance is nearly isotropic: the
+// contrast that makes the corridor's ratio a degeneracy test.
+TEST(IcpMatcherTest, CovarianceIsNearlyIsotropicWhereWallsFaceEveryWay) {
+  const SegmentWorld world = SegmentWorld::Office();
+  RandomEngine rng(19);
+  ScanPointsOptions points;
+  points.voxel_size_m = 0.05;
+  for (int trial = 0; trial < 10; ++trial) {
+    const Pose2 a = RandomCorridorPose(rng);
+    const std::optional<MatchResult> m = IcpMatcher::MatchScans(
+        IcpOptions{}, points, world.Scan(a, Time(), RangeFinderSpec{}, &rng),
+        world.Scan(a * Pose2(0.02, 0.01, 0.01), Time(), RangeFinderSpec{}, &rng), Pose2());
+    ASSERT_TRUE(m.has_value());
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(m->covariance.topLeftCorner<2, 2>());
+    EXPECT_LT(eig.eigenvalues()[1], 30.0 * eig.eigenvalues()[0]) << trial;
+  }
+}
+
+// The predicted covariance matches the spread of estimates over noise draws (within a factor 3).
+TEST(IcpMatcherTest, CovarianceMatchesTheSpreadOverNoiseDraws) {
+  const SegmentWorld world = SegmentWorld::Office();
+  RandomEngine rng(13);
+  RangeFinderSpec spec;
+  spec.range_sigma_m = 0.02;
+  ScanPointsOptions points;
+  points.beam_stride = 3;
+  const Pose2 a(8.0, 2.0, 0.3);
+  // A noise-free reference, so the spread comes from the source's noise alone.
+  const IcpMatcher matcher(IcpOptions{},
+                           ScanToBasePoints(world.Scan(a, Time(), spec, nullptr), points));
+  const int n = 60;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d sum_sq = Eigen::Matrix3d::Zero(), predicted = Eigen::Matrix3d::Zero();
+  for (int trial = 0; trial < n; ++trial) {
+    const std::vector<Eigen::Vector2d> src =
+        ScanToBasePoints(world.Scan(a, Time(), spec, &rng), points);
+    const std::optional<MatchResult> m = matcher.Match(src, Pose2(0.02, -0.01, 0.01));
+    ASSERT_TRUE(m.has_value());
+    const Eigen::Vector3d e(m->pose.x(), m->pose.y(), m->pose.theta());
+    sum += e;
+    sum_sq += e * e.transpose();
+    predicted += m->covariance / n;
+  }
+  const Eigen::Vector3d mean = sum / n;
+  const Eigen::Matrix3d empirical = sum_sq / n - mean * mean.transpose();
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_GT(empirical(i, i), predicted(i, i) / 3.0) << i;
+    EXPECT_LT(empirical(i, i), predicted(i, i) * 3.0) << i;
+  }
+}
+
+TEST(IcpMatcherTest, FailsWhenTheSourceIsFarFromTheReference) {
+  const SegmentWorld world = SegmentWorld::Office();
+  const ScanPointsOptions points;
+  const std::vector<Eigen::Vector2d> ref = ScanToBasePoints(
+      world.Scan(Pose2(8.0, 2.0, 0.0), Time(), RangeFinderSpec{}, nullptr), points);
+  const IcpMatcher matcher(IcpOptions{}, ref);
+  EXPECT_FALSE(matcher.Match(ref, Pose2(50.0, 50.0, 0.0)).has_value());
+  const IcpMatcher empty(IcpOptions{}, {});
+  EXPECT_FALSE(empty.Match(ref, Pose2()).has_value());
+}
+
+TEST(IcpOptionsTest, ValidateNamesEveryBrokenField) {
+  IcpOptions options;
+  EXPECT_TRUE(options.Validate().empty());
+  options.trim_fraction = 0.0;
+  options.max_correspondence_distance_m = -1.0;
+  options.normal_neighbors = 2;
+  const std::vector<std::string> errors = options.Validate();
+  ASSERT_EQ(errors.size(), 3u);
+  EXPECT_EQ(errors[0], "icp.max_correspondence_distance_m = -1; must be > 0");
+  EXPECT_EQ(errors[1], "icp.trim_fraction = 0; must be in (0, 1]");
+  EXPECT_EQ(errors[2], "icp.normal_neighbors = 2; must be >= 3");
+}
+
+}  // namespace
+}  // namespace slamrig::slam

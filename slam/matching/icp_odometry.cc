@@ -1,0 +1,189 @@
+#include "slam/matching/icp_odometry.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <unordered_set>
+
+#include "slam/types/check.h"
+#include "slam/types/validation.h"
+
+namespace slamrig::slam {
+namespace {
+
+// The first point of each voxel in the given order, in that order.
+std::vector<Eigen::Vector2d> VoxelThin(const std::vector<Eigen::Vector2d>& points, double voxel_m) {
+  if (voxel_m <= 0.0) return points;
+  std::unordered_set<std::int64_t> seen;
+  seen.reserve(points.size());
+  std::vector<Eigen::Vector2d> kept;
+  kept.reserve(points.size());
+  for (const Eigen::Vector2d& p : points) {
+    const auto vx = static_cast<std::int64_t>(std::floor(p.x() / voxel_m));
+    const auto vy = static_cast<std::int64_t>(std::floor(p.y() / voxel_m));
+    if (seen.insert(vx * 4000003 + vy).second) kept.push_back(p);
+  }
+  return kept;
+}
+
+}  // namespace
+
+std::vector<std::string> IcpOdometryOptions::Validate() const {
+  std::vector<std::string> errors = icp.Validate();
+  for (std::string& e : points.Validate()) errors.push_back(std::move(e));
+  auto add = [&](const char* field, double value, const char* rule) {
+    errors.push_back(RuleViolation(std::string("icp_odometry.") + field, value, rule));
+  };
+  if (local_map_keyframes < 1) add("local_map_keyframes", local_map_keyframes, "must be >= 1");
+  if (!(local_map_voxel_m >= 0.0)) add("local_map_voxel_m", local_map_voxel_m, "must be >= 0");
+  if (!(keyframe_distance_m >= 0.0)) {
+    add("keyframe_distance_m", keyframe_distance_m, "must be >= 0");
+  }
+  if (!(keyframe_angle_rad >= 0.0)) add("keyframe_angle_rad", keyframe_angle_rad, "must be >= 0");
+  if (!(max_translation_stddev_m > 0.0)) {
+    add("max_translation_stddev_m", max_translation_stddev_m, "must be > 0");
+  }
+  if (!(max_covariance_ratio > 1.0)) {
+    add("max_covariance_ratio", max_covariance_ratio, "must be > 1");
+  }
+  if (!(max_yaw_stddev_rad > 0.0)) add("max_yaw_stddev_rad", max_yaw_stddev_rad, "must be > 0");
+  if (!(min_score >= 0.0 && min_score <= 1.0)) add("min_score", min_score, "must be in [0, 1]");
+  if (!(max_correction_m > 0.0)) add("max_correction_m", max_correction_m, "must be > 0");
+  if (!(max_correction_rad > 0.0)) add("max_correction_rad", max_correction_rad, "must be > 0");
+  for (const auto& [field, value] : {std::pair{"sigma_xy_per_m", sigma_xy_per_m},
+                                     {"sigma_xy_floor_m", sigma_xy_floor_m},
+                                     {"sigma_yaw_per_rad", sigma_yaw_per_rad},
+                                     {"sigma_yaw_per_m", sigma_yaw_per_m},
+                                     {"sigma_yaw_floor_rad", sigma_yaw_floor_rad}}) {
+    if (!(value >= 0.0)) add(field, value, "must be >= 0");
+  }
+  return errors;
+}
+
+IcpOdometry::IcpOdometry(const IcpOdometryOptions& options) : options_(options) {
+  SLAMRIG_CHECK(options_.Validate().empty(), "invalid IcpOdometryOptions");
+}
+
+const std::vector<Eigen::Vector2d>& IcpOdometry::local_map() const {
+  static const std::vector<Eigen::Vector2d> kEmpty;
+  return matcher_ ? matcher_->reference() : kEmpty;
+}
+
+Eigen::Matrix3d IcpOdometry::IncrementCovariance(const Pose2& increment) const {
+  const double d = increment.translation().norm();
+  const double sxy = options_.sigma_xy_per_m * d + options_.sigma_xy_floor_m;
+  const double syaw = options_.sigma_yaw_per_rad * std::abs(increment.theta()) +
+                      options_.sigma_yaw_per_m * d + options_.sigma_yaw_floor_rad;
+  return Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
+}
+
+void IcpOdometry::AddKeyframe(const std::vector<Eigen::Vector2d>& points_base) {
+  std::vector<Eigen::Vector2d> odom_points;
+  odom_points.reserve(points_base.size());
+  for (const Eigen::Vector2d& p : points_base) odom_points.push_back(pose_ * p);
+  keyframes_.push_back(std::move(odom_points));
+  while (static_cast<int>(keyframes_.size()) > options_.local_map_keyframes) keyframes_.pop_front();
+  // Newest first, so the thinning keeps the newest point of each voxel.
+  std::vector<Eigen::Vector2d> all;
+  for (auto it = keyframes_.rbegin(); it != keyframes_.rend(); ++it) {
+    all.insert(all.end(), it->begin(), it->end());
+  }
+  matcher_.emplace(options_.icp, VoxelThin(all, options_.local_map_voxel_m));
+  last_keyframe_ = pose_;
+}
+
+IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_increment) {
+  const std::vector<Eigen::Vector2d> points = ScanToBasePoints(scan, options_.points);
+  ++counts_.scans;
+  IcpOdometryStep step;
+  if (!started_) {
+    started_ = true;
+    step.pose = pose_;
+    step.outcome = IcpOdometryOutcome::kFirstScan;
+    if (!points.empty()) {
+      AddKeyframe(points);
+      step.keyframe = true;
+    }
+    return step;
+  }
+
+  const Pose2 prior = pose_ * odometry_increment;
+  // The increment's noise, rotated from the previous base frame into the odom frame.
+  const Eigen::Matrix2d r = Eigen::Rotation2Dd(pose_.theta()).toRotationMatrix();
+  Eigen::Matrix3d prior_covariance = IncrementCovariance(odometry_increment);
+  prior_covariance.topLeftCorner<2, 2>() =
+      r * prior_covariance.topLeftCorner<2, 2>() * r.transpose();
+  step.pose = prior;
+  step.covariance = prior_covariance;
+
+  std::optional<MatchResult> match;
+  if (points.empty()) {
+    step.outcome = IcpOdometryOutcome::kNoPoints;
+  } else if (matcher_) {
+    match = matcher_->Match(points, prior);
+    if (match &&
+        (match->score < options_.min_score ||
+         (match->pose.translation() - prior.translation()).norm() > options_.max_correction_m ||
+         std::abs(NormalizeAngle(match->pose.theta() - prior.theta())) >
+             options_.max_correction_rad)) {
+      match.reset();
+    }
+    step.outcome = IcpOdometryOutcome::kMatchFailed;
+  } else {
+    step.outcome = IcpOdometryOutcome::kMatchFailed;  // no local map yet
+  }
+
+  if (match) {
+    // Keep the prior along poorly constrained directions of the match.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(
+        match->covariance.topLeftCorner<2, 2>());
+    Eigen::Vector2d correction = match->pose.translation() - prior.translation();
+    bool degenerate = false;
+    const double max_var = options_.max_translation_stddev_m * options_.max_translation_stddev_m;
+    for (int i = 0; i < 2; ++i) {
+      const double variance = eig.eigenvalues()[i];
+      if (variance > max_var ||
+          variance > options_.max_covariance_ratio * std::max(eig.eigenvalues()[0], 1e-300)) {
+        const Eigen::Vector2d e = eig.eigenvectors().col(i);
+        correction -= e.dot(correction) * e;
+        degenerate = true;
+      }
+    }
+    double yaw = match->pose.theta();
+    if (match->covariance(2, 2) > options_.max_yaw_stddev_rad * options_.max_yaw_stddev_rad) {
+      yaw = prior.theta();
+      degenerate = true;
+    }
+    step.pose = Pose2(prior.x() + correction.x(), prior.y() + correction.y(), yaw);
+    step.covariance = match->covariance;
+    step.outcome = degenerate ? IcpOdometryOutcome::kDegenerate : IcpOdometryOutcome::kMatched;
+  }
+  switch (step.outcome) {
+    case IcpOdometryOutcome::kMatched:
+      ++counts_.matched;
+      break;
+    case IcpOdometryOutcome::kDegenerate:
+      ++counts_.degenerate;
+      break;
+    case IcpOdometryOutcome::kMatchFailed:
+      ++counts_.failed;
+      break;
+    case IcpOdometryOutcome::kNoPoints:
+      ++counts_.no_points;
+      break;
+    case IcpOdometryOutcome::kFirstScan:
+      break;
+  }
+
+  pose_ = step.pose;
+  const Pose2 since = last_keyframe_.Between(pose_);
+  if (!points.empty() && (!matcher_ || since.translation().norm() >= options_.keyframe_distance_m ||
+                          std::abs(since.theta()) >= options_.keyframe_angle_rad)) {
+    AddKeyframe(points);
+    step.keyframe = true;
+  }
+  return step;
+}
+
+}  // namespace slamrig::slam

@@ -1,0 +1,112 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "slam/matching/icp_matcher.h"
+#include "slam/matching/scan_points.h"
+#include "slam/types/pose2.h"
+#include "slam/types/records.h"
+
+namespace slamrig::slam {
+
+/// Parameters of scan-to-local-map ICP odometry.
+struct IcpOdometryOptions {
+  /// Point-to-line ICP with a wider gate than IcpOptions' own, for logs whose scans are far apart
+  /// (intel: up to ~0.5 m), light trimming and a Cauchy weight.
+  IcpOptions icp = {
+      .max_correspondence_distance_m = 1.0, .trim_fraction = 0.95, .kernel = RobustKernel::kCauchy};
+  ScanPointsOptions points = {.voxel_size_m = 0.05};  ///< scan to points
+  int local_map_keyframes = 10;      ///< the local map holds the points of the last N keyframes ...
+  double local_map_voxel_m = 0.05;   ///< ... thinned to one point (the newest) per voxel
+  double keyframe_distance_m = 0.3;  ///< a scan becomes a keyframe after moving this far ...
+  double keyframe_angle_rad = 0.2;   ///< ... or turning this much since the last keyframe
+  /// A match is degenerate along a direction whose standard deviation exceeds this (translation,
+  /// from the match covariance's eigenvalues) ...
+  double max_translation_stddev_m = 0.05;
+  /// ... or whose variance exceeds this many times the other direction's (a corridor: the Hessian
+  /// is nearly singular, but range noise scatters the normals enough to keep the variance itself
+  /// small; a corridor's ratio is in the thousands, a room's below 20) ...
+  double max_covariance_ratio = 100.0;
+  double max_yaw_stddev_rad = 0.02;  ///< ... or in yaw when its standard deviation exceeds this
+  double min_score = 0.5;            ///< a match with a smaller inlier share fails
+  /// A match that moves the pose farther than this from the odometry prior fails.
+  double max_correction_m = 0.5;
+  double max_correction_rad = 0.3;
+  /// The odometry increment's noise model, for the covariance when the prior is used: standard
+  /// deviations of sigma_xy_per_m * distance + sigma_xy_floor_m and
+  /// sigma_yaw_per_rad * |turn| + sigma_yaw_per_m * distance + sigma_yaw_floor_rad.
+  double sigma_xy_per_m = 0.05;
+  double sigma_xy_floor_m = 0.005;
+  double sigma_yaw_per_rad = 0.05;
+  double sigma_yaw_per_m = 0.02;
+  double sigma_yaw_floor_rad = 0.002;
+
+  /// One message per broken rule (prefixed "icp_odometry."; the ICP and point options' own).
+  std::vector<std::string> Validate() const;
+};
+
+/// How IcpOdometry placed one scan.
+enum class IcpOdometryOutcome {
+  kFirstScan,    ///< the first scan: the origin, the first keyframe
+  kMatched,      ///< the ICP match
+  kDegenerate,   ///< the match along its well-constrained directions, the prior along the rest
+  kMatchFailed,  ///< ICP failed (too few pairs, low score, too far from the prior): the prior
+  kNoPoints,     ///< the scan had no usable points: the prior
+};
+
+/// One step of IcpOdometry.
+struct IcpOdometryStep {
+  Pose2 pose;  ///< odom_from_base of the scan
+  /// Covariance of (x, y, yaw) of `pose` given the local map: the match's (IcpMatcher's Hessian
+  /// estimate; huge along a degenerate direction), or the increment's noise model on a fallback.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  IcpOdometryOutcome outcome = IcpOdometryOutcome::kFirstScan;
+  bool keyframe = false;  ///< the scan joined the local map
+};
+
+/// How many scans ended in each outcome.
+struct IcpOdometryCounts {
+  int scans = 0;
+  int matched = 0;
+  int degenerate = 0;
+  int failed = 0;
+  int no_points = 0;
+};
+
+/// Scan-to-local-map ICP odometry with the wheel odometry as the prior: each scan is matched by
+/// point-to-line ICP (Censi 2008) against the points of the last N keyframes, expressed in the odom
+/// frame, starting from the previous pose composed with the odometry increment. When the match
+/// fails the prior stands; when it is degenerate along a direction (a corridor's axis: the
+/// covariance's eigenvalue above the threshold) the prior stands along that direction only. Both
+/// are counted. The core of the `icp-odometry` estimator. Deterministic; not thread-safe.
+class IcpOdometry {
+ public:
+  explicit IcpOdometry(const IcpOdometryOptions& options);
+
+  /// Places `scan`, taken after the robot moved by `odometry_increment` (base frame at the previous
+  /// scan to base frame at this one, from the wheel odometry; ignored for the first scan).
+  IcpOdometryStep Add(const LaserScan& scan, const Pose2& odometry_increment);
+
+  const Pose2& pose() const { return pose_; }
+  const IcpOdometryCounts& counts() const { return counts_; }
+  /// Points of the current local map, odom frame.
+  const std::vector<Eigen::Vector2d>& local_map() const;
+
+ private:
+  void AddKeyframe(const std::vector<Eigen::Vector2d>& points_base);
+  Eigen::Matrix3d IncrementCovariance(const Pose2& increment) const;
+
+  IcpOdometryOptions options_;
+  Pose2 pose_;
+  Pose2 last_keyframe_;
+  bool started_ = false;
+  std::deque<std::vector<Eigen::Vector2d>> keyframes_;  // odom frame, oldest first
+  std::optional<IcpMatcher> matcher_;
+  IcpOdometryCounts counts_;
+};
+
+}  // namespace slamrig::slam

@@ -1,0 +1,154 @@
+#include "slam/matching/icp_odometry.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "slam/matching/testing/segment_world.h"
+
+namespace slamrig::slam {
+namespace {
+
+using testing::RangeFinderSpec;
+using testing::SegmentWorld;
+
+// True poses round the office's corridor loop: 0.2 m steps along each side, turns on the spot in
+// 0.2 rad steps at the corners.
+std::vector<Pose2> OfficeLoop() {
+  const Eigen::Vector2d corners[] = {
+      {1.5, 1.5}, {18.5, 1.5}, {18.5, 10.5}, {1.5, 10.5}, {1.5, 1.5}};
+  std::vector<Pose2> poses;
+  double yaw = 0.0;
+  for (int side = 0; side < 4; ++side) {
+    const Eigen::Vector2d a = corners[side], b = corners[side + 1];
+    const int steps = static_cast<int>(std::round((b - a).norm() / 0.2));
+    for (int s = 0; s < steps; ++s) {
+      const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(s) / steps);
+      poses.emplace_back(p.x(), p.y(), yaw);
+    }
+    for (int t = 0; t < 8; ++t) poses.emplace_back(b.x(), b.y(), yaw + 1.5708 * (t / 8.0));
+    yaw += 1.5708;
+  }
+  return poses;
+}
+
+// Wheel odometry with a 3 % scale error, a yaw bias that grows with distance and white noise.
+Pose2 NoisyIncrement(const Pose2& truth, RandomEngine& rng) {
+  const double d = truth.translation().norm();
+  return Pose2(1.03 * truth.x() + 0.003 * StandardNormal(rng),
+               truth.y() + 0.003 * StandardNormal(rng),
+               1.04 * truth.theta() + 0.02 * d + 0.002 * StandardNormal(rng));
+}
+
+double PositionRmse(const std::vector<Pose2>& estimate, const std::vector<Pose2>& truth) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    sum += ((truth.front() * estimate[i]).translation() - truth[i].translation()).squaredNorm();
+  }
+  return std::sqrt(sum / static_cast<double>(truth.size()));
+}
+
+// A lap of the office with noisy odometry: scan-to-local-map ICP drifts far less than odometry.
+TEST(IcpOdometryTest, DriftsMuchLessThanOdometryRoundTheOffice) {
+  const SegmentWorld world = SegmentWorld::Office();
+  const std::vector<Pose2> truth = OfficeLoop();
+  RandomEngine rng(17);
+  IcpOdometry icp{IcpOdometryOptions{}};
+  std::vector<Pose2> estimate, odometry;
+  Pose2 dead_reckoning;
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    const Pose2 increment = k == 0 ? Pose2() : NoisyIncrement(truth[k - 1].Between(truth[k]), rng);
+    dead_reckoning = dead_reckoning * increment;
+    odometry.push_back(dead_reckoning);
+    const IcpOdometryStep step =
+        icp.Add(world.Scan(truth[k], Time(), RangeFinderSpec{}, &rng), increment);
+    estimate.push_back(step.pose);
+    EXPECT_EQ(step.pose, icp.pose());
+  }
+  const double icp_rmse = PositionRmse(estimate, truth), odom_rmse = PositionRmse(odometry, truth);
+  EXPECT_GT(odom_rmse, 1.0);  // the odometry really drifts
+  EXPECT_LT(icp_rmse, 0.1 * odom_rmse);
+  EXPECT_LT(icp_rmse, 0.03);
+  const IcpOdometryCounts& counts = icp.counts();
+  EXPECT_EQ(counts.scans, static_cast<int>(truth.size()));
+  EXPECT_GT(counts.matched, counts.scans * 9 / 10);
+  EXPECT_LE(static_cast<int>(icp.local_map().size()), 10 * 1081);
+}
+
+// In a featureless corridor the match is degenerate along the axis: the pose follows odometry
+// along it and the scans across it, and every such scan is counted.
+TEST(IcpOdometryTest, FallsBackToOdometryAlongADegenerateCorridor) {
+  const SegmentWorld corridor({{{-100.0, 1.0}, {100.0, 1.0}}, {{-100.0, -1.0}, {100.0, -1.0}}});
+  RandomEngine rng(23);
+  IcpOdometry icp{IcpOdometryOptions{}};
+  Pose2 truth(-10.0, 0.2, 0.0), dead_reckoning;
+  const Pose2 start = truth;
+  for (int k = 0; k < 75; ++k) {
+    const Pose2 true_increment = k == 0 ? Pose2() : Pose2(0.2, 0.0, 0.008 * std::sin(0.2 * k));
+    truth = truth * true_increment;
+    const Pose2 increment = k == 0 ? Pose2() : NoisyIncrement(true_increment, rng);
+    dead_reckoning = dead_reckoning * increment;
+    const IcpOdometryStep step =
+        icp.Add(corridor.Scan(truth, Time(), RangeFinderSpec{}, &rng), increment);
+    if (k > 0) {
+      EXPECT_EQ(step.outcome, IcpOdometryOutcome::kDegenerate) << k;
+    }
+  }
+  EXPECT_EQ(icp.counts().degenerate, 74);
+  const Pose2 estimate = start * icp.pose(), odometry = start * dead_reckoning;
+  // Across the corridor and in yaw: corrected. Along it: the odometry's 3 % overestimate stays.
+  EXPECT_LT(std::abs(estimate.y() - truth.y()), 0.03);
+  EXPECT_GT(std::abs(odometry.y() - truth.y()), 0.3);
+  EXPECT_LT(std::abs(NormalizeAngle(estimate.theta() - truth.theta())), 0.01);
+  // With the heading corrected, the distance along the axis is the odometry's: 3 % too long.
+  EXPECT_NEAR(estimate.x() - start.x(), 1.03 * (truth.x() - start.x()), 0.05);
+}
+
+// Same scans and increments, same bits.
+TEST(IcpOdometryTest, SameInputSameBits) {
+  const SegmentWorld world = SegmentWorld::Office();
+  const std::vector<Pose2> truth = OfficeLoop();
+  std::vector<LaserScan> scans;
+  std::vector<Pose2> increments;
+  RandomEngine rng(29);
+  for (std::size_t k = 0; k < 40; ++k) {
+    scans.push_back(world.Scan(truth[k], Time(), RangeFinderSpec{}, &rng));
+    increments.push_back(k == 0 ? Pose2() : NoisyIncrement(truth[k - 1].Between(truth[k]), rng));
+  }
+  IcpOdometry a{IcpOdometryOptions{}}, b{IcpOdometryOptions{}};
+  for (std::size_t k = 0; k < scans.size(); ++k) {
+    const IcpOdometryStep sa = a.Add(scans[k], increments[k]);
+    const IcpOdometryStep sb = b.Add(scans[k], increments[k]);
+    ASSERT_EQ(sa.pose, sb.pose) << k;
+    ASSERT_EQ(sa.covariance, sb.covariance) << k;
+  }
+}
+
+// A scan without a single return keeps the odometry prior and is counted.
+TEST(IcpOdometryTest, ScanWithoutPointsKeepsThePrior) {
+  const SegmentWorld world = SegmentWorld::Office();
+  IcpOdometry icp{IcpOdometryOptions{}};
+  icp.Add(world.Scan(Pose2(5.0, 1.5, 0.0), Time(), RangeFinderSpec{}, nullptr), Pose2());
+  const SegmentWorld empty({});
+  const Pose2 increment(0.1, 0.0, 0.01);
+  const IcpOdometryStep step =
+      icp.Add(empty.Scan(Pose2(5.1, 1.5, 0.01), Time(), RangeFinderSpec{}, nullptr), increment);
+  EXPECT_EQ(step.outcome, IcpOdometryOutcome::kNoPoints);
+  EXPECT_EQ(step.pose, increment);
+  EXPECT_EQ(icp.counts().no_points, 1);
+  EXPECT_GT(step.covariance(0, 0), 0.0);
+}
+
+TEST(IcpOdometryOptionsTest, ValidateIncludesTheNestedOptions) {
+  IcpOdometryOptions options;
+  EXPECT_TRUE(options.Validate().empty());
+  options.local_map_keyframes = 0;
+  options.icp.trim_fraction = 2.0;
+  const std::vector<std::string> errors = options.Validate();
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0], "icp.trim_fraction = 2; must be in (0, 1]");
+  EXPECT_EQ(errors[1], "icp_odometry.local_map_keyframes = 0; must be >= 1");
+}
+
+}  // namespace
+}  // namespace slamrig::slam
