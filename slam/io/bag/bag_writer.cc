@@ -327,4 +327,17 @@ void BagWriter::Commit() {
   committed_ = true;
 }
 
+void WriteBag(const Dataset& data, const std::string& folder, const BagWriterOptions& options) {
+  BagWriter writer(folder, options);
+  std::size_t r = 0;
+  for (const GroundTruthPose& truth : data.reference) {
+    while (r < data.records.size() && RecordTime(data.records[r]) <= truth.time) {
+      writer.Write(data.records[r++]);
+    }
+    writer.Write(truth);
+  }
+  while (r < data.records.size()) writer.Write(data.records[r++]);
+  writer.Commit();
+}
+
 }  // namespace slamrig::slam

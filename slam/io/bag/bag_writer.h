@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "slam/io/bag/mcap_writer.h"
+#include "slam/io/dataset.h"
 #include "slam/types/records.h"
 
 namespace slamrig::slam {
@@ -145,5 +146,9 @@ class BagWriter {
   std::int64_t start_ns_ = 0, end_ns_ = 0;
   bool committed_ = false;
 };
+
+/// Writes `data` as a bag folder: its records and reference poses merged in time order (a
+/// reference pose after the records of the same time), then commits.
+void WriteBag(const Dataset& data, const std::string& folder, const BagWriterOptions& options);
 
 }  // namespace slamrig::slam
