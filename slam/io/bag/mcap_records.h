@@ -50,4 +50,7 @@ inline void PutRecord(std::string* out, Opcode op, std::string_view content) {
   out->append(content);
 }
 
+/// CRC-32 (ISO-HDLC, the zlib polynomial MCAP uses) of `bytes`.
+std::uint32_t Crc32(std::string_view bytes);
+
 }  // namespace slamrig::slam::mcap

@@ -17,6 +17,11 @@ using mcap::Put;
 using mcap::PutRecord;
 using mcap::PutString;
 
+std::uint32_t mcap::Crc32(std::string_view bytes) {
+  return static_cast<std::uint32_t>(
+      crc32_z(crc32_z(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()), bytes.size()));
+}
+
 std::string_view McapCompressionName(McapCompression compression) {
   switch (compression) {
     case McapCompression::kZstd:
@@ -144,8 +149,7 @@ void McapWriter::WriteMessage(std::uint16_t channel_id, std::uint32_t sequence,
 
 void McapWriter::FlushChunk() {
   if (chunk_.empty()) return;
-  const auto uncompressed_crc = static_cast<std::uint32_t>(crc32_z(
-      crc32_z(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(chunk_.data()), chunk_.size()));
+  const std::uint32_t uncompressed_crc = mcap::Crc32(chunk_);
   std::string_view payload = chunk_;
   if (options_.compression == McapCompression::kZstd) {
     compressed_.resize(ZSTD_compressBound(chunk_.size()));

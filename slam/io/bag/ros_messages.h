@@ -84,17 +84,18 @@ LaserScan DecodeLaserScan(std::string_view data, std::string* frame_id = nullptr
 ImuSample DecodeImu(std::string_view data);
 /// sensor_msgs/msg/JointState.
 RosJointState DecodeJointState(std::string_view data);
-/// nav_msgs/msg/Odometry. The yaw is recovered from the quaternion; for a quaternion written by
-/// EncodeOdometry it is the exact double that was written (see YawFromQuaternion).
+/// nav_msgs/msg/Odometry. The yaw is recovered from the quaternion (see YawFromQuaternion).
 RosOdometry DecodeOdometry(std::string_view data);
 /// tf2_msgs/msg/TFMessage.
 std::vector<RosTransform> DecodeTfMessage(std::string_view data);
 /// rosgraph_msgs/msg/Clock.
 Time DecodeClock(std::string_view data);
 
-/// Yaw of the quaternion (x, y, z, w) about z. When (z, w) are exactly (sin(t/2), cos(t/2)) of a
-/// double t, as the encoders write them, t itself is returned: the nearest candidates around
-/// 2 atan2(z, w) are tried, so replay is bit-identical.
+/// Yaw of the quaternion (x, y, z, w) about z. For a planar quaternion the doubles around
+/// 2 atan2(z, w) are searched for one whose (sin(t/2), cos(t/2)) is exactly (z, w), as the
+/// encoders write it. That is the yaw that was written in about 96% of cases; otherwise a
+/// neighbour within a few ulps that encodes to the very same quaternion (sin and cos of doubles
+/// are not injective), so write -> read -> write is byte-identical but a yaw may differ by ulps.
 double YawFromQuaternion(double x, double y, double z, double w);
 
 }  // namespace slamrig::slam
