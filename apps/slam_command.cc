@@ -16,6 +16,7 @@
 #include "slam/eval/run_timing.h"
 #include "slam/eval/trajectory_metrics.h"
 #include "slam/io/atomic_file.h"
+#include "slam/io/bag/bag_reader.h"
 #include "slam/io/carmen_reader.h"
 #include "slam/io/dataset.h"
 #include "slam/io/ece276a_reader.h"
@@ -38,7 +39,14 @@ std::string Fixed(double v, int digits) {
   return buffer;
 }
 
-slam::Dataset LoadLog(const std::string& path, bool lenient, std::string* kind) {
+slam::Dataset LoadLog(const std::string& path, bool lenient, int ticks_per_revolution,
+                      std::string* kind) {
+  if (slam::LooksLikeBag(path)) {
+    *kind = "ros2 bag";
+    slam::BagReaderOptions options;
+    options.ticks_per_revolution = ticks_per_revolution;
+    return slam::ReadBag(path, options);
+  }
   if (slam::LooksLikeEce276a(path)) {
     *kind = "ece276a";
     return slam::ReadEce276a(slam::FindEce276aFiles(path));
@@ -181,8 +189,10 @@ int RunSlamCommand(const std::vector<std::string>& args) {
       "trajectory.tum (one pose per scan, stamped with the scan time), map.pgm +\n"
       "map.yaml (ROS map_server), map.png (with the reference trajectory when the log\n"
       "has one) and metrics.json (ATE/RPE against the reference, timing, settings).\n"
-      "LOG is a CARMEN log (plain or .gz; real, or written by `slamrig simulate`) or an\n"
-      "ECE276A dataset (DIR/20, or one of its Encoders/Imu/Hokuyo files).");
+      "LOG is a CARMEN log (plain or .gz; real, or written by `slamrig simulate`), a ROS 2\n"
+      "bag (MCAP or sqlite3 folder or file: /scan, /imu, /joint_states, /odom,\n"
+      "/ground_truth/odom) or an ECE276A dataset (DIR/20, or one of its\n"
+      "Encoders/Imu/Hokuyo files).");
   parser.AddPositional("LOG", "log path; a path, or relative to SLAMRIG_DATA_DIR", &log_path);
   parser.AddOption("out", "DIR", "output folder (created)", &out_dir);
   parser.AddOption("algorithm", "NAME", "pf or dead-reckoning", &algorithm);
@@ -245,7 +255,7 @@ int RunSlamCommand(const std::vector<std::string>& args) {
     path = (std::filesystem::path(DataDir()) / log_path).string();
   }
   std::string kind;
-  const slam::Dataset data = LoadLog(path, lenient, &kind);
+  const slam::Dataset data = LoadLog(path, lenient, sync.robot.ticks_per_revolution, &kind);
   slam::ScanSyncResult synced = slam::SyncToScans(data.records, sync);
   if (max_scans > 0 && synced.scans.size() > static_cast<std::size_t>(max_scans)) {
     synced.scans.resize(static_cast<std::size_t>(max_scans));

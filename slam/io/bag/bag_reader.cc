@@ -273,4 +273,17 @@ Dataset ReadBag(const std::string& path, const BagReaderOptions& options) {
   return data;
 }
 
+bool LooksLikeBag(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    if (fs::exists(fs::path(path) / "metadata.yaml", ec)) return true;
+    for (const auto& entry : fs::directory_iterator(path, ec)) {
+      const std::string ext = entry.path().extension().string();
+      if (ext == ".mcap" || ext == ".db3") return true;
+    }
+    return false;
+  }
+  return fs::is_regular_file(path, ec) && Sniff(path) != FileKind::kUnknown;
+}
+
 }  // namespace slamrig::slam

@@ -38,4 +38,8 @@ struct BagReaderOptions {
 /// decompress, a message too short or with a bad length, or a read topic of the wrong type.
 Dataset ReadBag(const std::string& path, const BagReaderOptions& options = {});
 
+/// True if `path` is a bag ReadBag would try to read: a folder with a metadata.yaml or with
+/// .mcap/.db3 files, or a file that starts with the MCAP or sqlite3 magic.
+bool LooksLikeBag(const std::string& path);
+
 }  // namespace slamrig::slam
