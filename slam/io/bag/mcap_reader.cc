@@ -145,6 +145,15 @@ class McapParser {
       throw ParseError(Where(records_at) + "chunk records run past the record");
     }
     if (size > kMaxChunkBytes) throw ParseError(Where(base) + "chunk too large");
+    // A damaged size field must not make us allocate: check it against the frame's own.
+    if (compression == "zstd") {
+      const unsigned long long declared =
+          ZSTD_getFrameContentSize(compressed.data(), compressed.size());
+      if (declared != ZSTD_CONTENTSIZE_UNKNOWN && declared != size) {
+        throw ParseError(Where(records_at) + "zstd chunk does not decompress: frame holds " +
+                         std::to_string(declared) + " bytes, chunk says " + std::to_string(size));
+      }
+    }
     std::string_view records;
     if (compression.empty()) {
       if (compressed.size() != size) throw ParseError(Where(base) + "chunk size mismatch");
