@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <set>
 #include <stdexcept>
 
 #include "slam/io/bag/cdr.h"
@@ -54,9 +55,8 @@ double ReadYawQuaternion(CdrReader* r) {
 }
 
 struct TypeInfo {
-  const char* name;                 // ROS 2 name
-  const char* fields;               // .msg text
-  std::vector<const char*> nested;  // pkg/Type of each nested type, in the order they appear
+  const char* name;    // ROS 2 name
+  const char* fields;  // .msg text
 };
 
 // The .msg texts (field types and names of ROS 2 Humble's common_interfaces, comments dropped).
@@ -85,30 +85,20 @@ const TypeInfo& Info(RosType type) {
       {"sensor_msgs/msg/LaserScan",
        "std_msgs/Header header\nfloat32 angle_min\nfloat32 angle_max\nfloat32 angle_increment\n"
        "float32 time_increment\nfloat32 scan_time\nfloat32 range_min\nfloat32 range_max\n"
-       "float32[] ranges\nfloat32[] intensities\n",
-       {"std_msgs/Header", "builtin_interfaces/Time"}},
+       "float32[] ranges\nfloat32[] intensities\n"},
       {"sensor_msgs/msg/Imu",
        "std_msgs/Header header\ngeometry_msgs/Quaternion orientation\n"
        "float64[9] orientation_covariance\ngeometry_msgs/Vector3 angular_velocity\n"
        "float64[9] angular_velocity_covariance\ngeometry_msgs/Vector3 linear_acceleration\n"
-       "float64[9] linear_acceleration_covariance\n",
-       {"std_msgs/Header", "builtin_interfaces/Time", "geometry_msgs/Quaternion",
-        "geometry_msgs/Vector3"}},
+       "float64[9] linear_acceleration_covariance\n"},
       {"sensor_msgs/msg/JointState",
        "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\n"
-       "float64[] effort\n",
-       {"std_msgs/Header", "builtin_interfaces/Time"}},
+       "float64[] effort\n"},
       {"nav_msgs/msg/Odometry",
        "std_msgs/Header header\nstring child_frame_id\ngeometry_msgs/PoseWithCovariance pose\n"
-       "geometry_msgs/TwistWithCovariance twist\n",
-       {"std_msgs/Header", "builtin_interfaces/Time", "geometry_msgs/PoseWithCovariance",
-        "geometry_msgs/Pose", "geometry_msgs/Point", "geometry_msgs/Quaternion",
-        "geometry_msgs/TwistWithCovariance", "geometry_msgs/Twist", "geometry_msgs/Vector3"}},
-      {"tf2_msgs/msg/TFMessage",
-       "geometry_msgs/TransformStamped[] transforms\n",
-       {"geometry_msgs/TransformStamped", "std_msgs/Header", "builtin_interfaces/Time",
-        "geometry_msgs/Transform", "geometry_msgs/Vector3", "geometry_msgs/Quaternion"}},
-      {"rosgraph_msgs/msg/Clock", "builtin_interfaces/Time clock\n", {"builtin_interfaces/Time"}},
+       "geometry_msgs/TwistWithCovariance twist\n"},
+      {"tf2_msgs/msg/TFMessage", "geometry_msgs/TransformStamped[] transforms\n"},
+      {"rosgraph_msgs/msg/Clock", "builtin_interfaces/Time clock\n"},
   }};
   return infos[static_cast<std::size_t>(type)];
 }
@@ -130,15 +120,46 @@ std::optional<RosType> RosTypeFromName(std::string_view name) {
   return std::nullopt;
 }
 
+namespace {
+
+// The non-primitive field types of a .msg text, sorted and unique.
+std::set<std::string> FieldTypes(std::string_view fields) {
+  static const std::set<std::string_view> kPrimitive = {
+      "bool",  "byte",   "char",  "float32", "float64", "int8",   "uint8",
+      "int16", "uint16", "int32", "uint32",  "int64",   "uint64", "string"};
+  std::set<std::string> types;
+  std::size_t line = 0;
+  while (line < fields.size()) {
+    const std::size_t end = std::min(fields.find('\n', line), fields.size());
+    std::string_view type = fields.substr(line, end - line);
+    type = type.substr(0, std::min(type.find(' '), type.find('[')));
+    if (!type.empty() && !kPrimitive.contains(type)) types.emplace(type);
+    line = end + 1;
+  }
+  return types;
+}
+
+// Appends the definitions of the dependencies of `fields` depth first, each once, in sorted
+// order at every level, after an empty line and the two-line delimiter (the layout of
+// rosbag2_storage_mcap's message definition cache).
+void AppendDependencies(std::string_view fields, std::set<std::string>* seen, std::string* text) {
+  for (const std::string& type : FieldTypes(fields)) {
+    if (!seen->insert(type).second) continue;
+    const std::string& nested = NestedDefinitions().at(type);
+    *text += "\n" + std::string(80, '=') + "\nMSG: " + type + "\n" + nested;
+    AppendDependencies(nested, seen, text);
+  }
+}
+
+}  // namespace
+
 const std::string& RosMessageDefinition(RosType type) {
   static const std::array<std::string, 6> texts = [] {
     std::array<std::string, 6> t;
     for (RosType ty : kAllRosTypes) {
-      const TypeInfo& info = Info(ty);
-      std::string text = info.fields;
-      for (const char* nested : info.nested) {
-        text += std::string(80, '=') + "\nMSG: " + nested + "\n" + NestedDefinitions().at(nested);
-      }
+      std::string text = Info(ty).fields;
+      std::set<std::string> seen;
+      AppendDependencies(Info(ty).fields, &seen, &text);
       t[static_cast<std::size_t>(ty)] = std::move(text);
     }
     return t;

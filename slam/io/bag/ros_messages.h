@@ -26,10 +26,11 @@ std::string_view RosTypeName(RosType type);
 /// "sensor_msgs/LaserScan" is accepted too), or nullopt.
 std::optional<RosType> RosTypeFromName(std::string_view name);
 
-/// The full message definition as rosbag2 stores it in MCAP schemas (encoding "ros2msg"): the
-/// type's fields, then each nested type once, after a line of 80 '=' and a `MSG: pkg/Type` line
-/// (rosbag2_storage_mcap's message_definition_cache.cpp does the same with the .msg files).
-/// Comments and constants are left out; field names, types and order are the ROS 2 Humble ones.
+/// The full message definition as rosbag2 stores it in MCAP schemas and the sqlite3
+/// message_definitions table (encoding "ros2msg"): the type's fields, then every nested type
+/// once, depth first and in sorted order at each level, each after an empty line, a line of 80
+/// '=' and a `MSG: pkg/Type` line (the layout of rosbag2_storage_mcap's message definition
+/// cache). Comments are left out; field types, names and order are the ROS 2 Humble ones.
 const std::string& RosMessageDefinition(RosType type);
 
 /// A rigid transform between two named frames at a time (geometry_msgs/TransformStamped, planar).
