@@ -84,7 +84,8 @@ std::optional<bool> WheelJointIsRight(std::string_view name);
 ///     is its accumulated ticks since the first record times 2 pi / ticks_per_revolution, so a
 ///     reader recovers the integer ticks exactly by rounding (position * ticks_per_revolution /
 ///     2 pi) for any count below 2^50;
-///   OdometryPose -> /odom (nav_msgs/msg/Odometry, odom -> base_link) and /tf;
+///   OdometryPose -> /odom (nav_msgs/msg/Odometry, odom -> base_link) and /tf; the yaw as a
+///     quaternion, which reads back within a few ulps (see YawFromQuaternion);
 ///   GroundTruthPose -> /ground_truth/odom (nav_msgs/msg/Odometry, map -> base_link);
 ///   and /clock at `clock_rate_hz`.
 /// Each message's log time, publish time and header stamp are the record's time. Nothing
