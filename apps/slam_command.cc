@@ -39,13 +39,10 @@ std::string Fixed(double v, int digits) {
   return buffer;
 }
 
-slam::Dataset LoadLog(const std::string& path, bool lenient, int ticks_per_revolution,
-                      std::string* kind) {
+slam::Dataset LoadLog(const std::string& path, bool lenient, std::string* kind) {
   if (slam::LooksLikeBag(path)) {
     *kind = "ros2 bag";
-    slam::BagReaderOptions options;
-    options.ticks_per_revolution = ticks_per_revolution;
-    return slam::ReadBag(path, options);
+    return slam::ReadBag(path);  // wheel ticks with the ticks per revolution the bag records
   }
   if (slam::LooksLikeEce276a(path)) {
     *kind = "ece276a";
@@ -255,7 +252,7 @@ int RunSlamCommand(const std::vector<std::string>& args) {
     path = (std::filesystem::path(DataDir()) / log_path).string();
   }
   std::string kind;
-  const slam::Dataset data = LoadLog(path, lenient, sync.robot.ticks_per_revolution, &kind);
+  const slam::Dataset data = LoadLog(path, lenient, &kind);
   slam::ScanSyncResult synced = slam::SyncToScans(data.records, sync);
   if (max_scans > 0 && synced.scans.size() > static_cast<std::size_t>(max_scans)) {
     synced.scans.resize(static_cast<std::size_t>(max_scans));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -45,7 +46,8 @@ RawBag ReadFile(const std::string& path, std::string_view storage) {
 }
 
 // The storage files of a bag folder and its storage identifier ("" if unknown).
-std::vector<std::string> BagFiles(const std::string& folder, std::string* storage) {
+std::vector<std::string> BagFiles(const std::string& folder, std::string* storage,
+                                  std::map<std::string, std::string>* custom_data) {
   const fs::path metadata = fs::path(folder) / "metadata.yaml";
   std::vector<std::string> files;
   if (fs::exists(metadata)) {
@@ -53,6 +55,11 @@ std::vector<std::string> BagFiles(const std::string& folder, std::string* storag
       const YamlNode root = YamlNode::LoadFile(metadata.string());
       const YamlNode info = root.Required("rosbag2_bagfile_information");
       *storage = info.Get<std::string>("storage_identifier");
+      if (const auto custom = info.Optional("custom_data"); custom && custom->IsMap()) {
+        for (const std::string& key : custom->Keys()) {
+          (*custom_data)[key] = custom->Get<std::string>(key);
+        }
+      }
       if (*storage != "mcap" && *storage != "sqlite3") {
         throw ParseError(info.Required("storage_identifier").Where() + ": storage_identifier: '" +
                          *storage + "' is not mcap or sqlite3");
@@ -92,6 +99,7 @@ struct Decoder {
 
   std::string file;
   const BagReaderOptions& options;
+  double ticks_per_revolution = 360.0;
   Dataset* data;
   std::map<std::string, Pose2> static_tf;  // child frame -> base_from_child
   std::vector<std::int64_t> tick_totals;
@@ -127,7 +135,7 @@ struct Decoder {
     }
     WheelTicks ticks;
     ticks.time = js.time;
-    const double ticks_per_rad = options.ticks_per_revolution / (2.0 * std::numbers::pi);
+    const double ticks_per_rad = ticks_per_revolution / (2.0 * std::numbers::pi);
     for (std::size_t i = 0; i < js.names.size(); ++i) {
       const double t = js.positions_rad[i] * ticks_per_rad;
       if (!std::isfinite(t) || std::abs(t) > 0x1.0p50) {
@@ -183,9 +191,9 @@ struct Decoder {
 
 std::vector<std::string> BagReaderOptions::Validate() const {
   std::vector<std::string> errors = topics.Validate();
-  if (!(ticks_per_revolution > 0.0) || !std::isfinite(ticks_per_revolution)) {
-    errors.push_back(
-        RuleViolation("ticks_per_revolution", ticks_per_revolution, "must be finite and > 0"));
+  if (!(ticks_per_revolution >= 0.0) || !std::isfinite(ticks_per_revolution)) {
+    errors.push_back(RuleViolation("ticks_per_revolution", ticks_per_revolution,
+                                   "must be finite and > 0 (or 0: from the bag)"));
   }
   if (base_frame.empty()) errors.push_back(RuleViolation("base_frame", "''", "must not be empty"));
   return errors;
@@ -196,8 +204,10 @@ Dataset ReadBag(const std::string& path, const BagReaderOptions& options) {
   if (!errors.empty()) throw ConfigError("bag reader: " + errors.front());
   if (!fs::exists(path)) throw ParseError(path + ": no such file or folder");
   std::string storage;
-  const std::vector<std::string> files =
-      fs::is_directory(path) ? BagFiles(path, &storage) : std::vector<std::string>{path};
+  std::map<std::string, std::string> custom_data;
+  const std::vector<std::string> files = fs::is_directory(path)
+                                             ? BagFiles(path, &storage, &custom_data)
+                                             : std::vector<std::string>{path};
 
   Dataset data;
   data.source = path;
@@ -212,6 +222,20 @@ Dataset ReadBag(const std::string& path, const BagReaderOptions& options) {
   Decoder decoder(options, &data);
   for (const std::string& file : files) {
     RawBag bag = ReadFile(file, storage);
+    custom_data.merge(bag.custom_data);  // metadata.yaml's entries win
+    decoder.ticks_per_revolution = options.ticks_per_revolution;
+    if (decoder.ticks_per_revolution == 0.0) {
+      decoder.ticks_per_revolution = 360.0;
+      if (const auto it = custom_data.find(kTicksKey); it != custom_data.end()) {
+        char* end = nullptr;
+        const double v = std::strtod(it->second.c_str(), &end);
+        if (end == it->second.c_str() || *end != '\0' || !(v > 0.0) || !std::isfinite(v)) {
+          throw ParseError(path + ": " + kTicksKey + ": '" + it->second +
+                           "' is not a positive number");
+        }
+        decoder.ticks_per_revolution = v;
+      }
+    }
     std::vector<std::optional<RosType>> topic_type(bag.topics.size());
     for (std::size_t i = 0; i < bag.topics.size(); ++i) {
       const RawBagTopic& t = bag.topics[i];

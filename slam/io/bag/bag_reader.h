@@ -12,8 +12,9 @@ namespace slamrig::slam {
 struct BagReaderOptions {
   /// Topics to read; the defaults are the ones BagWriter writes.
   BagTopicNames topics;
-  /// Encoder ticks per wheel revolution, to turn JointState positions back into ticks.
-  double ticks_per_revolution = 360.0;
+  /// Encoder ticks per wheel revolution, to turn JointState positions back into ticks; 0 takes
+  /// the value the bag records (kTicksKey, written by BagWriter), else 360 (the ECE276A robot).
+  double ticks_per_revolution = 0.0;
   /// The robot's frame: /tf_static transforms from it give each scan's base_from_laser.
   std::string base_frame = "base_link";
 

@@ -110,18 +110,31 @@ INSTANTIATE_TEST_SUITE_P(Storages, BagRoundTripTest,
                                            std::pair{BagStorage::kSqlite3,
                                                      McapCompression::kNone}));
 
-TEST(BagTest, TicksRoundTripExactlyFarFromZero) {
+// The bag records its ticks per revolution, so a reader needs no robot file to recover the
+// exact ticks: from metadata.yaml, or from the storage file alone (MCAP channel metadata, the
+// sqlite3 metadata table).
+TEST(BagTest, TicksRoundTripExactlyWithTheBagsTicksPerRevolution) {
   TempDir dir;
   Dataset data;
   for (int i = 0; i < 500; ++i) {
     data.records.push_back(WheelTicks{Time{i * 1000}, {2'000'000, -7}, {1'999'999, 3}});
   }
-  BagWriterOptions options;
-  options.ticks_per_revolution = 1440;
-  WriteBag(data, dir.File("ticks"), options);
-  BagReaderOptions read_options;
-  read_options.ticks_per_revolution = 1440;
-  ExpectSameData(ReadBag(dir.File("ticks"), read_options), data);
+  for (BagStorage storage : {BagStorage::kMcap, BagStorage::kSqlite3}) {
+    BagWriterOptions options;
+    options.storage = storage;
+    options.ticks_per_revolution = 2578;
+    const std::string folder = dir.File(std::string(BagStorageName(storage)));
+    WriteBag(data, folder, options);
+    ExpectSameData(ReadBag(folder), data);
+    const std::string file = folder + "/" + std::string(BagStorageName(storage)) +
+                             (storage == BagStorage::kMcap ? "_0.mcap" : "_0.db3");
+    ExpectSameData(ReadBag(file), data);
+    // Told otherwise, the reader believes the caller: other ticks come out.
+    BagReaderOptions read_options;
+    read_options.ticks_per_revolution = 360;
+    const Dataset wrong = ReadBag(file, read_options);
+    EXPECT_NE(std::get<WheelTicks>(wrong.records[0]).right_ticks[0], 2'000'000);
+  }
 }
 
 TEST(BagTest, OtherTopicNamesAndUnknownTopics) {
@@ -164,8 +177,9 @@ TEST(BagTest, MetadataListsTopicsAndCounts) {
   WriteBag(testing::SyntheticRun(0.1, 1, 8), dir.File("m"), {});
   const std::string yaml = ReadAll(dir.File("m/metadata.yaml"));
   for (const char* key :
-       {"rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n",
-        "  message_count: 41\n", "        name: /scan\n        type: sensor_msgs/msg/LaserScan\n",
+       {"rosbag2_bagfile_information:\n  version: 6\n  storage_identifier: mcap\n",
+        "  custom_data:\n    slamrig.ticks_per_revolution: \"360\"\n", "  message_count: 41\n",
+        "        name: /scan\n        type: sensor_msgs/msg/LaserScan\n",
         "  relative_file_paths:\n    - m_0.mcap\n"}) {
     EXPECT_NE(yaml.find(key), std::string::npos) << key;
   }

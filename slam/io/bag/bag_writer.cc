@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <numbers>
 #include <stdexcept>
@@ -58,6 +59,12 @@ void CheckTopicName(const std::string& field, const std::string& name,
 }
 
 }  // namespace
+
+std::string BagWriter::TicksText() const {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.17g", options_.ticks_per_revolution);
+  return text;
+}
 
 std::string_view BagStorageName(BagStorage storage) {
   return storage == BagStorage::kMcap ? "mcap" : "sqlite3";
@@ -188,8 +195,9 @@ BagWriter::Topic& BagWriter::GetTopic(const std::string& name, int type, bool la
                         mcap_->AddSchema(topic.type, "ros2msg", RosMessageDefinition(ros_type)))
                .first;
     }
-    topic.mcap_channel =
-        mcap_->AddChannel(it->second, name, "cdr", {{"offered_qos_profiles", topic.qos}});
+    std::map<std::string, std::string> metadata = {{"offered_qos_profiles", topic.qos}};
+    if (ros_type == RosType::kJointState) metadata[kTicksKey] = TicksText();
+    topic.mcap_channel = mcap_->AddChannel(it->second, name, "cdr", metadata);
   } else {
     topic.sqlite_id =
         sqlite_->AddTopic(name, topic.type, topic.qos, RosMessageDefinition(ros_type));
@@ -283,7 +291,7 @@ std::string BagWriter::MetadataYaml() const {
   const std::string duration = std::to_string(end_ns_ - start_ns_);
   const std::string count = std::to_string(message_count_);
   std::string y = "rosbag2_bagfile_information:\n";
-  y += "  version: 5\n";
+  y += "  version: 6\n";
   y += "  storage_identifier: " + storage + "\n";
   y += "  duration:\n    nanoseconds: " + duration + "\n";
   y += "  starting_time:\n    nanoseconds_since_epoch: " + start + "\n";
@@ -300,6 +308,7 @@ std::string BagWriter::MetadataYaml() const {
     y += "      message_count: " + std::to_string(t.count) + "\n";
   }
   y += "  compression_format: \"\"\n";
+  y += "  custom_data:\n    " + std::string(kTicksKey) + ": " + Quote(TicksText()) + "\n";
   y += "  compression_mode: \"\"\n";
   y += "  relative_file_paths:\n    - " + file_name_ + "\n";
   y += "  files:\n";
@@ -317,7 +326,7 @@ void BagWriter::Commit() {
     mcap_->Close();
     mcap_.reset();
   } else {
-    sqlite_->Close(metadata, 5);
+    sqlite_->Close(metadata, 6);
     sqlite_.reset();
   }
   WriteFileAtomically(tmp_folder_ + "/metadata.yaml", metadata);

@@ -72,6 +72,11 @@ struct BagWriterOptions {
 /// wheel_left_<i>.
 std::vector<std::string> WheelJointNames(std::size_t right, std::size_t left);
 
+/// Key under which a bag records the encoder ticks per revolution its JointState positions use:
+/// in metadata.yaml's custom_data (also stored in the sqlite3 metadata table) and in the MCAP
+/// channel metadata of the joint_states topic.
+inline constexpr const char* kTicksKey = "slamrig.ticks_per_revolution";
+
 /// Which side a joint named by WheelJointNames() is on: true right, false left, nullopt unknown.
 std::optional<bool> WheelJointIsRight(std::string_view name);
 
@@ -126,6 +131,7 @@ class BagWriter {
   void Emit(Topic& topic, Time time);
   void MaybeClock(Time time);
   std::string MetadataYaml() const;
+  std::string TicksText() const;
 
   std::string folder_;
   std::string tmp_folder_;

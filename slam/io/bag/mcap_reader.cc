@@ -205,6 +205,12 @@ class McapParser {
       RawBagTopic topic;
       topic.name = c.String();
       topic.encoding = c.String();
+      Cursor map{c.Bytes(c.U32()), base + c.pos, this};
+      while (map.pos < map.data.size()) {
+        std::string key = map.String();
+        std::string value = map.String();
+        if (key.starts_with("slamrig.")) bag_.custom_data[std::move(key)] = std::move(value);
+      }
       if (schema != 0) {
         const auto it = schemas_.find(schema);
         if (it == schemas_.end()) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,9 @@ struct RawBagMessage {
 struct RawBag {
   std::vector<RawBagTopic> topics;
   std::vector<RawBagMessage> messages;
+  /// Writer's key-value notes: metadata custom_data (sqlite3's metadata table) or channel
+  /// metadata entries named "slamrig.*" (MCAP).
+  std::map<std::string, std::string> custom_data;
 };
 
 /// Reads an MCAP file, checking the magic at both ends, every record length, the CRC of every
@@ -32,7 +36,8 @@ struct RawBag {
 /// what is wrong; never reads out of bounds.
 RawBag ReadMcapFile(const std::string& path);
 
-/// Reads a rosbag2 sqlite3 file (topics and messages tables, any schema version). Throws
+/// Reads a rosbag2 sqlite3 file (topics and messages tables, any schema version; custom_data
+/// from the YAML in the metadata table when it has one). Throws
 /// ParseError naming the file and sqlite's message, or the message id for a message whose
 /// topic is missing.
 RawBag ReadSqliteBagFile(const std::string& path);

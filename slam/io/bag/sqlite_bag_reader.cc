@@ -2,6 +2,7 @@
 
 #include <map>
 
+#include "slam/config/yaml_node.h"
 #include "slam/io/bag/raw_bag.h"
 #include "slam/types/error.h"
 
@@ -74,6 +75,29 @@ RawBag ReadSqliteBagFile(const std::string& path) {
     while (topics.Step()) {
       topic_index[topics.Int(0)] = bag.topics.size();
       bag.topics.push_back({topics.Text(1), topics.Text(2), topics.Text(3)});
+    }
+  }
+  // rosbag2 keeps a copy of metadata.yaml here since schema version 3.
+  bool has_metadata = false;
+  {
+    Statement table(db, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'metadata'");
+    has_metadata = table.Step();
+  }
+  if (has_metadata) {
+    Statement metadata(db, "SELECT metadata FROM metadata ORDER BY id DESC LIMIT 1");
+    if (metadata.Step()) {
+      try {
+        const YamlNode root = YamlNode::LoadString(metadata.Text(0), path + ": metadata table");
+        if (const auto info = root.Optional("rosbag2_bagfile_information")) {
+          if (const auto custom = info->Optional("custom_data")) {
+            for (const std::string& key : custom->Keys()) {
+              bag.custom_data[key] = custom->Get<std::string>(key);
+            }
+          }
+        }
+      } catch (const ConfigError& e) {
+        throw ParseError(e.what());
+      }
     }
   }
   Statement messages(db, "SELECT id, topic_id, timestamp, data FROM messages ORDER BY id");
