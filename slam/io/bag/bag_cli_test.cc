@@ -112,5 +112,21 @@ TEST(BagCliTest, SlamReadsABagAndRejectsADamagedOne) {
       << r.output;
 }
 
+// A recording killed with SIGKILL leaves no bag folder that looks complete: DIR/run appears only
+// by the rename after metadata.yaml and the storage file are closed.
+TEST(BagCliTest, KilledRecordingLeavesNoBag) {
+  slamrig::testing::TempDir dir;
+  const std::string out = dir.File("k");
+  const auto r = slamrig::testing::RunCommand(
+      "(" + std::string(SLAMRIG_BINARY) + " simulate office --duration 600 --format mcap --out " +
+      out + " & pid=$!; sleep 0.5; kill -9 $pid; wait $pid; echo killed $?)");
+  ASSERT_NE(r.output.find("killed 137"), std::string::npos) << r.output;  // 128 + SIGKILL
+  EXPECT_FALSE(fs::exists(out + "/run")) << r.output;
+  // What is left is the temporary folder, without metadata.yaml.
+  for (const auto& entry : fs::directory_iterator(out)) {
+    EXPECT_FALSE(fs::exists(entry.path() / "metadata.yaml")) << entry.path();
+  }
+}
+
 }  // namespace
 }  // namespace slamrig::slam
