@@ -168,6 +168,15 @@ TEST(BagTest, UncommittedWriterLeavesNothing) {
   BagWriterOptions bad;
   bad.topics.imu = "imu";
   EXPECT_THROW(BagWriter(dir.File("x"), bad), ConfigError);
+  McapWriterOptions tiny_chunks;
+  tiny_chunks.chunk_size_bytes = 10;
+  try {
+    McapWriter(dir.File("x.mcap"), tiny_chunks);
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_STREQ(e.what(), "mcap writer: chunk_size_bytes = 10; must be >= 1024");
+  }
+  EXPECT_FALSE(fs::exists(dir.File("x.mcap")));
 }
 
 TEST(BagTest, MetadataListsTopicsAndCounts) {

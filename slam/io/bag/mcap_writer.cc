@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "slam/io/bag/mcap_records.h"
+#include "slam/types/error.h"
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
@@ -48,6 +49,8 @@ std::vector<std::string> McapWriterOptions::Validate() const {
 
 McapWriter::McapWriter(std::string path, McapWriterOptions options)
     : path_(std::move(path)), options_(std::move(options)) {
+  const std::vector<std::string> errors = options_.Validate();
+  if (!errors.empty()) throw ConfigError("mcap writer: " + errors.front());
   file_ = std::fopen(path_.c_str(), "wb");
   if (file_ == nullptr) throw std::runtime_error(path_ + ": cannot write: " + std::strerror(errno));
   std::setvbuf(file_, nullptr, _IOFBF, 1 << 20);

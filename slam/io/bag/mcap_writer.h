@@ -35,7 +35,8 @@ struct McapWriterOptions {
 /// whole data section (magic included, as the reference writers compute it), then the Summary
 /// section (Schemas, Channels, Statistics, ChunkIndexes), SummaryOffset records, the Footer with
 /// the summary CRC, and the closing magic. Every chunk carries the CRC-32 of its uncompressed
-/// records. Throws std::runtime_error naming the path if it cannot write.
+/// records. Throws ConfigError for invalid options, std::runtime_error naming the path if it
+/// cannot write.
 class McapWriter {
  public:
   McapWriter(std::string path, McapWriterOptions options);
