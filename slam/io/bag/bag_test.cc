@@ -156,6 +156,20 @@ TEST(BagTest, OtherTopicNamesAndUnknownTopics) {
   ExpectSameData(ReadBag(dir.File("b"), read_options), data);
 }
 
+TEST(BagTest, EmptyBagsAreValid) {
+  TempDir dir;
+  for (BagStorage storage : {BagStorage::kMcap, BagStorage::kSqlite3}) {
+    BagWriterOptions options;
+    options.storage = storage;
+    const std::string folder = dir.File(std::string(BagStorageName(storage)));
+    WriteBag(Dataset{}, folder, options);
+    const Dataset back = ReadBag(folder);
+    EXPECT_TRUE(back.records.empty());
+    EXPECT_TRUE(back.reference.empty());
+    EXPECT_NE(ReadAll(folder + "/metadata.yaml").find("  message_count: 0\n"), std::string::npos);
+  }
+}
+
 TEST(BagTest, UncommittedWriterLeavesNothing) {
   TempDir dir;
   {
