@@ -1,4 +1,5 @@
-// `slamrig simulate WORLD --out DIR`: a simulated run written as a CARMEN log plus ground truth.
+// `slamrig simulate WORLD --out DIR`: a simulated run written as a CARMEN log plus ground truth,
+// or (`--format mcap|sqlite3`) as a ROS 2 bag.
 
 #include <algorithm>
 #include <chrono>
