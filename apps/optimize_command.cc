@@ -8,7 +8,7 @@
 
 #include "apps/cli_args.h"
 #include "apps/commands.h"
-#include "apps/data_path.h"
+#include "slam/io/log_reader.h"
 #include "slam/graph/g2o_io.h"
 #include "slam/graph/graph_initialization.h"
 #include "slam/graph/pose_graph_optimizer.h"
@@ -82,7 +82,7 @@ int RunOptimizeCommand(const std::vector<std::string>& args) {
   }
   options = ParseChoices(robust, strategy, options);
 
-  slam::PoseGraph graph = slam::ReadG2o(ResolveDataPath(graph_path));
+  slam::PoseGraph graph = slam::ReadG2o(slam::ResolveLogPath(graph_path));
   const auto start = std::chrono::steady_clock::now();
   if (init == "odometry") slam::InitializeFromOdometry(&graph);
   if (init == "chordal") slam::InitializeChordal(&graph);

@@ -158,8 +158,10 @@ int RunSlamCommand(const std::vector<std::string>& args) {
       "revises its past), map.pgm + map.yaml (ROS map_server), map.png (with the reference\n"
       "trajectory when the log has one) and metrics.json (ATE/RPE against the reference,\n"
       "dead reckoning alongside, timing, statistics, the resolved configuration).\n"
-      "LOG is a CARMEN log (plain or .gz; real, or written by `slamrig simulate`) or an\n"
-      "ECE276A dataset (DIR/20, or one of its Encoders/Imu/Hokuyo files).\n"
+      "LOG is a CARMEN log (plain or .gz; real, or written by `slamrig simulate`), a ROS 2\n"
+      "bag (MCAP or sqlite3 folder or file: /scan, /imu, /joint_states, /odom,\n"
+      "/ground_truth/odom) or an ECE276A dataset (DIR/20, or one of its Encoders/Imu/Hokuyo\n"
+      "files).\n"
       "Algorithms: " +
           slam::AlgorithmNames());
   parser.AddPositional("LOG", "log path; a path, or relative to SLAMRIG_DATA_DIR", &log_path);

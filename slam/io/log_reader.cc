@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "slam/io/bag/bag_reader.h"
 #include "slam/io/carmen_reader.h"
 #include "slam/io/ece276a_reader.h"
 #include "slam/types/error.h"
@@ -26,6 +27,8 @@ const char* LogFormatName(LogFormat format) {
       return "carmen";
     case LogFormat::kEce276a:
       return "ece276a";
+    case LogFormat::kRos2Bag:
+      return "ros2bag";
   }
   return "?";
 }
@@ -51,9 +54,12 @@ std::string ResolveLogPath(const std::string& path) {
 
 LogFormat DetectLogFormat(const std::string& path) {
   if (LooksLikeEce276a(path)) return LogFormat::kEce276a;
+  if (LooksLikeBag(path)) return LogFormat::kRos2Bag;
   if (!Exists(path)) throw ParseError(path + ": no such file or dataset");
   if (fs::is_directory(path)) {
-    throw ParseError(path + ": a folder, but not an ECE276A dataset (give the file or DIR/NUMBER)");
+    throw ParseError(path +
+                     ": a folder, but neither a ROS 2 bag (no metadata.yaml, .mcap or .db3) nor an "
+                     "ECE276A dataset (give the file or DIR/NUMBER)");
   }
   // CARMEN logs are text, gzip-compressed or not; the reader reports any line it cannot parse.
   std::ifstream in(path, std::ios::binary);
@@ -62,7 +68,7 @@ LogFormat DetectLogFormat(const std::string& path) {
   const bool gzip = in.gcount() == 2 && static_cast<unsigned char>(magic[0]) == 0x1f &&
                     static_cast<unsigned char>(magic[1]) == 0x8b;
   if (gzip || in.gcount() < 2 || (magic[0] != '\0' && magic[1] != '\0')) return LogFormat::kCarmen;
-  throw ParseError(path + ": not a log slamrig can read (CARMEN text or .gz, ECE276A)");
+  throw ParseError(path + ": not a log slamrig can read (CARMEN text or .gz, ROS 2 bag, ECE276A)");
 }
 
 Dataset ReadLog(const std::string& path, const LogReadOptions& options) {
@@ -72,6 +78,9 @@ Dataset ReadLog(const std::string& path, const LogReadOptions& options) {
   switch (format) {
     case LogFormat::kEce276a:
       data = ReadEce276a(FindEce276aFiles(resolved));
+      break;
+    case LogFormat::kRos2Bag:
+      data = ReadBag(resolved);  // wheel ticks with the ticks per revolution the bag records
       break;
     case LogFormat::kCarmen: {
       CarmenReadOptions carmen;

@@ -10,9 +10,10 @@ namespace slamrig::slam {
 enum class LogFormat {
   kCarmen,   ///< CARMEN text log, plain or .gz (real, corrected Radish, or `slamrig simulate`'s)
   kEce276a,  ///< an ECE276A robot dataset (folder + number, or one of its npz/csv files)
+  kRos2Bag,  ///< a ROS 2 bag, MCAP or sqlite3 (its folder with metadata.yaml, or the file)
 };
 
-/// The name of `format` ("carmen", "ece276a").
+/// The name of `format` ("carmen", "ece276a", "ros2bag").
 const char* LogFormatName(LogFormat format);
 
 /// How logs are read.

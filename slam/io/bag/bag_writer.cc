@@ -1,0 +1,352 @@
+#include "slam/io/bag/bag_writer.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <numbers>
+#include <stdexcept>
+
+#include "slam/io/atomic_file.h"
+#include "slam/io/bag/ros_messages.h"
+#include "slam/io/bag/sqlite_bag_writer.h"
+#include "slam/types/error.h"
+#include "slam/types/validation.h"
+
+namespace slamrig::slam {
+namespace {
+
+// offered_qos_profiles as rosbag2 (metadata version < 9) stores it: a YAML list, as a string.
+// Reliable, keep-last history, volatile (or transient-local for latched /tf_static), every
+// duration "infinite".
+std::string QosProfile(bool latched) {
+  constexpr const char* kInfinite = "    sec: 9223372036\n    nsec: 854775807\n";
+  std::string s = "- history: 3\n  depth: 0\n  reliability: 1\n  durability: ";
+  s += latched ? "1" : "2";
+  s += "\n  deadline:\n";
+  s += kInfinite;
+  s += "  lifespan:\n";
+  s += kInfinite;
+  s += "  liveliness: 1\n  liveliness_lease_duration:\n";
+  s += kInfinite;
+  s += "  avoid_ros_namespace_conventions: false";
+  return s;
+}
+
+// A YAML double-quoted scalar.
+std::string Quote(std::string_view s) {
+  std::string q = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') {
+      q += '\\';
+      q += c;
+    } else if (c == '\n') {
+      q += "\\n";
+    } else {
+      q += c;
+    }
+  }
+  return q + "\"";
+}
+
+void CheckTopicName(const std::string& field, const std::string& name,
+                    std::vector<std::string>* errors) {
+  if (name.size() < 2 || name[0] != '/' || name.back() == '/' ||
+      name.find_first_of(" \t\n\"'") != std::string::npos) {
+    errors->push_back(RuleViolation(field, "'" + name + "'", "must be an absolute ROS topic name"));
+  }
+}
+
+}  // namespace
+
+std::string BagWriter::TicksText() const {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.17g", options_.ticks_per_revolution);
+  return text;
+}
+
+std::string_view BagStorageName(BagStorage storage) {
+  return storage == BagStorage::kMcap ? "mcap" : "sqlite3";
+}
+
+std::vector<std::string> BagTopicNames::Validate() const {
+  std::vector<std::string> errors;
+  const std::vector<std::pair<const char*, const std::string*>> names = {
+      {"topics.scan", &scan},
+      {"topics.imu", &imu},
+      {"topics.joint_states", &joint_states},
+      {"topics.odom", &odom},
+      {"topics.ground_truth", &ground_truth},
+      {"topics.tf", &tf},
+      {"topics.tf_static", &tf_static},
+      {"topics.clock", &clock}};
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    CheckTopicName(names[i].first, *names[i].second, &errors);
+    for (std::size_t j = 0; j < i; ++j) {
+      if (*names[i].second == *names[j].second) {
+        errors.push_back(RuleViolation(names[i].first, "'" + *names[i].second + "'",
+                                       std::string("must differ from ") + names[j].first));
+      }
+    }
+  }
+  return errors;
+}
+
+std::vector<std::string> BagFrames::Validate() const {
+  std::vector<std::string> errors;
+  for (const auto& [field, value] :
+       {std::pair{"frames.map", &map}, std::pair{"frames.odom", &odom},
+        std::pair{"frames.base", &base}, std::pair{"frames.laser", &laser},
+        std::pair{"frames.imu", &imu}}) {
+    if (value->empty()) errors.push_back(RuleViolation(field, "''", "must not be empty"));
+  }
+  return errors;
+}
+
+std::vector<std::string> BagWriterOptions::Validate() const {
+  std::vector<std::string> errors = topics.Validate();
+  for (std::string& e : frames.Validate()) errors.push_back(std::move(e));
+  if (chunk_size_bytes < 1024) {
+    errors.push_back(RuleViolation("chunk_size_bytes", chunk_size_bytes, "must be >= 1024"));
+  }
+  if (!(ticks_per_revolution > 0.0) || !std::isfinite(ticks_per_revolution)) {
+    errors.push_back(
+        RuleViolation("ticks_per_revolution", ticks_per_revolution, "must be finite and > 0"));
+  }
+  if (!(clock_rate_hz >= 0.0) || !std::isfinite(clock_rate_hz)) {
+    errors.push_back(RuleViolation("clock_rate_hz", clock_rate_hz, "must be finite and >= 0"));
+  }
+  return errors;
+}
+
+std::vector<std::string> WheelJointNames(std::size_t right, std::size_t left) {
+  if (right == 1 && left == 1) return {"right_wheel", "left_wheel"};
+  if (right == 2 && left == 2) return {"wheel_fr", "wheel_rr", "wheel_fl", "wheel_rl"};
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < right; ++i) names.push_back("wheel_right_" + std::to_string(i));
+  for (std::size_t i = 0; i < left; ++i) names.push_back("wheel_left_" + std::to_string(i));
+  return names;
+}
+
+std::optional<bool> WheelJointIsRight(std::string_view name) {
+  if (name == "right_wheel" || name == "wheel_fr" || name == "wheel_rr" ||
+      name.starts_with("wheel_right_")) {
+    return true;
+  }
+  if (name == "left_wheel" || name == "wheel_fl" || name == "wheel_rl" ||
+      name.starts_with("wheel_left_")) {
+    return false;
+  }
+  return std::nullopt;
+}
+
+BagWriter::BagWriter(std::string folder, BagWriterOptions options)
+    : folder_(std::move(folder)), options_(std::move(options)) {
+  const std::vector<std::string> errors = options_.Validate();
+  if (!errors.empty()) throw ConfigError("bag writer: " + errors.front());
+  namespace fs = std::filesystem;
+  while (folder_.size() > 1 && folder_.back() == '/') folder_.pop_back();
+  if (fs::exists(folder_)) throw std::runtime_error(folder_ + ": already exists");
+  tmp_folder_ = folder_ + ".tmp" + std::to_string(::getpid());
+  fs::remove_all(tmp_folder_);
+  std::error_code ec;
+  fs::create_directories(tmp_folder_, ec);
+  if (ec) throw std::runtime_error(tmp_folder_ + ": cannot create: " + ec.message());
+  const std::string name = fs::path(folder_).filename().string();
+  file_name_ = name + (options_.storage == BagStorage::kMcap ? "_0.mcap" : "_0.db3");
+  const std::string path = tmp_folder_ + "/" + file_name_;
+  if (options_.storage == BagStorage::kMcap) {
+    McapWriterOptions mcap_options;
+    mcap_options.compression = options_.compression;
+    mcap_options.chunk_size_bytes = options_.chunk_size_bytes;
+    mcap_ = std::make_unique<McapWriter>(path, mcap_options);
+  } else {
+    sqlite_ = std::make_unique<SqliteBagWriter>(path);
+  }
+  if (options_.clock_rate_hz > 0.0) {
+    clock_period_ns_ = std::max<std::int64_t>(1, std::llround(1e9 / options_.clock_rate_hz));
+  }
+}
+
+BagWriter::~BagWriter() {
+  if (!committed_) {
+    mcap_.reset();
+    sqlite_.reset();
+    std::error_code ec;
+    std::filesystem::remove_all(tmp_folder_, ec);
+  }
+}
+
+BagWriter::Topic& BagWriter::GetTopic(const std::string& name, int type, bool latched) {
+  for (Topic& t : topics_) {
+    if (t.name == name) return t;
+  }
+  const auto ros_type = static_cast<RosType>(type);
+  Topic topic;
+  topic.name = name;
+  topic.type = std::string(RosTypeName(ros_type));
+  topic.qos = QosProfile(latched);
+  if (mcap_) {
+    auto it = mcap_schemas_.find(type);
+    if (it == mcap_schemas_.end()) {
+      it = mcap_schemas_
+               .emplace(type,
+                        mcap_->AddSchema(topic.type, "ros2msg", RosMessageDefinition(ros_type)))
+               .first;
+    }
+    std::map<std::string, std::string> metadata = {{"offered_qos_profiles", topic.qos}};
+    if (ros_type == RosType::kJointState) metadata[kTicksKey] = TicksText();
+    topic.mcap_channel = mcap_->AddChannel(it->second, name, "cdr", metadata);
+  } else {
+    topic.sqlite_id =
+        sqlite_->AddTopic(name, topic.type, topic.qos, RosMessageDefinition(ros_type));
+  }
+  topics_.push_back(std::move(topic));
+  return topics_.back();
+}
+
+void BagWriter::Emit(Topic& topic, Time time) {
+  const auto t = static_cast<std::uint64_t>(time.ns);
+  if (mcap_) {
+    mcap_->WriteMessage(topic.mcap_channel, topic.sequence, t, t, buffer_);
+  } else {
+    sqlite_->WriteMessage(topic.sqlite_id, time.ns, buffer_);
+  }
+  ++topic.sequence;
+  ++topic.count;
+  if (message_count_ == 0 || time.ns < start_ns_) start_ns_ = time.ns;
+  if (message_count_ == 0 || time.ns > end_ns_) end_ns_ = time.ns;
+  ++message_count_;
+}
+
+void BagWriter::MaybeClock(Time time) {
+  if (time.ns < 0) {
+    throw std::invalid_argument("bag writer: record time " + std::to_string(time.ns) +
+                                " ns is before 0");
+  }
+  if (clock_period_ns_ == 0) return;
+  if (last_clock_ && time.ns < last_clock_->ns + clock_period_ns_) return;
+  last_clock_ = time;
+  EncodeClock(time, &buffer_);
+  Emit(GetTopic(options_.topics.clock, static_cast<int>(RosType::kClock), false), time);
+}
+
+void BagWriter::Write(const Record& record) {
+  const Time time = RecordTime(record);
+  MaybeClock(time);
+  const BagFrames& f = options_.frames;
+  if (const auto* scan = std::get_if<LaserScan>(&record)) {
+    if (!static_laser_ || !(*static_laser_ == scan->base_from_laser)) {
+      static_laser_ = scan->base_from_laser;
+      EncodeTfMessage({{time, f.base, f.laser, scan->base_from_laser}}, &buffer_);
+      Emit(GetTopic(options_.topics.tf_static, static_cast<int>(RosType::kTfMessage), true), time);
+    }
+    EncodeLaserScan(*scan, f.laser, &buffer_);
+    Emit(GetTopic(options_.topics.scan, static_cast<int>(RosType::kLaserScan), false), time);
+  } else if (const auto* imu = std::get_if<ImuSample>(&record)) {
+    EncodeImu(*imu, f.imu, &buffer_);
+    Emit(GetTopic(options_.topics.imu, static_cast<int>(RosType::kImu), false), time);
+  } else if (const auto* ticks = std::get_if<WheelTicks>(&record)) {
+    const std::size_t n = ticks->right_ticks.size() + ticks->left_ticks.size();
+    if (joint_names_.empty()) {
+      right_wheels_ = ticks->right_ticks.size();
+      joint_names_ = WheelJointNames(right_wheels_, ticks->left_ticks.size());
+      tick_totals_.assign(n, 0);
+      positions_.resize(n);
+    } else if (ticks->right_ticks.size() != right_wheels_ || n != tick_totals_.size()) {
+      throw std::invalid_argument("bag writer: WheelTicks at " + std::to_string(time.ns) +
+                                  " ns has a different wheel count than the first one");
+    }
+    const double rad_per_tick = 2.0 * std::numbers::pi / options_.ticks_per_revolution;
+    for (std::size_t i = 0; i < n; ++i) {
+      tick_totals_[i] +=
+          i < right_wheels_ ? ticks->right_ticks[i] : ticks->left_ticks[i - right_wheels_];
+      positions_[i] = static_cast<double>(tick_totals_[i]) * rad_per_tick;
+    }
+    EncodeJointState(time, joint_names_, positions_, &buffer_);
+    Emit(GetTopic(options_.topics.joint_states, static_cast<int>(RosType::kJointState), false),
+         time);
+  } else if (const auto* odom = std::get_if<OdometryPose>(&record)) {
+    EncodeOdometry({time, f.odom, f.base, odom->odom_from_base}, &buffer_);
+    Emit(GetTopic(options_.topics.odom, static_cast<int>(RosType::kOdometry), false), time);
+    if (options_.write_tf) {
+      EncodeTfMessage({{time, f.odom, f.base, odom->odom_from_base}}, &buffer_);
+      Emit(GetTopic(options_.topics.tf, static_cast<int>(RosType::kTfMessage), false), time);
+    }
+  }
+}
+
+void BagWriter::Write(const GroundTruthPose& truth) {
+  MaybeClock(truth.time);
+  EncodeOdometry({truth.time, options_.frames.map, options_.frames.base, truth.map_from_base},
+                 &buffer_);
+  Emit(GetTopic(options_.topics.ground_truth, static_cast<int>(RosType::kOdometry), false),
+       truth.time);
+}
+
+std::string BagWriter::MetadataYaml() const {
+  const std::string storage(BagStorageName(options_.storage));
+  const std::string start = std::to_string(start_ns_);
+  const std::string duration = std::to_string(end_ns_ - start_ns_);
+  const std::string count = std::to_string(message_count_);
+  std::string y = "rosbag2_bagfile_information:\n";
+  y += "  version: 6\n";
+  y += "  storage_identifier: " + storage + "\n";
+  y += "  duration:\n    nanoseconds: " + duration + "\n";
+  y += "  starting_time:\n    nanoseconds_since_epoch: " + start + "\n";
+  y += "  message_count: " + count + "\n";
+  y += "  topics_with_message_count:";
+  if (topics_.empty()) y += " []";
+  y += "\n";
+  for (const Topic& t : topics_) {
+    y += "    - topic_metadata:\n";
+    y += "        name: " + t.name + "\n";
+    y += "        type: " + t.type + "\n";
+    y += "        serialization_format: cdr\n";
+    y += "        offered_qos_profiles: " + Quote(t.qos) + "\n";
+    y += "      message_count: " + std::to_string(t.count) + "\n";
+  }
+  y += "  compression_format: \"\"\n";
+  y += "  custom_data:\n    " + std::string(kTicksKey) + ": " + Quote(TicksText()) + "\n";
+  y += "  compression_mode: \"\"\n";
+  y += "  relative_file_paths:\n    - " + file_name_ + "\n";
+  y += "  files:\n";
+  y += "    - path: " + file_name_ + "\n";
+  y += "      starting_time:\n        nanoseconds_since_epoch: " + start + "\n";
+  y += "      duration:\n        nanoseconds: " + duration + "\n";
+  y += "      message_count: " + count + "\n";
+  return y;
+}
+
+void BagWriter::Commit() {
+  if (committed_) return;
+  const std::string metadata = MetadataYaml();
+  if (mcap_) {
+    mcap_->Close();
+    mcap_.reset();
+  } else {
+    sqlite_->Close(metadata, 6);
+    sqlite_.reset();
+  }
+  WriteFileAtomically(tmp_folder_ + "/metadata.yaml", metadata);
+  std::error_code ec;
+  std::filesystem::rename(tmp_folder_, folder_, ec);
+  if (ec) throw std::runtime_error(folder_ + ": cannot rename into place: " + ec.message());
+  committed_ = true;
+}
+
+void WriteBag(const Dataset& data, const std::string& folder, const BagWriterOptions& options) {
+  BagWriter writer(folder, options);
+  std::size_t r = 0;
+  for (const GroundTruthPose& truth : data.reference) {
+    while (r < data.records.size() && RecordTime(data.records[r]) <= truth.time) {
+      writer.Write(data.records[r++]);
+    }
+    writer.Write(truth);
+  }
+  while (r < data.records.size()) writer.Write(data.records[r++]);
+  writer.Commit();
+}
+
+}  // namespace slamrig::slam

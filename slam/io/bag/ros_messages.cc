@@ -1,0 +1,333 @@
+#include "slam/io/bag/ros_messages.h"
+
+#include <array>
+#include <cmath>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+#include "slam/io/bag/cdr.h"
+
+namespace slamrig::slam {
+namespace {
+
+constexpr std::int64_t kNsPerSecond = 1'000'000'000;
+
+// builtin_interfaces/Time: int32 sec, uint32 nanosec.
+void WriteStamp(Time t, CdrWriter* w) {
+  if (t.ns < 0 || t.ns / kNsPerSecond > INT32_MAX) {
+    throw std::invalid_argument("time " + std::to_string(t.ns) +
+                                " ns does not fit builtin_interfaces/Time (0 .. 2^31 s)");
+  }
+  w->Int32(static_cast<std::int32_t>(t.ns / kNsPerSecond));
+  w->Uint32(static_cast<std::uint32_t>(t.ns % kNsPerSecond));
+}
+
+Time ReadStamp(CdrReader* r) {
+  const std::int64_t sec = r->Int32();
+  const std::int64_t nanosec = r->Uint32();
+  return Time{sec * kNsPerSecond + nanosec};
+}
+
+void WriteHeader(Time t, std::string_view frame_id, CdrWriter* w) {
+  WriteStamp(t, w);
+  w->String(frame_id);
+}
+
+Time ReadHeader(CdrReader* r, std::string* frame_id) {
+  const Time t = ReadStamp(r);
+  std::string frame = r->String();
+  if (frame_id != nullptr) *frame_id = std::move(frame);
+  return t;
+}
+
+// geometry_msgs/Quaternion of a rotation by `yaw` about z.
+void WriteYawQuaternion(double yaw, CdrWriter* w) {
+  w->Float64(0.0);
+  w->Float64(0.0);
+  w->Float64(std::sin(0.5 * yaw));
+  w->Float64(std::cos(0.5 * yaw));
+}
+
+double ReadYawQuaternion(CdrReader* r) {
+  const double x = r->Float64(), y = r->Float64(), z = r->Float64(), w = r->Float64();
+  return YawFromQuaternion(x, y, z, w);
+}
+
+struct TypeInfo {
+  const char* name;    // ROS 2 name
+  const char* fields;  // .msg text
+};
+
+// The .msg texts (field types and names of ROS 2 Humble's common_interfaces, comments dropped).
+const std::map<std::string, std::string>& NestedDefinitions() {
+  static const std::map<std::string, std::string> defs = {
+      {"builtin_interfaces/Time", "int32 sec\nuint32 nanosec\n"},
+      {"std_msgs/Header", "builtin_interfaces/Time stamp\nstring frame_id\n"},
+      {"geometry_msgs/Vector3", "float64 x\nfloat64 y\nfloat64 z\n"},
+      {"geometry_msgs/Point", "float64 x\nfloat64 y\nfloat64 z\n"},
+      {"geometry_msgs/Quaternion", "float64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1\n"},
+      {"geometry_msgs/Pose",
+       "geometry_msgs/Point position\ngeometry_msgs/Quaternion orientation\n"},
+      {"geometry_msgs/PoseWithCovariance", "geometry_msgs/Pose pose\nfloat64[36] covariance\n"},
+      {"geometry_msgs/Twist", "geometry_msgs/Vector3 linear\ngeometry_msgs/Vector3 angular\n"},
+      {"geometry_msgs/TwistWithCovariance", "geometry_msgs/Twist twist\nfloat64[36] covariance\n"},
+      {"geometry_msgs/Transform",
+       "geometry_msgs/Vector3 translation\ngeometry_msgs/Quaternion rotation\n"},
+      {"geometry_msgs/TransformStamped",
+       "std_msgs/Header header\nstring child_frame_id\ngeometry_msgs/Transform transform\n"},
+  };
+  return defs;
+}
+
+const TypeInfo& Info(RosType type) {
+  static const std::array<TypeInfo, 6> infos = {{
+      {"sensor_msgs/msg/LaserScan",
+       "std_msgs/Header header\nfloat32 angle_min\nfloat32 angle_max\nfloat32 angle_increment\n"
+       "float32 time_increment\nfloat32 scan_time\nfloat32 range_min\nfloat32 range_max\n"
+       "float32[] ranges\nfloat32[] intensities\n"},
+      {"sensor_msgs/msg/Imu",
+       "std_msgs/Header header\ngeometry_msgs/Quaternion orientation\n"
+       "float64[9] orientation_covariance\ngeometry_msgs/Vector3 angular_velocity\n"
+       "float64[9] angular_velocity_covariance\ngeometry_msgs/Vector3 linear_acceleration\n"
+       "float64[9] linear_acceleration_covariance\n"},
+      {"sensor_msgs/msg/JointState",
+       "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\n"
+       "float64[] effort\n"},
+      {"nav_msgs/msg/Odometry",
+       "std_msgs/Header header\nstring child_frame_id\ngeometry_msgs/PoseWithCovariance pose\n"
+       "geometry_msgs/TwistWithCovariance twist\n"},
+      {"tf2_msgs/msg/TFMessage", "geometry_msgs/TransformStamped[] transforms\n"},
+      {"rosgraph_msgs/msg/Clock", "builtin_interfaces/Time clock\n"},
+  }};
+  return infos[static_cast<std::size_t>(type)];
+}
+
+}  // namespace
+
+std::string_view RosTypeName(RosType type) { return Info(type).name; }
+
+std::optional<RosType> RosTypeFromName(std::string_view name) {
+  for (RosType type : kAllRosTypes) {
+    const std::string_view full = RosTypeName(type);
+    if (name == full) return type;
+    // "pkg/msg/Type" -> "pkg/Type"
+    const std::size_t slash = full.find('/');
+    std::string short_name(full.substr(0, slash));
+    short_name += full.substr(full.rfind('/'));
+    if (name == short_name) return type;
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+// The non-primitive field types of a .msg text, sorted and unique.
+std::set<std::string> FieldTypes(std::string_view fields) {
+  static const std::set<std::string_view> kPrimitive = {
+      "bool",  "byte",   "char",  "float32", "float64", "int8",   "uint8",
+      "int16", "uint16", "int32", "uint32",  "int64",   "uint64", "string"};
+  std::set<std::string> types;
+  std::size_t line = 0;
+  while (line < fields.size()) {
+    const std::size_t end = std::min(fields.find('\n', line), fields.size());
+    std::string_view type = fields.substr(line, end - line);
+    type = type.substr(0, std::min(type.find(' '), type.find('[')));
+    if (!type.empty() && !kPrimitive.contains(type)) types.emplace(type);
+    line = end + 1;
+  }
+  return types;
+}
+
+// Appends the definitions of the dependencies of `fields` depth first, each once, in sorted
+// order at every level, after an empty line and the two-line delimiter (the layout of
+// rosbag2_storage_mcap's message definition cache).
+void AppendDependencies(std::string_view fields, std::set<std::string>* seen, std::string* text) {
+  for (const std::string& type : FieldTypes(fields)) {
+    if (!seen->insert(type).second) continue;
+    const std::string& nested = NestedDefinitions().at(type);
+    *text += "\n" + std::string(80, '=') + "\nMSG: " + type + "\n" + nested;
+    AppendDependencies(nested, seen, text);
+  }
+}
+
+}  // namespace
+
+const std::string& RosMessageDefinition(RosType type) {
+  static const std::array<std::string, 6> texts = [] {
+    std::array<std::string, 6> t;
+    for (RosType ty : kAllRosTypes) {
+      std::string text = Info(ty).fields;
+      std::set<std::string> seen;
+      AppendDependencies(Info(ty).fields, &seen, &text);
+      t[static_cast<std::size_t>(ty)] = std::move(text);
+    }
+    return t;
+  }();
+  return texts[static_cast<std::size_t>(type)];
+}
+
+double YawFromQuaternion(double x, double y, double z, double w) {
+  if (x != 0.0 || y != 0.0) {
+    return std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
+  }
+  const double guess = 2.0 * std::atan2(z, w);
+  // Try guess, then its neighbours 1, 2, ... ulps away, for the double that encodes to (z, w).
+  double up = guess, down = guess;
+  for (int i = 0; i < 8; ++i) {
+    if (std::sin(0.5 * up) == z && std::cos(0.5 * up) == w) return up;
+    if (std::sin(0.5 * down) == z && std::cos(0.5 * down) == w) return down;
+    up = std::nextafter(up, INFINITY);
+    down = std::nextafter(down, -INFINITY);
+  }
+  return guess;
+}
+
+void EncodeLaserScan(const LaserScan& scan, std::string_view frame_id, std::string* out) {
+  CdrWriter w(out);
+  WriteHeader(scan.time, frame_id, &w);
+  const std::size_t n = scan.ranges_m.size();
+  const double last = n > 0 ? static_cast<double>(n - 1) : 0.0;
+  w.Float32(static_cast<float>(scan.angle_min_rad));
+  w.Float32(static_cast<float>(scan.angle_min_rad + last * scan.angle_increment_rad));
+  w.Float32(static_cast<float>(scan.angle_increment_rad));
+  w.Float32(static_cast<float>(scan.time_increment_s));
+  w.Float32(static_cast<float>(static_cast<double>(n) * scan.time_increment_s));
+  w.Float32(static_cast<float>(scan.range_min_m));
+  w.Float32(static_cast<float>(scan.range_max_m));
+  w.Float32Sequence(scan.ranges_m);
+  w.Float32Sequence({});
+}
+
+LaserScan DecodeLaserScan(std::string_view data, std::string* frame_id) {
+  CdrReader r(data);
+  LaserScan scan;
+  scan.time = ReadHeader(&r, frame_id);
+  scan.angle_min_rad = r.Float32();
+  r.Float32();  // angle_max: implied by angle_min, the increment and the beam count
+  scan.angle_increment_rad = r.Float32();
+  scan.time_increment_s = r.Float32();
+  r.Float32();  // scan_time
+  scan.range_min_m = r.Float32();
+  scan.range_max_m = r.Float32();
+  scan.ranges_m = r.Float32Sequence();
+  r.Float32Sequence();  // intensities
+  return scan;
+}
+
+void EncodeImu(const ImuSample& imu, std::string_view frame_id, std::string* out) {
+  CdrWriter w(out);
+  WriteHeader(imu.time, frame_id, &w);
+  for (double q : {0.0, 0.0, 0.0, 1.0}) w.Float64(q);
+  w.Float64(-1.0);  // orientation_covariance[0] = -1: no orientation estimate (REP-145)
+  w.ZeroFloat64Array(8);
+  for (int i = 0; i < 3; ++i) w.Float64(imu.angular_velocity_rad_s[i]);
+  w.ZeroFloat64Array(9);
+  for (int i = 0; i < 3; ++i) w.Float64(imu.linear_acceleration_m_s2[i]);
+  w.ZeroFloat64Array(9);
+}
+
+ImuSample DecodeImu(std::string_view data) {
+  CdrReader r(data);
+  ImuSample imu;
+  imu.time = ReadHeader(&r, nullptr);
+  r.SkipFloat64Array(4);  // orientation
+  r.SkipFloat64Array(9);
+  for (int i = 0; i < 3; ++i) imu.angular_velocity_rad_s[i] = r.Float64();
+  r.SkipFloat64Array(9);
+  for (int i = 0; i < 3; ++i) imu.linear_acceleration_m_s2[i] = r.Float64();
+  r.SkipFloat64Array(9);
+  return imu;
+}
+
+void EncodeJointState(Time time, const std::vector<std::string>& names,
+                      std::span<const double> positions_rad, std::string* out) {
+  CdrWriter w(out);
+  WriteHeader(time, "", &w);
+  w.Uint32(static_cast<std::uint32_t>(names.size()));
+  for (const std::string& name : names) w.String(name);
+  w.Float64Sequence(positions_rad);
+  w.Float64Sequence({});
+  w.Float64Sequence({});
+}
+
+RosJointState DecodeJointState(std::string_view data) {
+  CdrReader r(data);
+  RosJointState js;
+  js.time = ReadHeader(&r, nullptr);
+  const std::uint32_t n = r.SequenceLength(4);  // a string is at least its length field
+  js.names.reserve(n);
+  for (std::uint32_t i = 0; i < n; ++i) js.names.push_back(r.String());
+  js.positions_rad = r.Float64Sequence();
+  r.Float64Sequence();  // velocity
+  r.Float64Sequence();  // effort
+  return js;
+}
+
+void EncodeOdometry(const RosOdometry& odometry, std::string* out) {
+  CdrWriter w(out);
+  WriteHeader(odometry.time, odometry.frame_id, &w);
+  w.String(odometry.child_frame_id);
+  w.Float64(odometry.pose.x());
+  w.Float64(odometry.pose.y());
+  w.Float64(0.0);
+  WriteYawQuaternion(odometry.pose.theta(), &w);
+  w.ZeroFloat64Array(36);
+  w.ZeroFloat64Array(6);  // twist
+  w.ZeroFloat64Array(36);
+}
+
+RosOdometry DecodeOdometry(std::string_view data) {
+  CdrReader r(data);
+  RosOdometry odometry;
+  odometry.time = ReadHeader(&r, &odometry.frame_id);
+  odometry.child_frame_id = r.String();
+  const double x = r.Float64(), y = r.Float64();
+  r.Float64();  // z
+  const double yaw = ReadYawQuaternion(&r);
+  odometry.pose = Pose2(x, y, yaw);
+  r.SkipFloat64Array(36);
+  r.SkipFloat64Array(6);
+  r.SkipFloat64Array(36);
+  return odometry;
+}
+
+void EncodeTfMessage(const std::vector<RosTransform>& transforms, std::string* out) {
+  CdrWriter w(out);
+  w.Uint32(static_cast<std::uint32_t>(transforms.size()));
+  for (const RosTransform& t : transforms) {
+    WriteHeader(t.time, t.parent_frame, &w);
+    w.String(t.child_frame);
+    w.Float64(t.parent_from_child.x());
+    w.Float64(t.parent_from_child.y());
+    w.Float64(0.0);
+    WriteYawQuaternion(t.parent_from_child.theta(), &w);
+  }
+}
+
+std::vector<RosTransform> DecodeTfMessage(std::string_view data) {
+  CdrReader r(data);
+  // A TransformStamped is at least 8 (stamp) + 4 + 4 (strings) + 56 (transform) bytes.
+  const std::uint32_t n = r.SequenceLength(72);
+  std::vector<RosTransform> transforms(n);
+  for (RosTransform& t : transforms) {
+    t.time = ReadHeader(&r, &t.parent_frame);
+    t.child_frame = r.String();
+    const double x = r.Float64(), y = r.Float64();
+    r.Float64();  // z
+    t.parent_from_child = Pose2(x, y, ReadYawQuaternion(&r));
+  }
+  return transforms;
+}
+
+void EncodeClock(Time time, std::string* out) {
+  CdrWriter w(out);
+  WriteStamp(time, &w);
+}
+
+Time DecodeClock(std::string_view data) {
+  CdrReader r(data);
+  return ReadStamp(&r);
+}
+
+}  // namespace slamrig::slam

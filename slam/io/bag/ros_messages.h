@@ -1,0 +1,102 @@
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "slam/types/records.h"
+
+namespace slamrig::slam {
+
+/// The ROS 2 message types slamrig writes to and reads from bags.
+enum class RosType { kLaserScan, kImu, kJointState, kOdometry, kTfMessage, kClock };
+
+/// All types, in a fixed order.
+inline constexpr RosType kAllRosTypes[] = {RosType::kLaserScan,  RosType::kImu,
+                                           RosType::kJointState, RosType::kOdometry,
+                                           RosType::kTfMessage,  RosType::kClock};
+
+/// The type's ROS 2 name, e.g. "sensor_msgs/msg/LaserScan".
+std::string_view RosTypeName(RosType type);
+
+/// The type for a ROS 2 name ("sensor_msgs/msg/LaserScan"; the ROS 1 style
+/// "sensor_msgs/LaserScan" is accepted too), or nullopt.
+std::optional<RosType> RosTypeFromName(std::string_view name);
+
+/// The full message definition as rosbag2 stores it in MCAP schemas and the sqlite3
+/// message_definitions table (encoding "ros2msg"): the type's fields, then every nested type
+/// once, depth first and in sorted order at each level, each after an empty line, a line of 80
+/// '=' and a `MSG: pkg/Type` line (the layout of rosbag2_storage_mcap's message definition
+/// cache). Comments are left out; field types, names and order are the ROS 2 Humble ones.
+const std::string& RosMessageDefinition(RosType type);
+
+/// A rigid transform between two named frames at a time (geometry_msgs/TransformStamped, planar).
+struct RosTransform {
+  Time time;
+  std::string parent_frame;
+  std::string child_frame;
+  Pose2 parent_from_child;
+};
+
+/// A nav_msgs/Odometry message reduced to what slamrig carries: stamp, frames and planar pose.
+struct RosOdometry {
+  Time time;
+  std::string frame_id;
+  std::string child_frame_id;
+  Pose2 pose;
+};
+
+/// A sensor_msgs/JointState message's stamp, names and positions (velocity and effort dropped).
+struct RosJointState {
+  Time time;
+  std::vector<std::string> names;
+  std::vector<double> positions_rad;
+};
+
+// Encoders: each clears `out` and writes one CDR payload. A time before 0 or past 2^31 s cannot
+// be a builtin_interfaces/Time and throws std::invalid_argument.
+
+/// sensor_msgs/msg/LaserScan. angle_min, angle_max (= angle_min + (n-1) * increment),
+/// angle_increment, time_increment, scan_time (= n * time_increment), range_min and range_max
+/// are float32 on the wire: a scan reads back equal only if those values are float-representable.
+/// Intensities are left empty.
+void EncodeLaserScan(const LaserScan& scan, std::string_view frame_id, std::string* out);
+/// sensor_msgs/msg/Imu without orientation (orientation_covariance[0] = -1, REP-145).
+void EncodeImu(const ImuSample& imu, std::string_view frame_id, std::string* out);
+/// sensor_msgs/msg/JointState with names and positions; velocity and effort empty.
+void EncodeJointState(Time time, const std::vector<std::string>& names,
+                      std::span<const double> positions_rad, std::string* out);
+/// nav_msgs/msg/Odometry with the planar pose (z = 0, yaw quaternion), zero twist and covariances.
+void EncodeOdometry(const RosOdometry& odometry, std::string* out);
+/// tf2_msgs/msg/TFMessage.
+void EncodeTfMessage(const std::vector<RosTransform>& transforms, std::string* out);
+/// rosgraph_msgs/msg/Clock.
+void EncodeClock(Time time, std::string* out);
+
+// Decoders: throw CdrError (slam/io/bag/cdr.h) when the payload is too short or a length is bad.
+
+/// sensor_msgs/msg/LaserScan into a LaserScan (base_from_laser left at identity); the frame id
+/// goes to `frame_id` when given.
+LaserScan DecodeLaserScan(std::string_view data, std::string* frame_id = nullptr);
+/// sensor_msgs/msg/Imu into an ImuSample (orientation ignored).
+ImuSample DecodeImu(std::string_view data);
+/// sensor_msgs/msg/JointState.
+RosJointState DecodeJointState(std::string_view data);
+/// nav_msgs/msg/Odometry. The yaw is recovered from the quaternion (see YawFromQuaternion).
+RosOdometry DecodeOdometry(std::string_view data);
+/// tf2_msgs/msg/TFMessage.
+std::vector<RosTransform> DecodeTfMessage(std::string_view data);
+/// rosgraph_msgs/msg/Clock.
+Time DecodeClock(std::string_view data);
+
+/// Yaw of the quaternion (x, y, z, w) about z. For a planar quaternion the doubles around
+/// 2 atan2(z, w) are searched for one whose (sin(t/2), cos(t/2)) is exactly (z, w), as the
+/// encoders write it. That is the yaw that was written in about 96% of cases; otherwise a
+/// neighbour within a few ulps that encodes to the very same quaternion (sin and cos of doubles
+/// are not injective), so write -> read -> write is byte-identical but a yaw may differ by ulps.
+double YawFromQuaternion(double x, double y, double z, double w);
+
+}  // namespace slamrig::slam
