@@ -18,7 +18,7 @@ namespace slamrig::app {
 constexpr int kExitExpectationsFailed = 3;
 
 int RunRunCommand(const std::vector<std::string>& args) {
-  std::string scenario_path = "scenarios/office_loop.yaml";
+  std::string scenario_path = "office_loop";
   std::string out_dir;
   std::vector<std::string> overrides;
   std::uint64_t seed = 0;
@@ -30,7 +30,9 @@ int RunRunCommand(const std::vector<std::string>& args) {
       "on the same clock, scores them against the ground truth, writes a report folder\n"
       "(report.html, metrics.json, trajectories, maps, plots) and prints the table of\n"
       "expectations. Exit code 3 when an expectation fails.");
-  parser.AddPositional("SCENARIO", "scenario file [default: scenarios/office_loop.yaml]",
+  parser.AddPositional("SCENARIO",
+                       "scenario file, or a shipped scenario's name (office_loop, corridor, "
+                       "intel_log, ...) [default: office_loop]",
                        &scenario_path,
                        /*required=*/false);
   parser.AddOption("out", "DIR", "report folder [default: out/<scenario name>]", &out_dir);
@@ -55,8 +57,9 @@ int RunRunCommand(const std::vector<std::string>& args) {
                         "'");
   }
 
-  const scenario::ScenarioSpec spec = scenario::LoadScenario(
-      scenario_path, overrides, has_seed ? std::optional<std::uint64_t>(seed) : std::nullopt);
+  const scenario::ScenarioSpec spec =
+      scenario::LoadScenario(scenario::FindScenarioFile(scenario_path), overrides,
+                             has_seed ? std::optional<std::uint64_t>(seed) : std::nullopt);
   if (out_dir.empty()) out_dir = "out/" + spec.name;
 
   scenario::RunnerOptions options;

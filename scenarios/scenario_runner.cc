@@ -89,7 +89,13 @@ void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
         (pairs.back().reference.translation() - pairs.back().estimate.translation()).norm();
   }
   if (run.truth_map) {
-    const slam::MapScore score = slam::ScoreMap(c->run.map, c->map_from_estimator, *run.truth_map);
+    // A simulation's map is scored where the estimate starts (on the truth); a log's reference
+    // is itself an estimate, whose first pose is no better an anchor than any other, so there the
+    // map is scored in the ATE alignment's frame, as `slamrig slam` does.
+    const Pose2 reference_from_map = run.spec->simulated
+                                         ? c->map_from_estimator
+                                         : t.ate.reference_from_estimate * c->map_from_estimator;
+    const slam::MapScore score = slam::ScoreMap(c->run.map, reference_from_map, *run.truth_map);
     m["map_f1"] = score.f1;
     m["map_iou"] = score.iou;
     m["map_precision"] = score.precision;

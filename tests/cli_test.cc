@@ -3,7 +3,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "tests/util/dataset.h"
 #include "tests/util/run_command.h"
@@ -18,6 +21,27 @@ using ::testing::StartsWith;
 using testing::TempDir;
 
 std::string Slamrig(const std::string& args) { return std::string(SLAMRIG_BINARY) + " " + args; }
+
+std::string Slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// `text` without its comment lines and the lines holding one of `words`.
+std::string Without(const std::string& text, const std::vector<std::string>& words) {
+  std::istringstream lines(text);
+  std::string out;
+  for (std::string line; std::getline(lines, line);) {
+    if (!line.empty() && line[0] == '#') continue;
+    if (std::none_of(words.begin(), words.end(),
+                     [&](const std::string& w) { return line.find(w) != std::string::npos; })) {
+      out += line + "\n";
+    }
+  }
+  return out;
+}
 
 int CountLines(const std::string& text) {
   int lines = 0;
@@ -120,6 +144,28 @@ TEST(CliTest, RunWritesAReportAndFailsOnAnUnmetExpectation) {
   }
 }
 
+// The report's config.yaml is a scenario file: running it repeats the run bit for bit.
+TEST(CliTest, TheReportsConfigReproducesTheRun) {
+  TempDir dir;
+  const auto first = RunCommand(Slamrig(std::string("run ") + SLAMRIG_SOURCE_DIR +
+                                        "/scenarios/lidar_blackout.yaml --set duration_s=40 "
+                                        "--set slam.pf.particles=20 --quiet --out " +
+                                        dir.File("a")));
+  ASSERT_EQ(first.exit_code == 0 || first.exit_code == 3, true) << first.output;
+  const auto again =
+      RunCommand(Slamrig("run " + dir.File("a/config.yaml") + " --quiet --out " + dir.File("b")));
+  ASSERT_EQ(again.exit_code, first.exit_code) << again.output;
+  // metrics.json equal line for line, the wall-clock figure (and the expectation on it) aside.
+  const std::string a = Slurp(dir.File("a/metrics.json"));
+  EXPECT_GT(a.size(), 500u);
+  EXPECT_EQ(Without(a, {"realtime_factor", "\"value\""}),
+            Without(Slurp(dir.File("b/metrics.json")), {"realtime_factor", "\"value\""}));
+  EXPECT_EQ(Slurp(dir.File("a/pf.tum")), Slurp(dir.File("b/pf.tum")));
+  // And the resolved configuration resolves to itself.
+  EXPECT_EQ(Without(Slurp(dir.File("a/config.yaml")), {}),
+            Without(Slurp(dir.File("b/config.yaml")), {}));
+}
+
 TEST(CliTest, BadScenarioInputNamesFileLineAndKey) {
   TempDir dir;
   const std::string scenario = dir.Write(
@@ -133,6 +179,15 @@ TEST(CliTest, BadScenarioInputNamesFileLineAndKey) {
   run = RunCommand(
       Slamrig("run " + scenario + " --set slam.pf.particles=abc --out " + dir.File("o")));
   EXPECT_THAT(run.output, HasSubstr("expected an integer"));
+  // Errors about overridden values name the command-line argument, not a line of the file.
+  EXPECT_THAT(run.output,
+              StartsWith("slamrig: error: --set slam.pf.particles=abc: slam.pf.particles"));
+  run =
+      RunCommand(Slamrig("run " + scenario + " --set slam.pf.particles=0 --out " + dir.File("o")));
+  EXPECT_THAT(run.output,
+              HasSubstr("--set slam.pf.particles=0: slam.pf.particles = 0; must be > 0"));
+  run = RunCommand(Slamrig("run " + scenario + " --set world.drive.laps=x --out " + dir.File("o")));
+  EXPECT_THAT(run.output, HasSubstr("--set world.drive.laps=x: drive.laps"));
   run = RunCommand(Slamrig("run " + scenario + " --seed -4 --out " + dir.File("o")));
   EXPECT_THAT(run.output, HasSubstr("--seed: expected a non-negative integer"));
   EXPECT_FALSE(std::filesystem::exists(dir.File("o")));
