@@ -127,9 +127,9 @@ slam::EstimatorConfig ConfigFromFlags(
     const std::string& algorithm, const std::string& preset,
     const std::vector<std::pair<std::string, std::string>>& fields, const std::string& odometry,
     bool no_gyro) {
-  std::string yaml = "algorithm: " + algorithm + "\n";
-  if (!preset.empty()) yaml += "preset: " + preset + "\n";
-  YamlNode node = YamlNode::LoadString(yaml, "slamrig slam");
+  YamlNode node = YamlNode::LoadString("{}", "slamrig slam");
+  node.Override("algorithm", algorithm, "--algorithm " + algorithm);
+  if (!preset.empty()) node.Override("preset", preset, "--preset " + preset);
   for (const auto& [key, origin] : fields) {
     const std::size_t eq = key.find('=');
     if (eq == std::string::npos || eq == 0) throw ConfigError(origin + ": expected KEY=VALUE");

@@ -10,16 +10,7 @@
 #include "slam/types/check.h"
 
 namespace slamrig::slam {
-namespace {
-
-double SideMean(const std::vector<std::int32_t>& ticks) {
-  if (ticks.empty()) return 0.0;
-  double sum = 0.0;
-  for (const std::int32_t t : ticks) sum += t;
-  return sum / static_cast<double>(ticks.size());
-}
-
-}  // namespace
+namespace {}  // namespace
 
 OdometrySource ResolveOdometrySource(const std::vector<Record>& records, OdometrySource wanted) {
   if (wanted != OdometrySource::kAuto) return wanted;
@@ -77,12 +68,10 @@ std::vector<SyncedScan> ScanSynchronizer::Add(const Record& record) {
   switch (source_) {
     case OdometrySource::kWheelTicks:
       if (const auto* ticks = std::get_if<WheelTicks>(&record)) {
-        right_ticks_ += SideMean(ticks->right_ticks);
-        left_ticks_ += SideMean(ticks->left_ticks);
+        interval_.AddTicks(*ticks);
         seen_ticks_ = true;
       } else if (const auto* imu = std::get_if<ImuSample>(&record)) {
-        gyro_sum_ += imu->angular_velocity_rad_s.z();
-        ++gyro_count_;
+        interval_.AddGyro(imu->angular_velocity_rad_s.z());
       } else if (const auto* scan = std::get_if<LaserScan>(&record)) {
         out.push_back(CompleteTicks(*scan));
       }
@@ -118,24 +107,14 @@ SyncedScan ScanSynchronizer::CompleteTicks(const LaserScan& scan) {
   synced.scan = scan;
   if (last_scan_time_) {
     const double dt = SecondsBetween(scan.time, *last_scan_time_);
-    const double metres_per_tick = options_.robot.MetresPerTick();
-    const double right_m = right_ticks_ * metres_per_tick;
-    const double left_m = left_ticks_ * metres_per_tick;
-    double yaw = (right_m - left_m) / options_.robot.track_width_m;
-    if (options_.use_gyro) {
-      if (gyro_count_ > 0) {
-        held_rate_ = gyro_sum_ / gyro_count_;
-        yaw = *held_rate_ * dt;
-      } else {
-        ++gyro_fallbacks_;
-        if (held_rate_) yaw = *held_rate_ * dt;
-      }
-    }
+    synced.imu_samples = interval_.gyro_samples();
+    const OdometryInterval::Motion motion =
+        interval_.Take(options_.robot, dt, options_.use_gyro, &held_rate_);
+    gyro_fallbacks_ += motion.gyro_fallback;
     synced.dt_s = dt;
-    synced.distance_m = 0.5 * (right_m + left_m);
-    synced.yaw_change_rad = yaw;
-    synced.imu_samples = gyro_count_;
-    synced.increment = DiffDriveIncrement(synced.distance_m, yaw, options_.integration);
+    synced.distance_m = motion.distance_m;
+    synced.yaw_change_rad = motion.yaw_rad;
+    synced.increment = DiffDriveIncrement(synced.distance_m, motion.yaw_rad, options_.integration);
     pose_ = pose_ * synced.increment;
     if (!seen_ticks_) ++scans_without_odometry_;
   } else if (!seen_ticks_) {
@@ -144,8 +123,7 @@ SyncedScan ScanSynchronizer::CompleteTicks(const LaserScan& scan) {
   synced.odom_from_base = pose_;
   last_scan_time_ = scan.time;
   // Counts before the first scan belong to no interval; start every interval empty.
-  right_ticks_ = left_ticks_ = gyro_sum_ = 0.0;
-  gyro_count_ = 0;
+  interval_.Clear();
   return synced;
 }
 

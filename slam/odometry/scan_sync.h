@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "slam/odometry/diff_drive_model.h"
+#include "slam/odometry/odometry_interval.h"
 #include "slam/odometry/wheel_odometry.h"
 #include "slam/types/pose2.h"
 #include "slam/types/records.h"
@@ -94,8 +95,7 @@ class ScanSynchronizer {
   int scans_without_odometry_ = 0;
   std::optional<Time> last_scan_time_;
   // Wheel ticks: sums since the previous scan.
-  double right_ticks_ = 0.0, left_ticks_ = 0.0, gyro_sum_ = 0.0;
-  int gyro_count_ = 0;
+  OdometryInterval interval_;
   bool seen_ticks_ = false;
   std::optional<double> held_rate_;  // last interval's mean gyro rate, for dropouts
   Pose2 pose_;

@@ -10,16 +10,6 @@
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
-namespace {
-
-double MeanTicks(const std::vector<std::int32_t>& ticks) {
-  double sum = 0.0;
-  for (const std::int32_t t : ticks) sum += t;
-  return sum / static_cast<double>(ticks.size());
-}
-
-}  // namespace
-
 double DiffDriveParams::MetresPerTick() const {
   return 2.0 * std::numbers::pi * wheel_radius_m / ticks_per_revolution;
 }
@@ -52,32 +42,20 @@ WheelOdometry::WheelOdometry(const WheelOdometryOptions& options) : options_(opt
 void WheelOdometry::AddImu(const ImuSample& imu) {
   // Samples at or before the last ticks belong to an interval already integrated.
   if (has_last_time_ && imu.time <= last_time_) return;
-  gyro_sum_rad_s_ += imu.angular_velocity_rad_s.z();
-  ++gyro_count_;
+  interval_.AddGyro(imu.angular_velocity_rad_s.z());
 }
 
 OdometryPose WheelOdometry::AddTicks(const WheelTicks& ticks) {
-  SLAMRIG_CHECK(!ticks.right_ticks.empty() && !ticks.left_ticks.empty(),
-                "WheelTicks needs at least one wheel per side");
-  const double metres_per_tick = options_.robot.MetresPerTick();
-  const double right_m = MeanTicks(ticks.right_ticks) * metres_per_tick;
-  const double left_m = MeanTicks(ticks.left_ticks) * metres_per_tick;
-  const double distance_m = 0.5 * (right_m + left_m);
-
-  double yaw_change_rad = (right_m - left_m) / options_.robot.track_width_m;
-  if (options_.use_gyro) {
-    if (has_last_time_ && gyro_count_ > 0) {
-      const double dt_s = SecondsBetween(ticks.time, last_time_);
-      yaw_change_rad = gyro_sum_rad_s_ / gyro_count_ * dt_s;
-    } else {
-      ++gyro_fallbacks_;
-    }
-  }
-  pose_ = IntegrateDiffDrive(pose_, distance_m, yaw_change_rad, DiffDriveIntegration::kExactArc);
+  interval_.AddTicks(ticks);
+  // The first record has no interval to take a gyro rate over: its yaw is the encoders'.
+  const double dt_s = has_last_time_ ? SecondsBetween(ticks.time, last_time_) : 0.0;
+  const OdometryInterval::Motion motion =
+      interval_.Take(options_.robot, dt_s, options_.use_gyro && has_last_time_, nullptr);
+  if (options_.use_gyro && (!has_last_time_ || motion.gyro_fallback)) ++gyro_fallbacks_;
+  pose_ =
+      IntegrateDiffDrive(pose_, motion.distance_m, motion.yaw_rad, DiffDriveIntegration::kExactArc);
   has_last_time_ = true;
   last_time_ = ticks.time;
-  gyro_sum_rad_s_ = 0.0;
-  gyro_count_ = 0;
   return OdometryPose{ticks.time, pose_};
 }
 

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "slam/odometry/odometry_interval.h"
 #include "slam/types/pose2.h"
 #include "slam/types/records.h"
 
@@ -62,8 +63,7 @@ class WheelOdometry {
   Pose2 pose_;
   bool has_last_time_ = false;
   Time last_time_;
-  double gyro_sum_rad_s_ = 0.0;
-  int gyro_count_ = 0;
+  OdometryInterval interval_;
   int gyro_fallbacks_ = 0;
 };
 

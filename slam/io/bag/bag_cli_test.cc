@@ -90,7 +90,7 @@ TEST(BagCliTest, SlamReadsABagAndRejectsADamagedOne) {
   auto r = slamrig::testing::RunCommand(std::string(SLAMRIG_BINARY) + " slam " + sim +
                                         "/run --algorithm dead-reckoning --quiet --out " + out);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(ReadAll(out + "/metrics.json").find("\"log_format\": \"ros2 bag\""), std::string::npos);
+  EXPECT_NE(ReadAll(out + "/metrics.json").find("\"log_format\": \"ros2bag\""), std::string::npos);
   EXPECT_TRUE(fs::exists(out + "/trajectory.tum"));
 
   // Cut the file: one error line naming it, exit code 1, nothing written.
