@@ -227,6 +227,26 @@ TEST(Ece276aReaderTest, BadFilesAreParseErrorsNamingTheFileAndPlace) {
             {"time_stamps", "<f8", {1}, false, Raw(std::vector<double>{1.0})}});
   EXPECT_THROW(ReadEce276a(FindEce276aFiles(dir.File("96"))), ParseError);
   EXPECT_THROW(FindEce276aFiles(dir.File("95")), ParseError);
+  // Found by fuzz/ (ece276a_csv target): stamps past int64 nanoseconds became garbage times
+  // and broke the time order of the records.
+  dir.Write("encoders93.csv", "1.0,1,2,3,4\n12988819529.5,1,2,3,4\n");
+  try {
+    ReadEce276a(Ece276aFiles{dir.File("encoders93.csv"), "", ""});
+    FAIL();
+  } catch (const ParseError& e) {
+    EXPECT_STREQ(e.what(), (dir.File("encoders93.csv") +
+                            ":2: column 1: time 12988819529.500000 s is outside +-9.2e9 s")
+                               .c_str());
+  }
+  WriteNpz(dir.File("Encoders92.npz"),
+           {{"counts", "<i2", {4, 1}, true, Raw(std::vector<std::int16_t>{1, 2, 3, 4})},
+            {"time_stamps", "<f8", {1}, false, Raw(std::vector<double>{-1e10})}});
+  try {
+    ReadEce276a(FindEce276aFiles(dir.File("92")));
+    FAIL();
+  } catch (const ParseError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("Encoders92.npz: time_stamps[0]: "));
+  }
   dir.Write("Encoders94.npz", "not a zip");
   EXPECT_THROW(ReadNpz(dir.File("Encoders94.npz")), ParseError);
 }
