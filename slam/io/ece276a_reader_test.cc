@@ -247,6 +247,42 @@ TEST(Ece276aReaderTest, BadFilesAreParseErrorsNamingTheFileAndPlace) {
   } catch (const ParseError& e) {
     EXPECT_THAT(e.what(), ::testing::HasSubstr("Encoders92.npz: time_stamps[0]: "));
   }
+  // Found by fuzz/ (npz target): a deflated entry claiming 4 GiB made the reader allocate it,
+  // and a huge npy shape overflowed the element count.
+  const std::string name = "counts.npy";
+  const std::string deflated("\x03\x00", 2);  // an empty deflate stream
+  const std::string fields = U16(8) + U16(0) + U16(0) + U32(0) + U32(2) + U32(0xFFFFFFF0u) +
+                             U16(static_cast<std::uint32_t>(name.size()));
+  const std::string local = U32(0x04034b50) + U16(20) + U16(0) + fields + U16(0) + name + deflated;
+  const std::string central = U32(0x02014b50) + U16(20) + U16(20) + U16(0) + fields + U16(0) +
+                              U16(0) + U16(0) + U16(0) + U32(0) + U32(0) + name;
+  dir.Write("Encoders91.npz", local + central + U32(0x06054b50) + U16(0) + U16(0) + U16(1) +
+                                  U16(1) + U32(static_cast<std::uint32_t>(central.size())) +
+                                  U32(static_cast<std::uint32_t>(local.size())) + U16(0));
+  try {
+    ReadNpz(dir.File("Encoders91.npz"));
+    FAIL();
+  } catch (const ParseError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("counts.npy: uncompressed size 4294967280 is "
+                                               "impossible for 2 deflated bytes"));
+  }
+  for (const char* shape : {"(2305843009213693952,)", "(99999999999999999999999,)"}) {
+    const std::string header =
+        std::string("{'descr': '<f8', 'fortran_order': False, 'shape': ") + shape + ", }\n";
+    const std::string npy = std::string("\x93NUMPY\x01\x00", 8) +
+                            U16(static_cast<std::uint32_t>(header.size())) + header + "12345678";
+    EXPECT_THROW(
+        {
+          try {
+            ParseNpy(npy, "big.npy");
+          } catch (const ParseError& e) {
+            EXPECT_THAT(e.what(), ::testing::HasSubstr("big.npy: npy shape"));
+            throw;
+          }
+        },
+        ParseError)
+        << shape;
+  }
   dir.Write("Encoders94.npz", "not a zip");
   EXPECT_THROW(ReadNpz(dir.File("Encoders94.npz")), ParseError);
 }
