@@ -9,6 +9,8 @@
 # fuzz/regressions/<target>/ (inputs that once crashed). Crashes, leaks, timeouts (-timeout=10)
 # and out-of-memory (-rss_limit_mb=2048) land in build-fuzz/fuzz_artifacts/<target>/; logs in
 # build-fuzz/fuzz_logs/<target>.log. Exits non-zero if any target failed.
+# SLAMRIG_FUZZ_KEEP_GOING=1 fuzzes on past crashes (libFuzzer -fork=1 -ignore_crashes=1 ...),
+# collecting every artifact of a long run instead of stopping at the first.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -47,6 +49,7 @@ failed=()
 printf '%-14s %12s %8s %s\n' target executions seconds result
 for t in "${targets[@]}"; do
   artifacts=$build/fuzz_artifacts/$t
+  rm -rf "$artifacts"
   mkdir -p "$artifacts"
   corpora=("$build/fuzz_corpora/$t")
   for extra in fuzz/corpus/$t fuzz/regressions/$t; do
@@ -57,6 +60,9 @@ for t in "${targets[@]}"; do
     flags+=(-runs=0)
   else
     flags+=("-max_total_time=$seconds" -max_len=8192)
+    if [[ ${SLAMRIG_FUZZ_KEEP_GOING:-0} == 1 ]]; then
+      flags+=(-fork=1 -ignore_crashes=1 -ignore_ooms=1 -ignore_timeouts=1)
+    fi
   fi
   log=$build/fuzz_logs/$t.log
   status=ok
@@ -69,6 +75,14 @@ for t in "${targets[@]}"; do
   fi
   elapsed=$(($(date +%s) - start))
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
+  if [[ -z $execs ]]; then # fork mode: the last '#N:' progress line
+    execs=$(sed -n 's/^#\([0-9]*\):.*/\1/p' "$log" | tail -n 1)
+  fi
+  crashes=$(find "$artifacts" -type f | wc -l)
+  if ((crashes > 0)) && [[ $status == ok ]]; then
+    status="FAILED ($crashes artifacts in $artifacts)"
+    failed+=("$t")
+  fi
   printf '%-14s %12s %8s %s\n' "$t" "${execs:-?}" "$elapsed" "$status"
 done
 if ((${#failed[@]} > 0)); then
