@@ -8,7 +8,8 @@
 # inputs the fuzzer finds are added there), fuzz/corpus/<target>/ (hand-made) and
 # fuzz/regressions/<target>/ (inputs that once crashed). Crashes, leaks, timeouts (-timeout=10)
 # and out-of-memory (-rss_limit_mb=2048) land in build-fuzz/fuzz_artifacts/<target>/; logs in
-# build-fuzz/fuzz_logs/<target>.log. Exits non-zero if any target failed.
+# build-fuzz/fuzz_logs/<target>.log (SLAMRIG_FUZZ_BUILD_DIR picks another build folder). Exits
+# non-zero if any target failed.
 # SLAMRIG_FUZZ_KEEP_GOING=1 fuzzes on past crashes (libFuzzer -fork=1 -ignore_crashes=1 ...),
 # collecting every artifact of a long run instead of stopping at the first.
 set -euo pipefail
@@ -29,7 +30,7 @@ all_targets=(carmen npz ece276a_csv tum map_server world_yaml robot_yaml scenari
 targets=("$@")
 if ((${#targets[@]} == 0)); then targets=("${all_targets[@]}"); fi
 
-build=build-fuzz
+build=${SLAMRIG_FUZZ_BUILD_DIR:-build-fuzz}
 jobs=${SLAMRIG_FUZZ_JOBS:-2}
 if [[ ! -f $build/CMakeCache.txt ]]; then
   CC=clang CXX=clang++ cmake -S . -B "$build" -DSLAMRIG_FUZZ=ON -DSLAMRIG_BUILD_BENCHMARKS=OFF \
