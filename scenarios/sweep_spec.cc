@@ -48,6 +48,15 @@ SweepSpec LoadSweepSpec(const std::string& path) {
     if (p.values.empty()) values.Fail("needs at least one value");
     spec.parameters.push_back(std::move(p));
   }
+  // ExpandSweep holds every run in memory: a grid past kMaxSweepRuns is a typo, not a plan.
+  std::size_t total = spec.seeds.size();
+  for (const SweepParameter& p : spec.parameters) {
+    total = total > kMaxSweepRuns / p.values.size() ? kMaxSweepRuns + 1 : total * p.values.size();
+  }
+  if (total > kMaxSweepRuns) {
+    parameters.Fail("seeds x parameter values is more than " + std::to_string(kMaxSweepRuns) +
+                    " runs");
+  }
   if (auto metrics = root.Optional("metrics")) {
     for (const YamlNode& m : metrics->Elements()) {
       const std::string name = m.As<std::string>();
