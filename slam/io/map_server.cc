@@ -1,7 +1,9 @@
 #include "slam/io/map_server.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -69,16 +71,28 @@ cv::Mat ReadPgm(const std::string& path) {
   const int maxval = next_int("maxval");
   if (maxval > 255)
     throw ParseError(path + ": 16-bit PGM (maxval " + std::to_string(maxval) + ") not supported");
+  // Every pixel takes at least one byte of the file (P5: one, P2: a digit): a header promising
+  // more pixels than the file has bytes is refused before the image is allocated.
+  const std::int64_t pixels = static_cast<std::int64_t>(width) * height;
+  const std::streamoff header_end = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff left = in.tellg() - header_end;
+  in.seekg(header_end);
+  if (pixels > left) {
+    throw ParseError(path + ": truncated PGM: expected " + std::to_string(pixels) +
+                     " pixels, found " + std::to_string(std::max<std::streamoff>(left - 1, 0)) +
+                     " bytes");
+  }
   cv::Mat image(height, width, CV_8UC1);
   if (magic == "P5") {
     in.get();  // the single whitespace after maxval
-    in.read(reinterpret_cast<char*>(image.data), static_cast<std::streamsize>(width) * height);
-    if (in.gcount() != static_cast<std::streamsize>(width) * height) {
-      throw ParseError(path + ": truncated PGM: expected " + std::to_string(width * height) +
+    in.read(reinterpret_cast<char*>(image.data), static_cast<std::streamsize>(pixels));
+    if (in.gcount() != static_cast<std::streamsize>(pixels)) {
+      throw ParseError(path + ": truncated PGM: expected " + std::to_string(pixels) +
                        " pixels, found " + std::to_string(in.gcount()));
     }
   } else {
-    for (int i = 0; i < width * height; ++i) {
+    for (std::int64_t i = 0; i < pixels; ++i) {
       int v = -1;
       if (!(in >> v) || v < 0 || v > maxval) {
         throw ParseError(path + ": pixel " + std::to_string(i) + " missing or out of range");
