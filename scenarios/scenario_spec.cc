@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <sstream>
+#include <system_error>
 
 #include "sim/robot_yaml.h"
 #include "sim/world_yaml.h"
@@ -17,7 +18,8 @@ namespace fs = std::filesystem;
 std::string Resolve(const YamlNode& node, const std::string& scenario_path) {
   fs::path p = node.As<std::string>();
   if (p.is_relative()) p = fs::path(scenario_path).parent_path() / p;
-  if (!fs::exists(p)) node.Fail("file '" + p.string() + "' does not exist");
+  std::error_code error;  // e.g. a name too long for the OS: not there either
+  if (!fs::exists(p, error)) node.Fail("file '" + p.string() + "' does not exist");
   return p.lexically_normal().string();
 }
 

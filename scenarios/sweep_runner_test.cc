@@ -137,6 +137,10 @@ TEST(SweepTest, BadSweepFilesNameFileLineAndKey) {
               ::testing::HasSubstr("sweep.yaml:4:3: parameters: seeds x parameter values is more "
                                    "than 1000000 runs"));
   EXPECT_EQ(error("scenario: s.yaml\nseeds: 1000\nparameters:\n  a: [" + thousand + "]\n"), "");
+  // Found by fuzz/ (scenario_yaml target): a file name longer than the OS allows made
+  // std::filesystem::exists throw filesystem_error (ENAMETOOLONG) instead of a ConfigError.
+  EXPECT_THAT(error("scenario: " + std::string(5000, 'x') + "\nseeds: 2\nparameters: {a: [1]}\n"),
+              ::testing::HasSubstr("sweep.yaml:1:11: scenario: scenario file"));
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "sim/presets.h"
 
 #include <filesystem>
+#include <system_error>
 #include <vector>
 
 #include "slam/types/error.h"
@@ -16,7 +17,8 @@ std::string FindPresetFile(const std::string& name_or_path, const std::string& f
 #endif
   std::string tried;
   for (const fs::path& candidate : candidates) {
-    if (fs::is_regular_file(candidate)) return candidate.string();
+    std::error_code error;  // e.g. a name too long for the OS: not a candidate
+    if (fs::is_regular_file(candidate, error)) return candidate.string();
     tried += (tried.empty() ? "" : ", ") + candidate.string();
   }
   throw ConfigError("'" + name_or_path + "': no such " +

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
+#include <system_error>
 
 #include "slam/config/yaml_node.h"
 #include "slam/io/atomic_file.h"
@@ -178,7 +179,8 @@ MapImage ReadMapServerMap(const std::string& yaml_path) {
   std::filesystem::path image_path(image_name);
   if (image_path.is_relative())
     image_path = std::filesystem::path(yaml_path).parent_path() / image_path;
-  if (!std::filesystem::exists(image_path)) {
+  std::error_code error;  // e.g. a name too long for the OS: does not exist either
+  if (!std::filesystem::exists(image_path, error)) {
     image_node.Fail("map image '" + image_path.string() + "' does not exist");
   }
   const std::string ext = image_path.extension().string();
