@@ -38,7 +38,20 @@ int RunSweepCommand(const std::vector<std::string>& args) {
   parser.AddOption("out", "DIR", "output folder (created; reused to resume)", &options.out_dir);
   parser.AddOption("jobs", "N", "runs at a time (0: one per core)", &options.jobs);
   parser.AddFlag("quiet", "no progress bar", &quiet);
+  std::string backend = "local";
+  int row = -1;
+  parser.AddOption("backend", "local|slurm",
+                   "where runs execute: child processes here, or one Slurm job array (sbatch)",
+                   &backend);
+  parser.AddOption("row", "K", "run grid row K alone into DIR/rows/ (what a Slurm task does)",
+                   &row);
   if (!parser.Parse(args)) return 0;
+  if (backend != "local" && backend != "slurm") {
+    throw ConfigError("slamrig sweep: --backend = " + backend + "; must be local or slurm");
+  }
+  options.backend =
+      backend == "slurm" ? scenario::SweepBackend::kSlurm : scenario::SweepBackend::kLocal;
+  options.sweep_path = sweep_path;
   if (options.out_dir.empty()) throw ConfigError("slamrig sweep: --out DIR is required");
   if (options.jobs < 0)
     throw ConfigError("slamrig sweep: --jobs = " + std::to_string(options.jobs) + "; must be >= 0");
@@ -46,6 +59,9 @@ int RunSweepCommand(const std::vector<std::string>& args) {
   options.slamrig_binary = SelfPath();
 
   const scenario::SweepSpec spec = scenario::LoadSweepSpec(sweep_path);
+  if (row >= 0) {
+    return scenario::RunSweepRow(spec, options, static_cast<std::size_t>(row)) ? 0 : 3;
+  }
   const scenario::SweepSummary s = scenario::RunSweep(spec, options);
   std::printf("%s: %d runs (%d from an earlier sweep, %d now), %d failed -> %s/results.csv\n",
               sweep_path.c_str(), s.total, s.already_done, s.ran, s.failed,

@@ -16,6 +16,13 @@ function(slamrig_set_target_options target)
                                              -fno-sanitize-recover=undefined)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
   endif()
+  if(SLAMRIG_FUZZ)
+    # Coverage instrumentation for libFuzzer on every target; the fuzz executables add
+    # -fsanitize=fuzzer at link time (fuzz/CMakeLists.txt).
+    target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link,address,undefined
+                                             -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
   if(SLAMRIG_VALIDATE)
     target_compile_definitions(${target} PRIVATE SLAMRIG_VALIDATE=1)
   endif()

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <sstream>
+#include <system_error>
 
 #include "sim/presets.h"
 #include "sim/robot_yaml.h"
@@ -25,7 +26,8 @@ YamlNode WorldOrRobot(const YamlNode& node, const std::string& scenario_path, co
   const std::string text = node.As<std::string>();
   fs::path p = text;
   if (p.is_relative()) p = fs::path(scenario_path).parent_path() / p;
-  if (fs::is_regular_file(p)) return YamlNode::LoadFile(p.lexically_normal().string());
+  std::error_code error;  // e.g. a name too long for the OS: not there either
+  if (fs::is_regular_file(p, error)) return YamlNode::LoadFile(p.lexically_normal().string());
   try {
     return YamlNode::LoadFile(sim::FindPresetFile(text, folder));
   } catch (const ConfigError& e) {
@@ -38,9 +40,12 @@ YamlNode WorldOrRobot(const YamlNode& node, const std::string& scenario_path, co
 std::string ResolveLog(const YamlNode& node, const std::string& scenario_path) {
   const std::string text = node.As<std::string>();
   const fs::path beside = fs::path(scenario_path).parent_path() / text;
-  if (fs::path(text).is_relative() && fs::exists(beside)) return beside.lexically_normal().string();
+  std::error_code error;
+  if (fs::path(text).is_relative() && fs::exists(beside, error)) {
+    return beside.lexically_normal().string();
+  }
   const std::string resolved = slam::ResolveLogPath(text);
-  if (!fs::exists(resolved) && !slam::LooksLikeEce276a(resolved)) {
+  if (!fs::exists(resolved, error) && !slam::LooksLikeEce276a(resolved)) {
     node.Fail("no such log '" + text +
               "' (looked beside the scenario and in SLAMRIG_DATA_DIR = " + slam::DataDir() + ")");
   }

@@ -21,6 +21,7 @@
 
 #include "scenarios/plot.h"
 #include "scenarios/scenario_spec.h"
+#include "scenarios/slurm_sweep.h"
 #include "slam/io/atomic_file.h"
 #include "slam/types/error.h"
 
@@ -133,6 +134,82 @@ struct Child {
   Clock::time_point start;
 };
 
+std::vector<std::string> MetricsOf(const SweepSpec& spec) {
+  return spec.metrics.empty() ? DefaultMetrics(spec) : spec.metrics;
+}
+
+std::string RunDir(const std::string& out_dir, std::size_t index) {
+  char name[16];
+  std::snprintf(name, sizeof(name), "%04zu", index);
+  return (std::filesystem::path(out_dir) / "runs" / name).string();
+}
+
+// Starts `slamrig run SCENARIO --out runs/<n> --seed S --set key=value ... --quiet` for grid
+// row `index`, its output in runs/<n>/log.txt, and returns the child's pid.
+pid_t SpawnRun(const SweepSpec& spec, const SweepRunnerOptions& options, const SweepRun& run,
+               std::size_t index) {
+  namespace fs = std::filesystem;
+  const std::string dir = RunDir(options.out_dir, index);
+  fs::create_directories(dir);
+  fs::remove(fs::path(dir) / "metrics.json");
+  std::vector<std::string> args = {
+      options.slamrig_binary,   "run",    spec.scenario_path, "--out", dir, "--seed",
+      std::to_string(run.seed), "--quiet"};
+  for (std::size_t p = 0; p < spec.parameters.size(); ++p) {
+    args.push_back("--set");
+    args.push_back(spec.parameters[p].key + "=" + spec.parameters[p].values[run.value_index[p]]);
+  }
+  const std::string log_path = dir + "/log.txt";
+  const pid_t pid = ::fork();
+  if (pid < 0) throw std::runtime_error(std::string("fork failed: ") + std::strerror(errno));
+  if (pid == 0) {
+    // A child never outlives a killed sweep: it would finish a run nobody records.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (log >= 0) {
+      ::dup2(log, STDOUT_FILENO);
+      ::dup2(log, STDERR_FILENO);
+    }
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(argv[0], argv.data());
+    std::perror("execv");
+    ::_exit(127);
+  }
+  return pid;
+}
+
+// The results.csv row of a finished run (wait status `status`, `wall_s` seconds); `*state` is
+// pass, fail or error.
+std::vector<std::string> ResultRow(const SweepSpec& spec, const std::vector<std::string>& metrics,
+                                   const SweepRun& run, const std::string& run_dir, int status,
+                                   double wall_s, std::string* state) {
+  const std::string metrics_path = (std::filesystem::path(run_dir) / "metrics.json").string();
+  *state = "error";
+  std::map<std::string, double> values;
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if ((code == 0 || code == 3) && std::filesystem::exists(metrics_path)) {
+    try {
+      values = ReadRunMetrics(metrics_path, state);
+    } catch (const std::exception&) {
+      *state = "error";
+    }
+  }
+  std::vector<std::string> row = {run.id};
+  for (std::size_t p = 0; p < spec.parameters.size(); ++p) {
+    row.push_back(spec.parameters[p].values[run.value_index[p]]);
+  }
+  row.push_back(std::to_string(run.seed));
+  row.push_back(*state);
+  for (const auto& m : metrics) {
+    const auto v = values.find(m);
+    row.push_back(v == values.end() ? "" : FormatValue(v->second));
+  }
+  row.push_back(FormatValue(wall_s));
+  return row;
+}
+
 }  // namespace
 
 std::vector<std::string> ResultsHeader(const SweepSpec& spec,
@@ -155,7 +232,7 @@ SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) 
   const std::string csv_path = (fs::path(options.out_dir) / "results.csv").string();
 
   // A resumed sweep must have been started with the same grid and metrics.
-  std::vector<std::string> metrics = spec.metrics.empty() ? DefaultMetrics(spec) : spec.metrics;
+  std::vector<std::string> metrics = MetricsOf(spec);
   std::set<std::string> done;
   std::vector<std::string> header;
   if (fs::exists(csv_path)) {
@@ -215,39 +292,26 @@ SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) 
   };
 
   auto start_run = [&](std::size_t index) {
-    const SweepRun& run = runs[index];
-    char name[16];
-    std::snprintf(name, sizeof(name), "%04zu", index);
-    const std::string dir = (fs::path(options.out_dir) / "runs" / name).string();
-    fs::create_directories(dir);
-    fs::remove(fs::path(dir) / "metrics.json");
-    std::vector<std::string> args = {
-        options.slamrig_binary,   "run",    spec.scenario_path, "--out", dir, "--seed",
-        std::to_string(run.seed), "--quiet"};
-    for (std::size_t p = 0; p < spec.parameters.size(); ++p) {
-      args.push_back("--set");
-      args.push_back(spec.parameters[p].key + "=" + spec.parameters[p].values[run.value_index[p]]);
-    }
-    const std::string log_path = dir + "/log.txt";
-    const pid_t pid = ::fork();
-    if (pid < 0) throw std::runtime_error(std::string("fork failed: ") + std::strerror(errno));
-    if (pid == 0) {
-      // A child never outlives a killed sweep: it would finish a run nobody records.
-      ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-      const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      if (log >= 0) {
-        ::dup2(log, STDOUT_FILENO);
-        ::dup2(log, STDERR_FILENO);
-      }
-      std::vector<char*> argv;
-      for (auto& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      ::execv(argv[0], argv.data());
-      std::perror("execv");
-      ::_exit(127);
-    }
-    running[pid] = {index, Clock::now()};
+    running[SpawnRun(spec, options, runs[index], index)] = {index, Clock::now()};
   };
+
+  if (options.backend == SweepBackend::kSlurm) {
+    // One job array for every missing row; rows are merged in grid order once it is over.
+    const std::vector<std::string> lines = RunRowsOnSlurm(options, todo);
+    for (std::size_t k = 0; k < todo.size(); ++k) {
+      const std::vector<std::string> fields = SplitCsv(lines[k]);
+      if (lines[k].empty() || fields.size() < spec.parameters.size() + 3 ||
+          fields[spec.parameters.size() + 2] != "pass") {
+        ++summary.failed;
+      }
+      if (lines[k].empty()) continue;  // the task left no row: the next sweep runs it again
+      AppendLine(fd, lines[k], csv_path);
+      ++summary.ran;
+    }
+    ::close(fd);
+    WriteSweepSummary(spec, options.out_dir);
+    return summary;
+  }
 
   report();
   while (next < todo.size() || !running.empty()) {
@@ -262,34 +326,11 @@ SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) 
     if (it == running.end()) continue;
     const Child child = it->second;
     running.erase(it);
-    const SweepRun& run = runs[child.run];
     const double wall = std::chrono::duration<double>(Clock::now() - child.start).count();
-    char name[16];
-    std::snprintf(name, sizeof(name), "%04zu", child.run);
-    const std::string metrics_path =
-        (fs::path(options.out_dir) / "runs" / name / "metrics.json").string();
-    std::string state = "error";
-    std::map<std::string, double> values;
-    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    if ((code == 0 || code == 3) && fs::exists(metrics_path)) {
-      try {
-        values = ReadRunMetrics(metrics_path, &state);
-      } catch (const std::exception&) {
-        state = "error";
-      }
-    }
+    std::string state;
+    const std::vector<std::string> row = ResultRow(
+        spec, metrics, runs[child.run], RunDir(options.out_dir, child.run), status, wall, &state);
     if (state != "pass") ++summary.failed;
-    std::vector<std::string> row = {run.id};
-    for (std::size_t p = 0; p < spec.parameters.size(); ++p) {
-      row.push_back(spec.parameters[p].values[run.value_index[p]]);
-    }
-    row.push_back(std::to_string(run.seed));
-    row.push_back(state);
-    for (const auto& m : metrics) {
-      const auto v = values.find(m);
-      row.push_back(v == values.end() ? "" : FormatValue(v->second));
-    }
-    row.push_back(FormatValue(wall));
     AppendLine(fd, JoinCsv(row), csv_path);
     ++finished_now;
     ++summary.ran;
@@ -299,6 +340,36 @@ SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) 
   if (options.progress && tty) std::fputc('\n', stderr);
   WriteSweepSummary(spec, options.out_dir);
   return summary;
+}
+
+bool RunSweepRow(const SweepSpec& spec, const SweepRunnerOptions& options, std::size_t row) {
+  const std::vector<SweepRun> runs = ExpandSweep(spec);
+  if (row >= runs.size()) {
+    throw ConfigError(spec.path + ": --row " + std::to_string(row) + " is past the grid's " +
+                      std::to_string(runs.size()) + " rows");
+  }
+  const std::vector<std::string> metrics = MetricsOf(spec);
+  const Clock::time_point start = Clock::now();
+  const pid_t pid = SpawnRun(spec, options, runs[row], row);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) throw std::runtime_error(std::string("waitpid: ") + std::strerror(errno));
+  }
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  std::string state;
+  const std::vector<std::string> fields =
+      ResultRow(spec, metrics, runs[row], RunDir(options.out_dir, row), status, wall, &state);
+  const std::string path = SweepRowPath(options.out_dir, row);
+  std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+  slam::WriteFileAtomically(path,
+                            JoinCsv(ResultsHeader(spec, metrics)) + "\n" + JoinCsv(fields) + "\n");
+  return state == "pass";
+}
+
+std::string SweepRowPath(const std::string& out_dir, std::size_t row) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "%04zu.csv", row);
+  return (std::filesystem::path(out_dir) / "rows" / name).string();
 }
 
 int WriteSweepSummary(const SweepSpec& spec, const std::string& out_dir) {

@@ -7,12 +7,20 @@
 
 namespace slamrig::scenario {
 
+/// Where the runs of a sweep execute.
+enum class SweepBackend {
+  kLocal,  ///< child processes on this machine, `jobs` at a time
+  kSlurm,  ///< one Slurm job array, a task per missing row (scenarios/slurm_sweep.h)
+};
+
 /// How to execute a sweep.
 struct SweepRunnerOptions {
   std::string out_dir;         ///< results.csv, runs/<n>/ and the summary plots go here
   std::string slamrig_binary;  ///< the program that runs one scenario (`slamrig run ...`)
   int jobs = 0;                ///< parallel runs; 0: one per core
   bool progress = true;        ///< progress bar with count and ETA on stderr
+  SweepBackend backend = SweepBackend::kLocal;
+  std::string sweep_path;  ///< the sweep file, passed on to the Slurm tasks (`--row K`)
 };
 
 /// What a sweep did.
@@ -31,6 +39,14 @@ struct SweepSummary {
 /// (summary_<metric>__<parameter>.png: the mean over seeds with the min-max spread) and
 /// summary.html.
 SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options);
+
+/// Runs grid row `row` alone (a child `slamrig run` as in RunSweep) and writes its results.csv
+/// line, under the header, to `out_dir`/rows/<row>.csv atomically; results.csv is not touched
+/// (a Slurm task). Returns true if the run passed. Throws ConfigError for a row past the grid.
+bool RunSweepRow(const SweepSpec& spec, const SweepRunnerOptions& options, std::size_t row);
+
+/// Where RunSweepRow writes row `row`: `out_dir`/rows/<row, 4 digits>.csv.
+std::string SweepRowPath(const std::string& out_dir, std::size_t row);
 
 /// Reads `out_dir`/results.csv and writes the summary plots and summary.html. Returns the
 /// number of plots written.

@@ -125,6 +125,22 @@ TEST(SweepTest, BadSweepFilesNameFileLineAndKey) {
               ::testing::HasSubstr("needs at least one value"));
   EXPECT_THAT(error("scenario: s.yaml\nseeds: 2\nparameters: {a: [1]}\nseed: 3\n"),
               ::testing::HasSubstr("sweep.yaml:4:1: seed: unknown key"));
+  // Found while fuzzing sweep files: 100000 seeds x 100 x 100 values ran out of memory
+  // (std::bad_alloc) in ExpandSweep. 1000 seeds x 1000 values is exactly the limit.
+  std::string hundred, thousand;
+  for (int i = 0; i < 1000; ++i) {
+    if (i < 100) hundred += (i ? "," : "") + std::to_string(i);
+    thousand += (i ? "," : "") + std::to_string(i);
+  }
+  EXPECT_THAT(error("scenario: s.yaml\nseeds: 100000\nparameters:\n  a: [" + hundred + "]\n  b: [" +
+                    hundred + "]\n"),
+              ::testing::HasSubstr("sweep.yaml:4:3: parameters: seeds x parameter values is more "
+                                   "than 1000000 runs"));
+  EXPECT_EQ(error("scenario: s.yaml\nseeds: 1000\nparameters:\n  a: [" + thousand + "]\n"), "");
+  // Found by fuzz/ (scenario_yaml target): a file name longer than the OS allows made
+  // std::filesystem::exists throw filesystem_error (ENAMETOOLONG) instead of a ConfigError.
+  EXPECT_THAT(error("scenario: " + std::string(5000, 'x') + "\nseeds: 2\nparameters: {a: [1]}\n"),
+              ::testing::HasSubstr("sweep.yaml:1:11: scenario: scenario file"));
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <set>
+#include <system_error>
 
 #include "slam/config/yaml_node.h"
 
@@ -15,7 +16,8 @@ SweepSpec LoadSweepSpec(const std::string& path) {
   std::filesystem::path scenario_path = scenario.As<std::string>();
   if (scenario_path.is_relative())
     scenario_path = std::filesystem::path(path).parent_path() / scenario_path;
-  if (!std::filesystem::exists(scenario_path)) {
+  std::error_code error;  // e.g. a name too long for the OS: does not exist either
+  if (!std::filesystem::exists(scenario_path, error)) {
     scenario.Fail("scenario file '" + scenario_path.string() + "' does not exist");
   }
   spec.scenario_path = scenario_path.lexically_normal().string();
@@ -47,6 +49,15 @@ SweepSpec LoadSweepSpec(const std::string& path) {
     }
     if (p.values.empty()) values.Fail("needs at least one value");
     spec.parameters.push_back(std::move(p));
+  }
+  // ExpandSweep holds every run in memory: a grid past kMaxSweepRuns is a typo, not a plan.
+  std::size_t total = spec.seeds.size();
+  for (const SweepParameter& p : spec.parameters) {
+    total = total > kMaxSweepRuns / p.values.size() ? kMaxSweepRuns + 1 : total * p.values.size();
+  }
+  if (total > kMaxSweepRuns) {
+    parameters.Fail("seeds x parameter values is more than " + std::to_string(kMaxSweepRuns) +
+                    " runs");
   }
   if (auto metrics = root.Optional("metrics")) {
     for (const YamlNode& m : metrics->Elements()) {

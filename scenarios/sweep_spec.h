@@ -39,8 +39,11 @@ struct SweepRun {
   std::uint64_t seed = 0;
 };
 
-/// Reads a sweep file strictly (unknown keys, wrong types, empty lists are ConfigErrors with
-/// file:line and key).
+/// The most runs a sweep grid may have (seeds times every parameter's value count).
+inline constexpr std::size_t kMaxSweepRuns = 1'000'000;
+
+/// Reads a sweep file strictly (unknown keys, wrong types, empty lists and grids of more than
+/// kMaxSweepRuns runs are ConfigErrors with file:line and key).
 SweepSpec LoadSweepSpec(const std::string& path);
 
 /// Every combination of parameter values times every seed, in a fixed order.

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <system_error>
 #include <vector>
 
 #include "slam/types/error.h"
@@ -45,7 +46,8 @@ std::string FindPresetFile(const std::string& name_or_path, const std::string& f
   }
   std::string tried;
   for (const fs::path& candidate : candidates) {
-    if (fs::is_regular_file(candidate)) return candidate.lexically_normal().string();
+    std::error_code error;  // e.g. a name too long for the OS: not there either
+    if (fs::is_regular_file(candidate, error)) return candidate.lexically_normal().string();
     tried += (tried.empty() ? "" : ", ") + candidate.string();
   }
   const std::string kind = folder == "robots"      ? "robot"

@@ -1,6 +1,7 @@
 #include "sim/world_yaml.h"
 
 #include <filesystem>
+#include <system_error>
 
 #include "sim/mount_pose.h"
 #include "slam/config/fields.h"
@@ -116,7 +117,8 @@ WorldSpec ParseWorldSpec(const YamlNode& node) {
     fs::path map_path(spec.map->yaml_path);
     if (map_path.is_relative()) map_path = fs::path(node.file()).parent_path() / map_path;
     spec.map->yaml_path = std::filesystem::absolute(map_path).lexically_normal().string();
-    if (!fs::exists(map_path)) {
+    std::error_code error;  // e.g. a name too long for the OS: no such file either
+    if (!fs::exists(map_path, error)) {
       map_node.Required("yaml_path").Fail("no such map file '" + spec.map->yaml_path + "'");
     }
     try {

@@ -61,6 +61,14 @@ class Fields {
     return value;
   }
 
+  // A laser message's beam count: a whole number in [1, kMaxBeams] (a scan without beams is
+  // malformed: nothing downstream can use it).
+  int BeamCount(std::size_t i, int max_value) const {
+    const int n = Count(i, "num_readings", max_value);
+    if (n == 0) throw LineError{"num_readings", "a laser message needs at least one reading"};
+    return n;
+  }
+
   int Count(std::size_t i, const std::string& field, int max_value) const {
     const std::string_view t = tokens_[i];
     int value = 0;
@@ -180,7 +188,7 @@ class CarmenParser {
 
   void ParseOldLaser(const Fields& f, const std::string& type, int line_number) {
     f.ExpectAtLeast(2, " for " + type);
-    const int n = f.Count(1, "num_readings", kMaxBeams);
+    const int n = f.BeamCount(1, kMaxBeams);
     f.ExpectCount(static_cast<std::size_t>(n) + 11,
                   " for " + type + " with " + std::to_string(n) + " readings");
     CarmenScan s;
@@ -207,7 +215,7 @@ class CarmenParser {
     s->scan.angle_increment_rad = f.Number(4, "angular_resolution");
     s->scan.range_max_m = f.Number(5, "maximum_range");
     s->scan.range_min_m = 1e-3;
-    const int n = f.Count(8, "num_readings", kMaxBeams);
+    const int n = f.BeamCount(8, kMaxBeams);
     f.ExpectAtLeast(10 + static_cast<std::size_t>(n),
                     " for " + type + " with " + std::to_string(n) + " readings");
     s->scan.ranges_m = f.Ranges(9, n);

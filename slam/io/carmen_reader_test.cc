@@ -183,6 +183,11 @@ TEST(CarmenReaderTest, BadInputNamesFileLineAndField) {
   EXPECT_THAT(ErrorOf(dir.Write("u.log", "HELLO 1 2 3\nWORLD\n")), HasSubstr("no CARMEN messages"));
   EXPECT_THAT(ErrorOf(dir.Write("neg.log", "FLASER 1 -1.0 0 0 0 0 0 0 1 h 1\n")),
               HasSubstr("range[0]: negative range"));
+  // Found by fuzz/ (carmen target): a laser message without beams was accepted as a scan.
+  EXPECT_THAT(ErrorOf(dir.Write("z.log", "FLASER 0 0 0 0 0 0 0 1 h 1\n")),
+              HasSubstr("z.log:1: FLASER num_readings: a laser message needs at least one"));
+  EXPECT_THAT(ErrorOf(dir.Write("zr.log", "RAWLASER1 0 -1.57 3.14 0.01 81.9 0.01 0 0 0 1 h 1\n")),
+              HasSubstr("zr.log:1: RAWLASER1 num_readings: a laser message needs at least one"));
 }
 
 TEST(CarmenReaderTest, LenientModeCountsSkippedLines) {

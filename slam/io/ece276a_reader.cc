@@ -41,6 +41,11 @@ std::vector<std::vector<double>> ReadCsv(const std::string& path, std::size_t co
       row.push_back(v);
       start = comma + 1;
     }
+    // Column 1 is the unix time in every layout; Time holds int64 nanoseconds (+-292 years).
+    if (!(std::abs(row[0]) <= 9.2e9)) {
+      throw ParseError(path + ":" + std::to_string(reader.line_number()) + ": column 1: time " +
+                       std::to_string(row[0]) + " s is outside +-9.2e9 s");
+    }
     if (row.size() != columns) {
       throw ParseError(path + ":" + std::to_string(reader.line_number()) + ": expected " +
                        std::to_string(columns) + " columns, got " + std::to_string(row.size()));
@@ -93,6 +98,14 @@ std::vector<double> Stamps(const std::map<std::string, NpyArray>& arrays, const 
 void CheckFinite(double v, const std::string& path, const std::string& what, std::size_t index) {
   if (!std::isfinite(v)) {
     throw ParseError(path + ": " + what + " column " + std::to_string(index) + ": not finite");
+  }
+}
+
+// Time holds int64 nanoseconds: stamps past about +-292 years from 1970 cannot be represented.
+void CheckStamp(double t, const std::string& path, std::size_t index) {
+  if (!(std::abs(t) <= 9.2e9)) {
+    throw ParseError(path + ": time_stamps[" + std::to_string(index) + "]: " + std::to_string(t) +
+                     " s is outside +-9.2e9 s");
   }
 }
 
@@ -185,6 +198,7 @@ Dataset ReadEce276a(const Ece276aFiles& files, const Ece276aReadOptions& options
       }
     }
     for (std::size_t i = 0; i < t.size(); ++i) {
+      CheckStamp(t[i], files.encoders, i);
       for (int k = 0; k < 4; ++k) {
         CheckFinite(counts[i][static_cast<std::size_t>(k)], files.encoders, "counts", i);
       }
@@ -217,6 +231,7 @@ Dataset ReadEce276a(const Ece276aFiles& files, const Ece276aReadOptions& options
       }
     }
     for (std::size_t i = 0; i < t.size(); ++i) {
+      CheckStamp(t[i], files.imu, i);
       for (std::size_t k = 0; k < 6; ++k) CheckFinite(rows[i][k], files.imu, "imu", i);
       ImuSample imu;
       imu.time = Time::FromSeconds(t[i]);
@@ -249,6 +264,7 @@ Dataset ReadEce276a(const Ece276aFiles& files, const Ece276aReadOptions& options
     prototype.base_from_laser = options.base_from_lidar;
     int nan_beams = 0;
     for (std::size_t i = 0; i < t.size(); ++i) {
+      CheckStamp(t[i], path, i);
       LaserScan scan = prototype;
       scan.time = Time::FromSeconds(t[i]);
       scan.ranges_m.resize(beams);

@@ -227,6 +227,62 @@ TEST(Ece276aReaderTest, BadFilesAreParseErrorsNamingTheFileAndPlace) {
             {"time_stamps", "<f8", {1}, false, Raw(std::vector<double>{1.0})}});
   EXPECT_THROW(ReadEce276a(FindEce276aFiles(dir.File("96"))), ParseError);
   EXPECT_THROW(FindEce276aFiles(dir.File("95")), ParseError);
+  // Found by fuzz/ (ece276a_csv target): stamps past int64 nanoseconds became garbage times
+  // and broke the time order of the records.
+  dir.Write("encoders93.csv", "1.0,1,2,3,4\n12988819529.5,1,2,3,4\n");
+  try {
+    ReadEce276a(Ece276aFiles{dir.File("encoders93.csv"), "", ""});
+    FAIL();
+  } catch (const ParseError& e) {
+    EXPECT_STREQ(e.what(), (dir.File("encoders93.csv") +
+                            ":2: column 1: time 12988819529.500000 s is outside +-9.2e9 s")
+                               .c_str());
+  }
+  WriteNpz(dir.File("Encoders92.npz"),
+           {{"counts", "<i2", {4, 1}, true, Raw(std::vector<std::int16_t>{1, 2, 3, 4})},
+            {"time_stamps", "<f8", {1}, false, Raw(std::vector<double>{-1e10})}});
+  try {
+    ReadEce276a(FindEce276aFiles(dir.File("92")));
+    FAIL();
+  } catch (const ParseError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("Encoders92.npz: time_stamps[0]: "));
+  }
+  // Found by fuzz/ (npz target): a deflated entry claiming 4 GiB made the reader allocate it,
+  // and a huge npy shape overflowed the element count.
+  const std::string name = "counts.npy";
+  const std::string deflated("\x03\x00", 2);  // an empty deflate stream
+  const std::string fields = U16(8) + U16(0) + U16(0) + U32(0) + U32(2) + U32(0xFFFFFFF0u) +
+                             U16(static_cast<std::uint32_t>(name.size()));
+  const std::string local = U32(0x04034b50) + U16(20) + U16(0) + fields + U16(0) + name + deflated;
+  const std::string central = U32(0x02014b50) + U16(20) + U16(20) + U16(0) + fields + U16(0) +
+                              U16(0) + U16(0) + U16(0) + U32(0) + U32(0) + name;
+  dir.Write("Encoders91.npz", local + central + U32(0x06054b50) + U16(0) + U16(0) + U16(1) +
+                                  U16(1) + U32(static_cast<std::uint32_t>(central.size())) +
+                                  U32(static_cast<std::uint32_t>(local.size())) + U16(0));
+  try {
+    ReadNpz(dir.File("Encoders91.npz"));
+    FAIL();
+  } catch (const ParseError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("counts.npy: uncompressed size 4294967280 is "
+                                               "impossible for 2 deflated bytes"));
+  }
+  for (const char* shape : {"(2305843009213693952,)", "(99999999999999999999999,)"}) {
+    const std::string header =
+        std::string("{'descr': '<f8', 'fortran_order': False, 'shape': ") + shape + ", }\n";
+    const std::string npy = std::string("\x93NUMPY\x01\x00", 8) +
+                            U16(static_cast<std::uint32_t>(header.size())) + header + "12345678";
+    EXPECT_THROW(
+        {
+          try {
+            ParseNpy(npy, "big.npy");
+          } catch (const ParseError& e) {
+            EXPECT_THAT(e.what(), ::testing::HasSubstr("big.npy: npy shape"));
+            throw;
+          }
+        },
+        ParseError)
+        << shape;
+  }
   dir.Write("Encoders94.npz", "not a zip");
   EXPECT_THROW(ReadNpz(dir.File("Encoders94.npz")), ParseError);
 }

@@ -56,7 +56,8 @@ LogFormat DetectLogFormat(const std::string& path) {
   if (LooksLikeEce276a(path)) return LogFormat::kEce276a;
   if (LooksLikeBag(path)) return LogFormat::kRos2Bag;
   if (!Exists(path)) throw ParseError(path + ": no such file or dataset");
-  if (fs::is_directory(path)) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
     throw ParseError(path +
                      ": a folder, but neither a ROS 2 bag (no metadata.yaml, .mcap or .db3) nor an "
                      "ECE276A dataset (give the file or DIR/NUMBER)");

@@ -1,12 +1,15 @@
 #include "slam/io/map_server.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
+#include <system_error>
 
 #include "slam/config/yaml_node.h"
 #include "slam/io/atomic_file.h"
@@ -69,16 +72,28 @@ cv::Mat ReadPgm(const std::string& path) {
   const int maxval = next_int("maxval");
   if (maxval > 255)
     throw ParseError(path + ": 16-bit PGM (maxval " + std::to_string(maxval) + ") not supported");
+  // Every pixel takes at least one byte of the file (P5: one, P2: a digit): a header promising
+  // more pixels than the file has bytes is refused before the image is allocated.
+  const std::int64_t pixels = static_cast<std::int64_t>(width) * height;
+  const std::streamoff header_end = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff left = in.tellg() - header_end;
+  in.seekg(header_end);
+  if (pixels > left) {
+    throw ParseError(path + ": truncated PGM: expected " + std::to_string(pixels) +
+                     " pixels, found " + std::to_string(std::max<std::streamoff>(left - 1, 0)) +
+                     " bytes");
+  }
   cv::Mat image(height, width, CV_8UC1);
   if (magic == "P5") {
     in.get();  // the single whitespace after maxval
-    in.read(reinterpret_cast<char*>(image.data), static_cast<std::streamsize>(width) * height);
-    if (in.gcount() != static_cast<std::streamsize>(width) * height) {
-      throw ParseError(path + ": truncated PGM: expected " + std::to_string(width * height) +
+    in.read(reinterpret_cast<char*>(image.data), static_cast<std::streamsize>(pixels));
+    if (in.gcount() != static_cast<std::streamsize>(pixels)) {
+      throw ParseError(path + ": truncated PGM: expected " + std::to_string(pixels) +
                        " pixels, found " + std::to_string(in.gcount()));
     }
   } else {
-    for (int i = 0; i < width * height; ++i) {
+    for (std::int64_t i = 0; i < pixels; ++i) {
       int v = -1;
       if (!(in >> v) || v < 0 || v > maxval) {
         throw ParseError(path + ": pixel " + std::to_string(i) + " missing or out of range");
@@ -164,7 +179,8 @@ MapImage ReadMapServerMap(const std::string& yaml_path) {
   std::filesystem::path image_path(image_name);
   if (image_path.is_relative())
     image_path = std::filesystem::path(yaml_path).parent_path() / image_path;
-  if (!std::filesystem::exists(image_path)) {
+  std::error_code error;  // e.g. a name too long for the OS: does not exist either
+  if (!std::filesystem::exists(image_path, error)) {
     image_node.Fail("map image '" + image_path.string() + "' does not exist");
   }
   const std::string ext = image_path.extension().string();

@@ -98,6 +98,14 @@ TEST(MapServerTest, BadYamlAndImagesNameFileAndKey) {
               HasSubstr("missing required key 'origin'"));
   dir.Write("t.pgm", "P5\n4 4\n255\nab");
   EXPECT_THAT(error("image: t.pgm\nresolution: 0.05\n" + rest), HasSubstr("truncated PGM"));
+  // Found while fuzzing map_server maps: a 65535 x 65535 header allocated 4 GiB before the
+  // pixels were counted (and P2's pixel loop overflowed int).
+  for (const char* magic : {"P5", "P2"}) {
+    dir.Write("huge.pgm", std::string(magic) + "\n65535 65535\n255\n1 2 3");
+    EXPECT_THAT(error("image: huge.pgm\nresolution: 0.05\n" + rest),
+                HasSubstr("huge.pgm: truncated PGM: expected 4294836225 pixels, found 5 bytes"))
+        << magic;
+  }
 }
 
 }  // namespace

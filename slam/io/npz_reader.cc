@@ -6,6 +6,7 @@
 
 #include <zlib.h>
 
+#include <charconv>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -18,15 +19,25 @@ namespace slamrig::slam {
 namespace {
 
 std::uint64_t Le(const std::string& b, std::size_t at, int bytes, const std::string& where) {
-  if (at + static_cast<std::size_t>(bytes) > b.size()) throw ParseError(where + ": truncated");
+  if (at > b.size() || b.size() - at < static_cast<std::size_t>(bytes)) {
+    throw ParseError(where + ": truncated");
+  }
   std::uint64_t v = 0;
   for (int i = bytes - 1; i >= 0; --i)
     v = (v << 8) | static_cast<unsigned char>(b[at + static_cast<std::size_t>(i)]);
   return v;
 }
 
-std::string Inflate(const std::string& compressed, std::size_t size, const std::string& where) {
-  std::string out(size, '\0');
+// Deflate expands at most 1032:1 (RFC 1951 blocks of 258-byte matches): a larger declared size
+// is a corrupt header, refused before allocating it.
+constexpr std::uint64_t kMaxDeflateRatio = 1032;
+
+std::string Inflate(const std::string& compressed, std::uint64_t size, const std::string& where) {
+  if (size > (compressed.size() + 1) * kMaxDeflateRatio) {
+    throw ParseError(where + ": uncompressed size " + std::to_string(size) + " is impossible for " +
+                     std::to_string(compressed.size()) + " deflated bytes");
+  }
+  std::string out(static_cast<std::size_t>(size), '\0');
   z_stream z{};
   if (inflateInit2(&z, -MAX_WBITS) != Z_OK) throw ParseError(where + ": zlib init failed");
   z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(compressed.data()));
@@ -97,8 +108,15 @@ NpyArray ParseNpy(const std::string& bytes, const std::string& name) {
       if (c >= '0' && c <= '9') {
         digits += c;
       } else if (!digits.empty()) {
-        array.shape.push_back(std::stoull(digits));
-        count *= array.shape.back();
+        std::size_t dim = 0;
+        const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), dim);
+        // Element counts past 2^48 cannot be in a file anyway; refusing them keeps count * item
+        // below 2^64.
+        if (ec != std::errc() || (dim != 0 && count > (std::size_t{1} << 48) / dim)) {
+          throw ParseError(name + ": npy shape " + shape_text + " is too large");
+        }
+        array.shape.push_back(dim);
+        count *= dim;
         digits.clear();
       }
     }
@@ -227,13 +245,15 @@ std::map<std::string, NpyArray> ReadNpz(const std::string& path) {
     if (Le(b, lo, 4, where) != 0x04034b50) throw ParseError(where + ": corrupt local header");
     const std::size_t data_at = lo + 30 + static_cast<std::size_t>(Le(b, lo + 26, 2, where)) +
                                 static_cast<std::size_t>(Le(b, lo + 28, 2, where));
-    if (data_at + compressed > b.size()) throw ParseError(where + ": truncated");
+    if (data_at > b.size() || compressed > b.size() - data_at) {
+      throw ParseError(where + ": truncated");
+    }
     const std::string raw = b.substr(data_at, static_cast<std::size_t>(compressed));
     std::string bytes;
     if (method == 0) {
       bytes = raw;
     } else if (method == 8) {
-      bytes = Inflate(raw, static_cast<std::size_t>(size), where);
+      bytes = Inflate(raw, size, where);
     } else {
       throw ParseError(where + ": zip compression method " + std::to_string(method) +
                        " not supported");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <optional>
 
@@ -13,8 +14,12 @@
 namespace slamrig::slam {
 namespace {
 
+// Whole seconds that fit Time's int64 nanoseconds with room for the fraction (about +-292 years).
+constexpr std::int64_t kMaxStampSeconds = 9'223'372'035;
+
 // Parses a decimal seconds stamp exactly to nanoseconds ("1298445274.541885123"), so unix-time
-// stamps survive a round trip; other spellings (exponents) go through double.
+// stamps survive a round trip; other spellings (exponents) go through double. Stamps Time cannot
+// hold (|t| > kMaxStampSeconds) are rejected like malformed ones.
 std::optional<Time> ParseStamp(std::string_view text) {
   const std::size_t dot = text.find('.');
   const std::string_view whole = text.substr(0, dot);
@@ -26,13 +31,15 @@ std::optional<Time> ParseStamp(std::string_view text) {
       std::all_of(frac.begin(), frac.end(), [](char c) { return c >= '0' && c <= '9'; });
   if (ec == std::errc() && end == whole.data() + whole.size() && digits_only && frac.size() <= 9 &&
       !whole.empty()) {
+    if (seconds > kMaxStampSeconds || seconds < -kMaxStampSeconds) return std::nullopt;
     std::int64_t nanos = 0;
     for (std::size_t i = 0; i < 9; ++i) nanos = nanos * 10 + (i < frac.size() ? frac[i] - '0' : 0);
     return Time::FromNanoseconds(seconds * 1'000'000'000 + (negative ? -nanos : nanos));
   }
   double value = 0.0;
   const auto [end2, ec2] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec2 != std::errc() || end2 != text.data() + text.size() || !std::isfinite(value)) {
+  if (ec2 != std::errc() || end2 != text.data() + text.size() || !std::isfinite(value) ||
+      std::abs(value) > static_cast<double>(kMaxStampSeconds)) {
     return std::nullopt;
   }
   return Time::FromSeconds(value);
@@ -90,7 +97,9 @@ Trajectory ReadTum(const std::string& path) {
           ok = ec == std::errc() && end == token.data() + token.size() && std::isfinite(v[n]);
         }
         if (!ok) {
-          throw ParseError(where + kFields[n] + ": expected a finite number, got '" +
+          throw ParseError(where + kFields[n] +
+                           (n == 0 ? ": expected seconds within +-9.2e9, got '"
+                                   : ": expected a finite number, got '") +
                            std::string(line.substr(start, i - start)) + "'");
         }
         ++n;

@@ -61,6 +61,11 @@ TEST(TumIoTest, BadLinesNameFileLineAndField) {
   EXPECT_THAT(error("1 2 3 0 0 0 0 2\n"), HasSubstr("quaternion: norm"));
   EXPECT_THAT(error("1 2 3 0 1 0 0 0\n"), HasSubstr("leaves the plane"));
   EXPECT_THAT(error("2 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n"), HasSubstr("b.tum:2: timestamp"));
+  // Found by fuzz/ (tum target): stamps past int64 nanoseconds overflowed (undefined behaviour).
+  EXPECT_THAT(error("18327992021 0 0 0 0 0 0 1\n"),
+              HasSubstr("b.tum:1: timestamp: expected seconds within +-9.2e9, got '18327992021'"));
+  EXPECT_THAT(error("-9.3e9 0 0 0 0 0 0 1\n"), HasSubstr("b.tum:1: timestamp: expected seconds"));
+  EXPECT_THAT(error("9223372035.999999999 0 0 0 0 0 0 1\n"), ::testing::IsEmpty());
 }
 
 }  // namespace

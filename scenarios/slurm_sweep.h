@@ -1,0 +1,24 @@
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "scenarios/sweep_runner.h"
+
+namespace slamrig::scenario {
+
+/// Runs grid rows `rows` (ascending) of a sweep as one Slurm job array: `sbatch --array=<rows>`
+/// with a task per row, each running `slamrig sweep SWEEP --out DIR --row K --quiet` (which
+/// writes DIR/rows/<K>.csv atomically), then follows the job with `squeue` until no task is left.
+/// Returns, per row, its results.csv line (empty when the task left no row file, e.g. it was
+/// cancelled). Job script and task logs go to DIR/slurm/. sbatch's own environment variables
+/// (SBATCH_PARTITION, SBATCH_TIMELIMIT, ...) choose where the tasks run. Throws
+/// std::runtime_error when sbatch fails.
+std::vector<std::string> RunRowsOnSlurm(const SweepRunnerOptions& options,
+                                        const std::vector<std::size_t>& rows);
+
+/// Slurm's compact form of ascending indices: {0, 1, 2, 5, 7, 8} -> "0-2,5,7-8".
+std::string SlurmArrayIndices(const std::vector<std::size_t>& rows);
+
+}  // namespace slamrig::scenario
