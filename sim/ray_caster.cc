@@ -16,6 +16,8 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // the rounding of a computed hit distance (1e-13 m; 1e-7 m for a ray grazing a circle), so that a
 // skipped test could never have shortened the range.
 constexpr double kDepthMargin = 1e-3;
+// Bound on the error of CoarseAtan2 (1.15e-5 rad) with room for its rounding, rad.
+constexpr double kCoarseAngleError = 2e-5;
 
 Eigen::Vector2d ToEigen(const b2Vec2& v) {
   return {static_cast<double>(v.x), static_cast<double>(v.y)};
@@ -38,6 +40,24 @@ struct Transform {
 
 Transform FromB2(const b2Transform& xf) {
   return {ToEigen(xf.p), static_cast<double>(xf.q.c), static_cast<double>(xf.q.s)};
+}
+
+// atan2(y, x) within kCoarseAngleError, for the angular bounds of a shape only (they are widened
+// by it, so a bound stays conservative and no hit is lost): Abramowitz and Stegun, Handbook of
+// Mathematical Functions (1964), Eq. 4.4.49, atan(a) for 0 <= a <= 1 (stated |error| <= 1e-5; with
+// the printed coefficients 1.15e-5 at a = 0.396), extended to every octant by symmetry. A fraction
+// of the cost of std::atan2.
+double CoarseAtan2(double y, double x) {
+  const double ax = std::abs(x), ay = std::abs(y);
+  const double big = std::max(ax, ay);
+  if (big == 0.0) return 0.0;
+  const double a = std::min(ax, ay) / big;
+  const double a2 = a * a;
+  double angle =
+      a * (0.9998660 + a2 * (-0.3302995 + a2 * (0.1801410 + a2 * (-0.0851330 + a2 * 0.0208351))));
+  if (ay > ax) angle = 0.5 * std::numbers::pi - angle;
+  if (x < 0.0) angle = std::numbers::pi - angle;
+  return std::signbit(y) ? -angle : angle;
 }
 
 // Distance from `p` to the segment a + [0, 1] e.
@@ -181,10 +201,11 @@ void RayCaster::CastSegment(const Segment& s, const Candidate& candidate, std::s
   // The angles under which the segment is seen from the centre, widened by the most the view can
   // turn from another origin within the spread: asin(spread / d) <= tan(asin(spread / d)).
   const Eigen::Vector2d pa = s.a - center_, pb = pa + s.e;
-  const double phi_a = std::atan2(pa.y(), pa.x());
-  const double delta = std::atan2(Cross(pa, pb), pa.dot(pb));
+  // (Each of the two coarse angles is off by at most kCoarseAngleError, so are both ends.)
+  const double phi_a = CoarseAtan2(pa.y(), pa.x());
+  const double delta = CoarseAtan2(Cross(pa, pb), pa.dot(pb));
   const double lo = phi_a + std::min(0.0, delta);
-  const double widen = x / std::sqrt(1.0 - x * x) + 1e-9;
+  const double widen = x / std::sqrt(1.0 - x * x) + 2.0 * kCoarseAngleError;
   ForEachRayInInterval(lo - widen, lo + std::abs(delta) + widen, rays.size(), test);
 }
 
@@ -215,8 +236,9 @@ void RayCaster::CastCircle(const Circle& c, const Candidate& candidate, std::spa
   }
   // Half-angle of the disc seen from the nearest origin, plus the turn of the centre's bearing.
   const double x1 = c.radius / (d - spread_m_), x2 = spread_m_ / d;
-  const double half = x1 / std::sqrt(1.0 - x1 * x1) + x2 / std::sqrt(1.0 - x2 * x2) + 1e-9;
-  const double phi = std::atan2(pc.y(), pc.x());
+  const double half =
+      x1 / std::sqrt(1.0 - x1 * x1) + x2 / std::sqrt(1.0 - x2 * x2) + kCoarseAngleError;
+  const double phi = CoarseAtan2(pc.y(), pc.x());
   ForEachRayInInterval(phi - half, phi + half, rays.size(), test);
 }
 
