@@ -66,18 +66,20 @@ LidarModel::LidarModel(const LidarOptions& options, std::uint64_t seed)
     : options_(options), rng_(seed, "lidar") {
   SLAMRIG_CHECK(options_.Validate().empty(), "invalid LidarOptions");
   if (options_.range_resolution_m > 0.0) inverse_resolution_ = 1.0 / options_.range_resolution_m;
+  p_max_random_ = options_.p_max + options_.p_random;
+  p_any_ = options_.p_max + options_.p_random + options_.p_short;
 }
 
 double LidarModel::Measure(double true_range_m) {
   const LidarOptions& o = options_;
   const bool hit = true_range_m < o.range_max_m;
   double z = 0.0;
-  const double u = (o.p_max + o.p_random + o.p_short) > 0.0 ? rng_.Uniform() : 1.0;
+  const double u = p_any_ > 0.0 ? rng_.Uniform() : 1.0;
   if (u < o.p_max) {
     return o.range_max_m;
-  } else if (u < o.p_max + o.p_random) {
+  } else if (u < p_max_random_) {
     z = o.range_min_m + rng_.Uniform() * (o.range_max_m - o.range_min_m);
-  } else if (u < o.p_max + o.p_random + o.p_short && hit) {
+  } else if (u < p_any_ && hit) {
     // Exponential truncated to [0, true range), by inversion.
     const double lambda = o.short_decay_per_m;
     z = -std::log1p(-rng_.Uniform() * -std::expm1(-lambda * true_range_m)) / lambda;

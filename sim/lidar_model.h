@@ -60,6 +60,8 @@ class LidarModel {
 
   LidarOptions options_;
   double inverse_resolution_ = 0.0;
+  double p_max_random_ = 0.0;  // p_max + p_random, the bound of the random readings
+  double p_any_ = 0.0;         // p_max + p_random + p_short, the bound of every unexpected reading
   RandomStream rng_;
 };
 

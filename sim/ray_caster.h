@@ -23,7 +23,11 @@ struct Ray {
 /// and circle is rasterised over the beam angles it can cover, seen from the fan's origins, into a
 /// per-ray depth buffer; every ray it covers gets an exact ray-segment or ray-circle intersection.
 /// So each ray only meets the few edges near its direction, and rays may each start elsewhere (a
-/// spinning lidar on a moving robot).
+/// spinning lidar on a moving robot). The shapes are rasterised nearest first, and a ray whose
+/// range is already shorter than the least distance at which a shape could be hit from any of
+/// the origins skips the intersection with it (a depth test, as in a z-buffer renderer drawing
+/// front to back): a range is the minimum over the shapes it hits, so neither the order nor the
+/// skipped tests change a single bit of the result.
 class RayCaster {
  public:
   /// Caches the shapes of every fixture of `world` except sensors and the fixtures of `ignore`
@@ -56,11 +60,22 @@ class RayCaster {
     std::vector<Segment> segments;  // world frame if static, else body frame
     std::vector<Circle> circles;
   };
+  // A shape in range of the fan, in the world frame, with the distance from the fan's centre.
+  struct Candidate {
+    double near_m = 0.0;  // no ray of the fan can hit the shape closer than this
+    double distance_m = 0.0;
+    std::size_t index = 0;  // into segments_ or circles_
+    bool circle = false;
+  };
   class Query;
 
-  void CastSegment(const Segment& s, double max_range_m, std::span<const Ray> rays,
+  // Adds the segment (world frame) unless no ray of the fan can hit it.
+  void AddSegment(const Segment& s, double max_range_m);
+  // Adds the circle (world frame) unless no ray of the fan can hit it.
+  void AddCircle(const Circle& c, double max_range_m);
+  void CastSegment(const Segment& s, const Candidate& candidate, std::span<const Ray> rays,
                    std::span<double> ranges_m);
-  void CastCircle(const Circle& c, double max_range_m, std::span<const Ray> rays,
+  void CastCircle(const Circle& c, const Candidate& candidate, std::span<const Ray> rays,
                   std::span<double> ranges_m);
   // Calls visit(first, last) for the runs of rays whose angle lies in [lo, hi] modulo 2 pi.
   void ForEachRayInInterval(double lo, double hi, std::size_t num_rays, auto&& visit) const;
@@ -71,6 +86,9 @@ class RayCaster {
   // Per-Cast scratch.
   std::vector<double> relative_angles_;
   std::vector<const FixtureShapes*> gathered_;
+  std::vector<Segment> segments_;      // in range, world frame
+  std::vector<Circle> circles_;        // in range, world frame
+  std::vector<Candidate> candidates_;  // nearest first
   double first_angle_rad_ = 0.0;
   Eigen::Vector2d center_ = Eigen::Vector2d::Zero();
   double spread_m_ = 0.0;

@@ -168,8 +168,15 @@ void Robot::ApplyWheelForces(double dt_s, int iterations) {
     const double relax =
         1.0 + dt_s * std::abs(wheel.radius_m * wheel.spin_rad_s) / w.relaxation_length_m;
     const double d = k * dt_s / relax + w.contact_damping_s_m * wheel.load_n;
-    contacts_[i] = {1.0 / (dt_s * d), k * deflection_m_[i].x() / relax / d,
-                    k * deflection_m_[i].y() / relax / d, relax};
+    Contact& contact = contacts_[i];
+    contact = {1.0 / (dt_s * d), k * deflection_m_[i].x() / relax / d,
+               k * deflection_m_[i].y() / relax / d, relax};
+    // The 2x2 effective mass K + gamma I stays the same over the iterations.
+    const double x = wheel.position_m.x(), y = wheel.position_m.y(), r = wheel.radius_m;
+    contact.k11 = r * r / spin_inertia + inv_m + y * y * inv_i + contact.gamma;
+    contact.k12 = -x * y * inv_i;
+    contact.k22 = inv_m + x * x * inv_i + contact.gamma;
+    contact.det = contact.k11 * contact.k22 - contact.k12 * contact.k12;
     impulse_[i].setZero();
   }
   for (int iteration = 0; iteration < iterations; ++iteration) {
@@ -180,12 +187,9 @@ void Robot::ApplyWheelForces(double dt_s, int iterations) {
       const double slip_x = r * wheel.spin_rad_s - (vx - omega * y);
       const double slip_y = -(vy + omega * x);
       // Solve (K + gamma I) dP = s - gamma P + bias for the 2x2 effective mass K.
-      const double k11 = r * r / spin_inertia + inv_m + y * y * inv_i + contact.gamma;
-      const double k12 = -x * y * inv_i;
-      const double k22 = inv_m + x * x * inv_i + contact.gamma;
+      const double k11 = contact.k11, k12 = contact.k12, k22 = contact.k22, det = contact.det;
       const double rhs1 = slip_x - contact.gamma * impulse_[i].x() + contact.bias_x;
       const double rhs2 = slip_y - contact.gamma * impulse_[i].y() + contact.bias_y;
-      const double det = k11 * k22 - k12 * k12;
       Eigen::Vector2d total =
           impulse_[i] + Eigen::Vector2d(k22 * rhs1 - k12 * rhs2, k11 * rhs2 - k12 * rhs1) / det;
       const double limit = wheel.mu * wheel.load_n * dt_s;

@@ -94,10 +94,12 @@ class Robot {
   std::vector<Eigen::Vector2d> deflection_m_;  // tread deflection per wheel, base_link axes
   std::vector<Eigen::Vector2d> impulse_;       // tyre impulse per wheel in the last step
   struct Contact {
-    double gamma = 0.0;   // soft-constraint compliance
-    double bias_x = 0.0;  // stored-deflection bias, longitudinal
-    double bias_y = 0.0;  // and lateral
-    double relax = 1.0;   // deflection relaxation factor 1 + dt |v_roll| / L
+    double gamma = 0.0;                      // soft-constraint compliance
+    double bias_x = 0.0;                     // stored-deflection bias, longitudinal
+    double bias_y = 0.0;                     // and lateral
+    double relax = 1.0;                      // deflection relaxation factor 1 + dt |v_roll| / L
+    double k11 = 0.0, k12 = 0.0, k22 = 0.0;  // effective mass K + gamma I of the step
+    double det = 1.0;                        // its determinant
   };
   std::vector<Contact> contacts_;  // per wheel, for the step under way
   VelocityCommand command_;

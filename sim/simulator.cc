@@ -232,9 +232,11 @@ void Simulator::MeasureLidar() {
     double c = 1.0, s = 0.0, dc = 1.0, ds = 0.0;                // cos/sin of yaw and beam angle
     double yaw_c = 1.0, yaw_s = 0.0, dir_c = 1.0, dir_s = 0.0;  // per-beam rotations
     const double base = static_cast<double>(j0) + f0;
+    const std::size_t last_step = history_.size() - 2;
+    const double mount_x = o.mount.x_m, mount_y = o.mount.y_m;
     for (std::size_t i = 0; i < rays_.size(); ++i) {
       const double u = base + static_cast<double>(i) * steps_per_beam;
-      std::size_t j = std::min(static_cast<std::size_t>(u), history_.size() - 2);
+      std::size_t j = std::min(static_cast<std::size_t>(u), last_step);
       double f = u - static_cast<double>(j);
       if (f == 0.0 && j > 0 && history_[j + 1].jump_before) {
         // Exactly at a teleport: still the old pose, the end of the step before.
@@ -273,8 +275,8 @@ void Simulator::MeasureLidar() {
         dc = dc_next;
       }
       Ray& ray = rays_[i];
-      ray.origin = Eigen::Vector2d(x0 + f * dx + c * o.mount.x_m - s * o.mount.y_m,
-                                   y0 + f * dy + s * o.mount.x_m + c * o.mount.y_m);
+      ray.origin = Eigen::Vector2d(x0 + f * dx + c * mount_x - s * mount_y,
+                                   y0 + f * dy + s * mount_x + c * mount_y);
       ray.angle_rad = yaw0 + f * dyaw + angle0 + static_cast<double>(i) * increment;
       ray.direction = Eigen::Vector2d(dc, ds);
     }
