@@ -78,6 +78,21 @@ TEST_P(BagReplayTest, ReplayedBagGivesBitIdenticalSlamOutput) {
       "name: replay_log\nsource: {log: " + summary.files[0] + topics + "}\n" + std::string(kSlam)));
   ASSERT_TRUE(replay.log);
 
+  // base_from_laser goes through /tf_static and comes back exactly.
+  const Pose2 mount = in_process.simulated->options.robot.lidar.mount.ToPose2();
+  slam::BagReaderOptions read;
+  read.topics = replay.log->read.topics;
+  int scans = 0;
+  for (const Record& r : slam::ReadBag(summary.files[0], read).records) {
+    if (const auto* scan = std::get_if<LaserScan>(&r)) {
+      ++scans;
+      ASSERT_TRUE(SameBits(scan->base_from_laser.x(), mount.x()) &&
+                  SameBits(scan->base_from_laser.y(), mount.y()) &&
+                  SameBits(scan->base_from_laser.theta(), mount.theta()));
+    }
+  }
+  EXPECT_EQ(scans, summary.num_scans);
+
   const ScenarioResult a = RunScenario(in_process);
   const ScenarioResult b = RunScenario(replay);
   ASSERT_GT(a.scans, 1000);
