@@ -11,6 +11,7 @@
 
 #include "apps/cli_args.h"
 #include "apps/commands.h"
+#include "apps/topic_flags.h"
 #include "slam/config/yaml_node.h"
 #include "slam/eval/json_writer.h"
 #include "slam/eval/map_score.h"
@@ -147,7 +148,7 @@ slam::EstimatorConfig ConfigFromFlags(
 int RunSlamCommand(const std::vector<std::string>& args) {
   std::string log_path, out_dir, algorithm = "pf", preset, odometry = "auto";
   std::string truth_map_path, particles, threads, resolution;
-  std::vector<std::string> sets;
+  std::vector<std::string> sets, topic_flags;
   int clouds = 0, max_scans = 0;
   std::uint64_t seed = 1;
   bool no_gyro = false, lenient = false, quiet = false;
@@ -186,6 +187,10 @@ int RunSlamCommand(const std::vector<std::string>& args) {
                    "(aligned by the ATE alignment; needs a log with a reference)",
                    &truth_map_path);
   parser.AddFlag("lenient", "skip and count malformed CARMEN lines instead of failing", &lenient);
+  parser.AddRepeated("topic", "KEY=NAME",
+                     "a ROS 2 bag's topic to read, e.g. scan=/front/scan (keys: " +
+                         std::string(slam::BagTopicNames::Keys()) + ")",
+                     &topic_flags);
   parser.AddFlag("quiet", "no progress output", &quiet);
   if (!parser.Parse(args)) return 0;
   if (out_dir.empty()) throw ConfigError("slamrig slam: --out DIR is required");
@@ -205,6 +210,7 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   // Read and run everything before creating any output, so bad input leaves nothing behind.
   slam::LogReadOptions read;
   read.lenient = lenient;
+  read.topics = ParseTopicFlags("slamrig slam", topic_flags);
   const std::string path = slam::ResolveLogPath(log_path);
   const slam::Dataset data = slam::ReadLog(path, read);
   slam::EstimatorConfig config = base;

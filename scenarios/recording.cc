@@ -4,13 +4,16 @@
 
 #include <cmath>
 #include <filesystem>
+#include <memory>
 
 #include "sim/robot_yaml.h"
 #include "sim/world_yaml.h"
 #include "slam/io/atomic_file.h"
+#include "slam/io/bag/bag_sink.h"
 #include "slam/io/carmen_sink.h"
 #include "slam/io/tum_io.h"
 #include "slam/types/check.h"
+#include "slam/types/error.h"
 #include "slam/types/trajectory.h"
 #include "slam/types/validation.h"
 
@@ -46,28 +49,57 @@ std::vector<std::string> RunOptions::Validate() const {
   return errors;
 }
 
+std::vector<std::string> RecordingOptions::Validate() const {
+  if (format == RecordingFormat::kCarmen) return {};
+  return topics.Validate();
+}
+
 RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptions& run,
-                            const std::string& out_dir) {
+                            const std::string& out_dir, const RecordingOptions& recording) {
   SLAMRIG_CHECK(run.Validate().empty(), "invalid RunOptions");
-  std::filesystem::create_directories(out_dir);
-  const std::string dir = std::filesystem::path(out_dir).string() + "/";
+  if (const auto errors = recording.Validate(); !errors.empty()) {
+    throw ConfigError("recording: " + errors.front());
+  }
+  namespace fs = std::filesystem;
+  fs::create_directories(out_dir);
+  const std::string dir = fs::path(out_dir).string() + "/";
   RunSummary summary;
 
   sim::Simulator sim(options);
   const sim::RobotSpec& robot = options.robot;
-  slam::CarmenSinkOptions carmen;
-  carmen.odometry.robot = sim::NominalOdometry(robot);
-  carmen.odometry.use_gyro = robot.imu.enabled;
-  carmen.params = {
-      {"robot_front_laser_max", FormatNumber(robot.lidar.range_max_m)},
-      {"robot_frontlaser_offset", FormatNumber(robot.lidar.mount.x_m)},
-      // ROBOTLASER1 has no field for these; slamrig's reader applies them to every laser line.
-      {"laser_time_increment_s", FormatNumber(robot.lidar.time_increment_s())},
-      {"laser_range_min_m", FormatNumber(robot.lidar.range_min_m)},
-      {"slamrig_world", options.world.name.empty() ? "unnamed" : options.world.name},
-      {"slamrig_robot", robot.name.empty() ? "unnamed" : robot.name},
-      {"slamrig_seed", std::to_string(options.seed)}};
-  slam::CarmenSink log(dir + "run.log", carmen);
+  slam::WheelOdometryOptions odometry;
+  odometry.robot = sim::NominalOdometry(robot);
+  odometry.use_gyro = robot.imu.enabled;
+  // One sink, by format; the concrete one is kept for its counters.
+  std::unique_ptr<slam::CarmenSink> carmen_sink;
+  std::unique_ptr<slam::BagSink> bag_sink;
+  const std::string run_name = recording.format == RecordingFormat::kCarmen ? "run.log" : "run";
+  if (recording.format == RecordingFormat::kCarmen) {
+    slam::CarmenSinkOptions carmen;
+    carmen.odometry = odometry;
+    carmen.params = {
+        {"robot_front_laser_max", FormatNumber(robot.lidar.range_max_m)},
+        {"robot_frontlaser_offset", FormatNumber(robot.lidar.mount.x_m)},
+        // ROBOTLASER1 has no field for these; slamrig's reader applies them to every laser line.
+        {"laser_time_increment_s", FormatNumber(robot.lidar.time_increment_s())},
+        {"laser_range_min_m", FormatNumber(robot.lidar.range_min_m)},
+        {"slamrig_world", options.world.name.empty() ? "unnamed" : options.world.name},
+        {"slamrig_robot", robot.name.empty() ? "unnamed" : robot.name},
+        {"slamrig_seed", std::to_string(options.seed)}};
+    carmen_sink = std::make_unique<slam::CarmenSink>(dir + run_name, carmen);
+  } else {
+    slam::BagSinkOptions bag;
+    bag.writer.storage = recording.format == RecordingFormat::kMcap ? slam::BagStorage::kMcap
+                                                                    : slam::BagStorage::kSqlite3;
+    bag.writer.compression = recording.compression;
+    bag.writer.topics = recording.topics;
+    bag.writer.ticks_per_revolution = robot.encoders.ticks_per_revolution;
+    bag.odometry = odometry;
+    // A bag from an earlier run is replaced; anything else in the way is an error (BagWriter).
+    if (fs::exists(fs::path(dir + run_name) / "metadata.yaml")) fs::remove_all(dir + run_name);
+    bag_sink = std::make_unique<slam::BagSink>(dir + run_name, bag);
+  }
+  slam::RecordSink& log = carmen_sink ? static_cast<slam::RecordSink&>(*carmen_sink) : *bag_sink;
 
   Trajectory truth_at_scans;
   auto consume = [&](const sim::StepResult& step) {
@@ -95,18 +127,20 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
   consume(sim.Flush());
   log.Commit();
 
-  summary.num_scans = log.scans();
-  summary.num_odometry = log.odometry_lines();
-  summary.num_imu = log.imu_samples();
+  summary.num_scans = carmen_sink ? carmen_sink->scans() : bag_sink->scans();
+  summary.num_odometry =
+      carmen_sink ? carmen_sink->odometry_lines() : bag_sink->odometry_messages();
+  summary.num_imu = carmen_sink ? carmen_sink->imu_samples() : bag_sink->imu_samples();
   summary.duration_s = sim.time().seconds();
   summary.drive_finished = sim.drive_finished();
   summary.final_truth = sim.Truth().map_from_base;
-  summary.final_odometry = log.odometry_pose();
+  summary.final_odometry = carmen_sink ? carmen_sink->odometry_pose() : bag_sink->odometry_pose();
   slam::WriteTum(dir + "truth.tum", truth_at_scans);
   slam::WriteFileAtomically(dir + "world.yaml", sim::WorldSpecToYaml(options.world));
   slam::WriteFileAtomically(dir + "robot.yaml", sim::RobotSpecToYaml(options.robot));
   slam::WriteFileAtomically(dir + "sim.yaml", SimSettingsYaml(options, summary));
-  for (const char* name : {"run.log", "truth.tum", "world.yaml", "robot.yaml", "sim.yaml"}) {
+  for (const std::string& name : {run_name, std::string("truth.tum"), std::string("world.yaml"),
+                                  std::string("robot.yaml"), std::string("sim.yaml")}) {
     summary.files.push_back(dir + name);
   }
   return summary;

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "sim/simulator.h"
+#include "slam/io/bag/bag_writer.h"
 #include "slam/types/pose2.h"
 
 namespace slamrig::scenario {
@@ -19,12 +20,31 @@ struct RunOptions {
   std::vector<std::string> Validate() const;
 };
 
+/// The file format a recorded run is written in.
+enum class RecordingFormat {
+  kCarmen,   ///< run.log, a CARMEN log (slam::CarmenSink)
+  kMcap,     ///< run/, a ROS 2 bag with MCAP storage (slam::BagSink)
+  kSqlite3,  ///< run/, a ROS 2 bag with sqlite3 storage (slam::BagSink)
+};
+
+/// How a recorded run is written.
+struct RecordingOptions {
+  RecordingFormat format = RecordingFormat::kCarmen;
+  /// Bags only: MCAP chunk compression (sqlite3 bags are never compressed).
+  slam::McapCompression compression = slam::McapCompression::kZstd;
+  /// Bags only: topic names (the ROS defaults).
+  slam::BagTopicNames topics;
+
+  /// One RuleViolation() message per broken rule; empty when valid.
+  std::vector<std::string> Validate() const;
+};
+
 /// What a written run contains.
 struct RunSummary {
   double duration_s = 0.0;      ///< simulated seconds
   bool drive_finished = false;  ///< the world's driver completed its path or schedule
-  int num_scans = 0;            ///< ROBOTLASER1 lines
-  int num_odometry = 0;         ///< ODOM lines
+  int num_scans = 0;            ///< scans written (ROBOTLASER1 lines, /scan messages)
+  int num_odometry = 0;         ///< odometry poses written (ODOM lines, /odom messages)
   int num_imu = 0;              ///< IMU samples fed to the odometry
   Pose2 final_truth;            ///< map_from_base at the end
   Pose2 final_odometry;  ///< odom_from_base at the end (the robot's own encoder + gyro estimate)
@@ -34,15 +54,18 @@ struct RunSummary {
 
 /// Runs a simulation and records it into `out_dir` (created if missing), every file atomically.
 /// The simulator only emits records and the truth; what is written is the sinks' business:
-///  - run.log: a CARMEN log through slam::CarmenSink (PARAM, ODOM, ROBOTLASER1, TRUEPOS). ODOM
-///    is the robot's own odometry, computed there from the encoder ticks and gyro with the
-///    nominal radius and track; each scan carries the odometry pose interpolated to its time,
-///    and a TRUEPOS line follows it with the ground truth.
-///  - truth.tum: ground truth at every scan time (TUM format).
-///  - world.yaml, robot.yaml: the resolved world and robot; sim.yaml: seed, rates, duration.
-/// Equal options give byte-identical files. Throws std::runtime_error when a file cannot be
-/// written.
+///  - with RecordingFormat::kCarmen, run.log: a CARMEN log through slam::CarmenSink (PARAM,
+///    ODOM, ROBOTLASER1, TRUEPOS). ODOM is the robot's own odometry, computed there from the
+///    encoder ticks and gyro with the nominal radius and track; each scan carries the odometry
+///    pose interpolated to its time, and a TRUEPOS line follows it with the ground truth;
+///  - with kMcap or kSqlite3, run/: a ROS 2 bag through slam::BagSink (the records, the same
+///    robot odometry on /odom and /tf, the truth at every scan on /ground_truth/odom); a bag
+///    folder left by an earlier run is replaced;
+///  - in every format, truth.tum: ground truth at every scan time (TUM format); world.yaml,
+///    robot.yaml: the resolved world and robot; sim.yaml: seed, rates, duration.
+/// Equal options give byte-identical files. Throws ConfigError for invalid `recording`
+/// options, std::runtime_error when a file cannot be written.
 RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptions& run,
-                            const std::string& out_dir);
+                            const std::string& out_dir, const RecordingOptions& recording = {});
 
 }  // namespace slamrig::scenario

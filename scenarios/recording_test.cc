@@ -8,8 +8,10 @@
 
 #include "sim/presets.h"
 #include "sim/world_yaml.h"
+#include "slam/io/bag/bag_reader.h"
 #include "slam/io/carmen_reader.h"
 #include "slam/io/tum_io.h"
+#include "slam/odometry/wheel_odometry.h"
 
 namespace slamrig::scenario {
 namespace {
@@ -57,7 +59,9 @@ TEST(RunWriterTest, OurCarmenReaderReadsTheLogBack) {
   ASSERT_FALSE(log.scans.empty());
   const LaserScan& scan = log.scans.front().scan;
   EXPECT_EQ(scan.ranges_m.size(), 1081u);
-  EXPECT_NEAR(scan.angle_increment_rad, 0.25 * 3.141592653589793 / 180.0, 1e-15);
+  // The simulator states scan metadata as the floats a ROS LaserScan carries.
+  EXPECT_NEAR(scan.angle_increment_rad,
+              static_cast<double>(static_cast<float>(0.25 * 3.141592653589793 / 180.0)), 1e-15);
   EXPECT_NEAR(scan.base_from_laser.x(), 0.133, 1e-12);
   // The truth file holds the same poses as the TRUEPOS lines.
   const Trajectory truth = slam::ReadTum(summary.files[1]);
@@ -69,6 +73,72 @@ TEST(RunWriterTest, OurCarmenReaderReadsTheLogBack) {
   // The odometry starts at the identity and follows the robot forwards along the corridor.
   EXPECT_GT(log.odometry.back().odometry.odom_from_base.x(), 0.5);
   EXPECT_LT(std::abs(log.odometry.back().odometry.odom_from_base.y()), 0.05);
+}
+
+}  // namespace
+}  // namespace slamrig::scenario
+
+namespace slamrig::scenario {
+namespace {
+
+RunSummary WriteBagRun(std::uint64_t seed, const std::string& name, RecordingFormat format) {
+  RunOptions run;
+  run.duration_s = 3.0;
+  RecordingOptions recording;
+  recording.format = format;
+  return RecordSimulation(Office(seed), run, testing::TempDir() + "/" + name, recording);
+}
+
+TEST(RunWriterTest, BagsHoldTheSameRunAsTheCarmenLog) {
+  const RunSummary carmen = WriteRun(5, "run_fmt_carmen");
+  for (const RecordingFormat format : {RecordingFormat::kMcap, RecordingFormat::kSqlite3}) {
+    const std::string name = format == RecordingFormat::kMcap ? "run_fmt_mcap" : "run_fmt_db3";
+    const RunSummary bag = WriteBagRun(5, name, format);
+    ASSERT_EQ(bag.files.size(), 5u);
+    EXPECT_EQ(std::filesystem::path(bag.files[0]).filename(), "run");
+    // truth.tum and the yaml files do not depend on the format.
+    for (std::size_t i = 1; i < bag.files.size(); ++i) {
+      EXPECT_EQ(Slurp(bag.files[i]), Slurp(carmen.files[i])) << bag.files[i];
+    }
+    EXPECT_EQ(bag.num_scans, carmen.num_scans);
+    EXPECT_EQ(bag.num_odometry, carmen.num_odometry);
+    EXPECT_EQ(bag.num_imu, carmen.num_imu);
+    // One odometry computation for both sinks: the same robot estimate, bit for bit.
+    EXPECT_EQ(bag.final_odometry, carmen.final_odometry);
+
+    const slam::Dataset data = slam::ReadBag(bag.files[0]);
+    int scans = 0, ticks = 0, poses = 0;
+    slam::WheelOdometryOptions odometry_options;
+    odometry_options.robot = sim::NominalOdometry(Office(5).robot);
+    odometry_options.use_gyro = true;
+    slam::WheelOdometry odometry(odometry_options);
+    for (const Record& r : data.records) {
+      scans += std::holds_alternative<LaserScan>(r) ? 1 : 0;
+      if (const auto* imu = std::get_if<ImuSample>(&r)) odometry.AddImu(*imu);
+      if (const auto* t = std::get_if<WheelTicks>(&r)) {
+        odometry.AddTicks(*t);
+        ++ticks;
+      }
+      if (const auto* p = std::get_if<OdometryPose>(&r)) {
+        // /odom is the integration of the ticks before it (up to the quaternion's yaw).
+        EXPECT_NEAR(p->odom_from_base.x(), odometry.pose().x(), 1e-12);
+        EXPECT_NEAR(p->odom_from_base.y(), odometry.pose().y(), 1e-12);
+        EXPECT_NEAR(p->odom_from_base.theta(), odometry.pose().theta(), 1e-12);
+        ++poses;
+      }
+    }
+    EXPECT_EQ(scans, bag.num_scans);
+    EXPECT_EQ(ticks, bag.num_odometry);
+    EXPECT_EQ(poses, bag.num_odometry);
+    // The truth at every scan, as truth.tum has it.
+    const Trajectory truth = slam::ReadTum(bag.files[1]);
+    ASSERT_EQ(data.reference.size(), truth.size());
+    EXPECT_EQ(data.reference.back().time, truth.poses().back().time);
+  }
+  // The same seed again: the same bag bytes.
+  const RunSummary again = WriteBagRun(5, "run_fmt_mcap_again", RecordingFormat::kMcap);
+  const std::string mcap = "/run_0.mcap";
+  EXPECT_EQ(Slurp(again.files[0] + mcap), Slurp(testing::TempDir() + "/run_fmt_mcap/run" + mcap));
 }
 
 }  // namespace

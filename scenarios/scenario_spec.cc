@@ -263,7 +263,15 @@ std::string ResolvedYaml(const ScenarioSpec& spec, const std::vector<std::string
   } else {
     out << YAML::Key << "source" << YAML::Value << YAML::BeginMap << YAML::Key << "log"
         << YAML::Value << fs::absolute(spec.log->path).lexically_normal().string() << YAML::Key
-        << "lenient" << YAML::Value << spec.log->read.lenient << YAML::EndMap;
+        << "lenient" << YAML::Value << spec.log->read.lenient;
+    // Bag topic names, every one (the defaults too), so that the resolved file is complete.
+    slam::BagTopicNames topics = spec.log->read.topics;
+    out << YAML::Key << "topics" << YAML::Value << YAML::BeginMap;
+    for (const char* key :
+         {"scan", "imu", "joint_states", "odom", "ground_truth", "tf", "tf_static", "clock"}) {
+      out << YAML::Key << key << YAML::Value << *topics.Find(key);
+    }
+    out << YAML::EndMap << YAML::EndMap;
   }
   out << YAML::Key << "slam" << YAML::Value << YAML::BeginMap;
   for (const slam::EstimatorConfig& c : spec.configs) {
@@ -341,6 +349,18 @@ ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string
     LogSource log;
     log.path = ResolveLog(source->Required("log"), path);
     source->Read("lenient", &log.read.lenient);
+    if (const auto topics = source->Optional("topics")) {
+      if (!topics->IsMap()) topics->Fail("topics is a map (scan: /front/scan, ...)");
+      for (const std::string& key : topics->Keys()) {
+        std::string* name = log.read.topics.Find(key);
+        if (name == nullptr) {
+          topics->Required(key).Fail("unknown topic key '" + key + "' (expected one of " +
+                                     slam::BagTopicNames::Keys() + ")");
+        }
+        *name = topics->Get<std::string>(key);
+      }
+      topics->ThrowIfInvalid(log.read.topics.Validate());
+    }
     if (const auto robot_node = root.Optional("robot")) {
       YamlNode robot = WorldOrRobot(*robot_node, path, "robots");
       for (const auto& [k, v] : robot_set) robot.Override(k, v, "--set robot." + k + "=" + v);

@@ -72,7 +72,8 @@ struct LogSource {
 ///
 /// or, instead of world/robot/faults, a log: `source: {log:
 /// carmen_corrected/intel-corrected.log.gz}` (relative to this file or to SLAMRIG_DATA_DIR;
-/// `lenient: true` counts malformed lines).
+/// `lenient: true` counts malformed lines; a ROS 2 bag's topics other than the defaults as
+/// `topics: {scan: /front/scan, odom: /wheel_odom}`, keys as in slam::BagTopicNames).
 struct ScenarioSpec {
   std::string path;
   std::string name;

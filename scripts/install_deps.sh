@@ -8,7 +8,7 @@ packages=(
   libbox2d-dev libeigen3-dev libopencv-dev libmujoco-dev libyaml-cpp-dev libceres-dev
   libgtest-dev libgmock-dev libbenchmark-dev libsqlite3-dev zlib1g-dev libnanoflann-dev
   libzstd-dev liblz4-dev
-  clang libclang-rt-14-dev
+  clang libclang-rt-14-dev nodejs npm
   libegl-dev libegl-mesa0 libgl1-mesa-dri
   slurm-wlm munge
 )

@@ -103,13 +103,15 @@ LaserScan LidarModel::MakeScan(Time time, std::span<const double> true_ranges_m)
                 "one true range per beam");
   LaserScan scan;
   scan.time = time;
-  scan.angle_min_rad = options_.angle_min_rad();
-  scan.angle_increment_rad = options_.angle_increment_rad();
-  scan.time_increment_s = options_.time_increment_s();
-  scan.range_min_m = options_.range_min_m;
-  // Ranges are floats: state the limit as the float it is stored as, so that a no-return reading
-  // (exactly range_max_m) compares as "at or beyond" the limit.
-  scan.range_max_m = static_cast<double>(static_cast<float>(options_.range_max_m));
+  // The metadata are stated as the floats sensor_msgs/LaserScan carries (and ranges are floats,
+  // so a no-return reading, exactly range_max_m, compares as "at or beyond" the limit): a scan
+  // recorded to a ROS 2 bag reads back bit for bit.
+  auto as_float = [](double v) { return static_cast<double>(static_cast<float>(v)); };
+  scan.angle_min_rad = as_float(options_.angle_min_rad());
+  scan.angle_increment_rad = as_float(options_.angle_increment_rad());
+  scan.time_increment_s = as_float(options_.time_increment_s());
+  scan.range_min_m = as_float(options_.range_min_m);
+  scan.range_max_m = as_float(options_.range_max_m);
   scan.base_from_laser = options_.mount.ToPose2();
   scan.ranges_m.resize(true_ranges_m.size());
   for (std::size_t i = 0; i < true_ranges_m.size(); ++i) {

@@ -12,12 +12,7 @@ CarmenSink::CarmenSink(const std::string& path, const CarmenSinkOptions& options
 }
 
 void CarmenSink::Add(const Record& record, const GroundTruthPose* truth) {
-  if (const auto* imu = std::get_if<ImuSample>(&record)) {
-    odometry_.AddImu(*imu);
-    ++imu_samples_;
-  } else if (const auto* ticks = std::get_if<WheelTicks>(&record)) {
-    WriteOdometry(odometry_.AddTicks(*ticks));
-  } else if (const auto* pose = std::get_if<OdometryPose>(&record)) {
+  if (const std::optional<OdometryPose> pose = odometry_.Add(record)) {
     WriteOdometry(*pose);
   } else if (const auto* scan = std::get_if<LaserScan>(&record)) {
     held_.emplace_back(*scan, truth ? std::optional<GroundTruthPose>(*truth) : std::nullopt);

@@ -7,7 +7,7 @@
 
 #include "slam/io/carmen_writer.h"
 #include "slam/io/record_sink.h"
-#include "slam/odometry/wheel_odometry.h"
+#include "slam/odometry/robot_odometry.h"
 
 namespace slamrig::slam {
 
@@ -35,7 +35,7 @@ class CarmenSink final : public RecordSink {
 
   int scans() const { return scans_; }
   int odometry_lines() const { return odometry_lines_; }
-  int imu_samples() const { return imu_samples_; }
+  int imu_samples() const { return odometry_.imu_samples(); }
   /// The robot's odometry pose after the last WheelTicks record.
   const Pose2& odometry_pose() const { return odometry_.pose(); }
 
@@ -44,12 +44,11 @@ class CarmenSink final : public RecordSink {
   void WriteHeldScans(const std::optional<OdometryPose>& next);
 
   CarmenWriter writer_;
-  WheelOdometry odometry_;
+  RobotOdometry odometry_;
   std::optional<OdometryPose> last_odometry_;
   std::vector<std::pair<LaserScan, std::optional<GroundTruthPose>>> held_;
   int scans_ = 0;
   int odometry_lines_ = 0;
-  int imu_samples_ = 0;
 };
 
 }  // namespace slamrig::slam

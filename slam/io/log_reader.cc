@@ -80,9 +80,12 @@ Dataset ReadLog(const std::string& path, const LogReadOptions& options) {
     case LogFormat::kEce276a:
       data = ReadEce276a(FindEce276aFiles(resolved));
       break;
-    case LogFormat::kRos2Bag:
-      data = ReadBag(resolved);  // wheel ticks with the ticks per revolution the bag records
+    case LogFormat::kRos2Bag: {
+      BagReaderOptions bag;  // wheel ticks with the ticks per revolution the bag records
+      bag.topics = options.topics;
+      data = ReadBag(resolved, bag);
       break;
+    }
     case LogFormat::kCarmen: {
       CarmenReadOptions carmen;
       carmen.lenient = options.lenient;

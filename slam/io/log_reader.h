@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "slam/io/bag/bag_writer.h"
 #include "slam/io/dataset.h"
 
 namespace slamrig::slam {
@@ -19,6 +20,8 @@ const char* LogFormatName(LogFormat format);
 /// How logs are read.
 struct LogReadOptions {
   bool lenient = false;  ///< CARMEN: count malformed lines instead of failing
+  /// ROS 2 bags: the topics to read (the ROS defaults BagWriter writes).
+  BagTopicNames topics;
 };
 
 /// The datasets folder: $SLAMRIG_DATA_DIR, else ../shared/datasets of the current folder when it

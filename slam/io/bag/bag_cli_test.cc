@@ -112,6 +112,36 @@ TEST(BagCliTest, SlamReadsABagAndRejectsADamagedOne) {
       << r.output;
 }
 
+// Topic names other than the defaults: `simulate --topic` writes them, `slam --topic` reads them,
+// and without the flag the renamed scans are skipped and said to be.
+TEST(BagCliTest, RenamedTopicsAreWrittenAndRead) {
+  slamrig::testing::TempDir dir;
+  const std::string out = dir.File("r");
+  auto r = slamrig::testing::RunCommand(std::string(SLAMRIG_BINARY) +
+                                        " simulate office --duration 4 --format sqlite3 --topic "
+                                        "scan=/front/scan --out " +
+                                        out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  BagReaderOptions options;
+  options.topics.scan = "/front/scan";
+  EXPECT_EQ(Scans(ReadBag(out + "/run", options)).size(), 160u);  // 4 s at 40 Hz
+  EXPECT_TRUE(Scans(ReadBag(out + "/run")).empty());
+
+  const std::string slam = std::string(SLAMRIG_BINARY) + " slam " + out +
+                           "/run --algorithm dead-reckoning --quiet --out ";
+  r = slamrig::testing::RunCommand(slam + dir.File("with") + " --topic scan=/front/scan");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir.File("with") + "/trajectory.tum"));
+  r = slamrig::testing::RunCommand(slam + dir.File("without"));
+  EXPECT_NE(r.output.find("(no scans)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("skipped topic /front/scan (sensor_msgs/msg/LaserScan): 160 messages"),
+            std::string::npos)
+      << r.output;
+  r = slamrig::testing::RunCommand(slam + dir.File("bad") + " --topic scan=front");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--topic: topics.scan = 'front'"), std::string::npos) << r.output;
+}
+
 // A recording killed with SIGKILL leaves no bag folder that looks complete: DIR/run appears only
 // by the rename after metadata.yaml and the storage file are closed.
 TEST(BagCliTest, KilledRecordingLeavesNoBag) {

@@ -93,6 +93,25 @@ std::vector<std::string> BagTopicNames::Validate() const {
   return errors;
 }
 
+std::string* BagTopicNames::Find(std::string_view key) {
+  const std::pair<std::string_view, std::string*> fields[] = {{"scan", &scan},
+                                                              {"imu", &imu},
+                                                              {"joint_states", &joint_states},
+                                                              {"odom", &odom},
+                                                              {"ground_truth", &ground_truth},
+                                                              {"tf", &tf},
+                                                              {"tf_static", &tf_static},
+                                                              {"clock", &clock}};
+  for (const auto& [name, field] : fields) {
+    if (name == key) return field;
+  }
+  return nullptr;
+}
+
+const char* BagTopicNames::Keys() {
+  return "scan, imu, joint_states, odom, ground_truth, tf, tf_static, clock";
+}
+
 std::vector<std::string> BagFrames::Validate() const {
   std::vector<std::string> errors;
   for (const auto& [field, value] :

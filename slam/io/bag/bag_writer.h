@@ -32,6 +32,12 @@ struct BagTopicNames {
 
   /// One RuleViolation() message per name that is not an absolute ROS name, or is repeated.
   std::vector<std::string> Validate() const;
+
+  /// The name stored under `key` (scan, imu, joint_states, odom, ground_truth, tf, tf_static,
+  /// clock: the field names), or nullptr for another key.
+  std::string* Find(std::string_view key);
+  /// The keys Find() knows, comma-separated, for error messages.
+  static const char* Keys();
 };
 
 /// Frame names (REP-105).

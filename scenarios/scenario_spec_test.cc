@@ -1,0 +1,62 @@
+#include "scenarios/scenario_spec.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "slam/types/error.h"
+
+namespace slamrig::scenario {
+namespace {
+
+// A scenario file beside an (empty) log file, in the test's temporary folder.
+std::string WriteScenario(const std::string& name, const std::string& source) {
+  const std::string dir = testing::TempDir() + "/spec_" + name;
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/run.mcap") << "";
+  const std::string path = dir + "/s.yaml";
+  std::ofstream(path) << "name: " << name << "\nsource: " << source
+                      << "\nslam:\n  dr: {algorithm: dead-reckoning}\n";
+  return path;
+}
+
+std::string ErrorOf(const std::string& path) {
+  try {
+    LoadScenario(path);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ScenarioSpecTest, LogSourceTakesBagTopicNames) {
+  const ScenarioSpec spec =
+      LoadScenario(WriteScenario("topics", "{log: run.mcap, topics: {scan: /front/scan}}"));
+  ASSERT_TRUE(spec.log);
+  EXPECT_EQ(spec.log->read.topics.scan, "/front/scan");
+  EXPECT_EQ(spec.log->read.topics.imu, slam::BagTopicNames{}.imu);  // the others: defaults
+  // The resolved file names every topic, so that it repeats the run.
+  EXPECT_NE(spec.resolved_yaml.find("scan: /front/scan"), std::string::npos) << spec.resolved_yaml;
+  EXPECT_NE(spec.resolved_yaml.find("ground_truth: /ground_truth/odom"), std::string::npos);
+}
+
+TEST(ScenarioSpecTest, BadTopicNamesNameFileLineAndKey) {
+  const std::string unknown = ErrorOf(WriteScenario("typo", "{log: run.mcap, topics: {scna: /x}}"));
+  EXPECT_NE(unknown.find("s.yaml:2:"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("source.topics.scna: unknown topic key 'scna'"), std::string::npos)
+      << unknown;
+  const std::string relative = ErrorOf(WriteScenario("rel", "{log: run.mcap, topics: {imu: imu}}"));
+  EXPECT_NE(relative.find("s.yaml:2:"), std::string::npos) << relative;
+  EXPECT_NE(relative.find("topics.imu = 'imu'; must be an absolute ROS topic name"),
+            std::string::npos)
+      << relative;
+  const std::string repeated =
+      ErrorOf(WriteScenario("dup", "{log: run.mcap, topics: {imu: /scan}}"));
+  EXPECT_NE(repeated.find("must differ from topics.scan"), std::string::npos) << repeated;
+  const std::string not_map = ErrorOf(WriteScenario("list", "{log: run.mcap, topics: [/x]}"));
+  EXPECT_NE(not_map.find("topics is a map"), std::string::npos) << not_map;
+}
+
+}  // namespace
+}  // namespace slamrig::scenario
