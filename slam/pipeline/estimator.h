@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <map>
 #include <optional>
 #include <string>
@@ -24,6 +25,9 @@ struct ScanEstimate {
   Pose2 pose;                      ///< the online estimate of base_link at the scan's time
   std::optional<Pose2> mean_pose;  ///< a second estimate where there is one (a PF's mean)
   std::vector<TraceValue> trace;   ///< per-scan values for plots
+  /// Covariance of (x, y, yaw) of `pose` in the estimator's frame (m^2, m rad, rad^2), where the
+  /// estimator has one (a Kalman filter, propagated dead reckoning).
+  std::optional<Eigen::Matrix3d> covariance;
 };
 
 /// A pose hypothesis with its normalised weight (a particle).

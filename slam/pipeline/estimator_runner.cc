@@ -46,6 +46,7 @@ void EstimatorRunner::Process(const SyncedScan& scan) {
   pose_ = estimate.pose;
   run_.online.Append(time, estimate.pose);
   if (estimate.mean_pose) run_.mean.Append(time, *estimate.mean_pose);
+  if (estimate.covariance) run_.covariances.push_back(*estimate.covariance);
   if (!estimate.trace.empty()) {
     run_.trace_time_s.push_back(time.seconds());
     for (const TraceValue& v : estimate.trace) run_.traces[v.name].push_back(v.value);
@@ -63,6 +64,7 @@ EstimatorRun EstimatorRunner::TakeResult() {
       final.Append(run_.online[i].time, (*revised)[i]);
     run_.final = std::move(final);
   }
+  if (run_.covariances.size() != run_.online.size()) run_.covariances.clear();
   run_.statistics = estimator_->Statistics();
   run_.map = estimator_->map();
   run_.gyro_fallbacks = sync_.gyro_fallbacks();
