@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "slam/types/check.h"
@@ -58,6 +59,27 @@ double PoseNees(const Pose2& truth, const Pose2& estimate, const Eigen::Matrix3d
     return std::numeric_limits<double>::infinity();
   }
   return e.dot(ldlt.solve(e));
+}
+
+Eigen::Matrix3d RotateCovariance(const Eigen::Matrix3d& covariance, double yaw_rad) {
+  Eigen::Matrix3d j = Eigen::Matrix3d::Identity();
+  const double c = std::cos(yaw_rad), s = std::sin(yaw_rad);
+  j.topLeftCorner<2, 2>() << c, -s, s, c;
+  return j * covariance * j.transpose();
+}
+
+std::string CovarianceCsv(const Trajectory& poses,
+                          const std::vector<Eigen::Matrix3d>& covariances) {
+  SLAMRIG_CHECK(poses.size() == covariances.size(), "CovarianceCsv: one covariance per pose");
+  std::string out = "# time_s,xx,xy,xt,yy,yt,tt\n";
+  char line[256];
+  for (std::size_t i = 0; i < covariances.size(); ++i) {
+    const Eigen::Matrix3d& p = covariances[i];
+    std::snprintf(line, sizeof(line), "%.9f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
+                  poses[i].time.seconds(), p(0, 0), p(0, 1), p(0, 2), p(1, 1), p(1, 2), p(2, 2));
+    out += line;
+  }
+  return out;
 }
 
 double ChiSquareQuantile(double p, double dof) {

@@ -5,14 +5,25 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
+#include <vector>
 
 #include "slam/types/pose2.h"
+#include "slam/types/trajectory.h"
 
 namespace slamrig::slam {
 
 /// NEES of `estimate` with covariance `covariance` (x, y, yaw) against `truth`, both in the same
 /// frame: e = truth - estimate with the angle wrapped. Infinity when the covariance is singular.
 double PoseNees(const Pose2& truth, const Pose2& estimate, const Eigen::Matrix3d& covariance);
+
+/// `covariance` of (x, y, yaw) in frame B as seen from frame A, where A_from_B turns by `yaw_rad`:
+/// J P J^T with J = diag(R(yaw), 1).
+Eigen::Matrix3d RotateCovariance(const Eigen::Matrix3d& covariance, double yaw_rad);
+
+/// CSV of one covariance per pose, "# time_s,xx,xy,xt,yy,yt,tt" then one line per pose (m^2,
+/// m rad, rad^2); `covariances` has one matrix per pose of `poses` (checked).
+std::string CovarianceCsv(const Trajectory& poses, const std::vector<Eigen::Matrix3d>& covariances);
 
 /// The `p` quantile of the chi-square distribution with `dof` degrees of freedom
 /// (Wilson-Hilferty's start refined by Newton steps on the incomplete gamma function).

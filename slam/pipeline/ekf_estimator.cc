@@ -8,6 +8,9 @@
 namespace slamrig::slam {
 namespace {
 
+constexpr int kStillIntervals = 10;
+constexpr double kZeroRateGate = 10.83;
+
 double MeanTicks(const std::vector<std::int32_t>& ticks) {
   if (ticks.empty()) return 0.0;
   return std::accumulate(ticks.begin(), ticks.end(), 0.0) / static_cast<double>(ticks.size());
@@ -41,8 +44,18 @@ EkfEstimator::EkfEstimator(const EkfOptions& options, const EstimatorContext& co
       map_(options.map) {}
 
 void EkfEstimator::AddRecord(const Record& record) {
+  const auto* ticks = std::get_if<WheelTicks>(&record);
+  last_record_was_ticks_ = ticks != nullptr;
   if (const auto* imu = std::get_if<ImuSample>(&record)) AddImu(*imu);
-  if (const auto* ticks = std::get_if<WheelTicks>(&record)) AddTicks(*ticks);
+  if (ticks) AddTicks(*ticks);
+}
+
+std::optional<ScanEstimate> EkfEstimator::RecordEstimate() const {
+  if (!last_record_was_ticks_) return std::nullopt;
+  ScanEstimate estimate;
+  estimate.pose = ekf_.pose();
+  estimate.covariance = ekf_.PoseCovariance();
+  return estimate;
 }
 
 void EkfEstimator::AddImu(const ImuSample& imu) {
@@ -58,9 +71,16 @@ void EkfEstimator::AddImu(const ImuSample& imu) {
     }
   }
   last_imu_time_ = imu.time;
-  if (standstill_ && options_.filter.zero_rate_updates) {
-    ekf_.UpdateZeroRate(rate);
-    ++zero_rate_updates_;
+  // Encoder ticks are coarse (a slow turn can leave an interval without a tick), so only a run
+  // of still intervals counts, and a sample far from the bias (chi2_1 at 0.999) is no standstill.
+  if (still_intervals_ >= kStillIntervals && options_.filter.zero_rate_updates) {
+    const double innovation = rate - ekf_.gyro_bias();
+    const double variance = ekf_.covariance()(6, 6) +
+                            options_.filter.gyro_sigma_rad_s * options_.filter.gyro_sigma_rad_s;
+    if (innovation * innovation < kZeroRateGate * variance) {
+      ekf_.UpdateZeroRate(rate);
+      ++zero_rate_updates_;
+    }
   }
 }
 
@@ -71,8 +91,7 @@ void EkfEstimator::AddTicks(const WheelTicks& ticks) {
   ekf_.PredictWheels(
       right_m, left_m, robot_.track_width_m,
       gyro_since_ticks_ ? std::optional<double>(gyro_yaw_since_ticks_) : std::nullopt);
-  // Only a second still interval counts as standstill (the robot may start within the first).
-  standstill_ = saw_ticks_ && right_m == 0.0 && left_m == 0.0;
+  still_intervals_ = right_m == 0.0 && left_m == 0.0 ? still_intervals_ + 1 : 0;
   saw_ticks_ = true;
   gyro_since_ticks_ = false;
   gyro_yaw_since_ticks_ = 0.0;

@@ -52,6 +52,8 @@ class EkfEstimator final : public Estimator {
   EkfEstimator(const EkfOptions& options, const EstimatorContext& context);
 
   void AddRecord(const Record& record) override;
+  /// The pose and covariance after each wheel-ticks record (the record-rate trajectory).
+  std::optional<ScanEstimate> RecordEstimate() const override;
   ScanEstimate AddScan(const SyncedScan& scan) override;
   const OccupancyGrid& map() const override { return map_; }
   std::map<std::string, double> Statistics() const override;
@@ -68,7 +70,8 @@ class EkfEstimator final : public Estimator {
   Pose2 icp_previous_;
   int scans_ = 0;
   bool saw_ticks_ = false;
-  bool standstill_ = false;
+  bool last_record_was_ticks_ = false;
+  int still_intervals_ = 0;  // consecutive encoder intervals without a tick
   std::optional<Time> last_imu_time_;
   bool gyro_since_ticks_ = false;
   double gyro_yaw_since_ticks_ = 0.0;

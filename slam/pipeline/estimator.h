@@ -54,6 +54,10 @@ class Estimator {
 
   /// Every record in arrival order, before any scan it completes. Default: ignored.
   virtual void AddRecord(const Record& record) { (void)record; }
+  /// The estimate right after the last AddRecord when that record moved it (an EKF predicting
+  /// from wheel ticks), else nullopt (the default). The runner keeps these as the run's
+  /// record-rate trajectory, which is all there is on a log without scans.
+  virtual std::optional<ScanEstimate> RecordEstimate() const { return std::nullopt; }
   /// One synchronised scan; returns the online estimate at its time.
   virtual ScanEstimate AddScan(const SyncedScan& scan) = 0;
   /// The end of the data (a graph back end runs its final optimisation here).

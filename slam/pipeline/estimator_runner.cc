@@ -27,6 +27,13 @@ void EstimatorRunner::Add(const Record& record) {
   SLAMRIG_CHECK(!finished_, "EstimatorRunner::Add after Finish");
   const auto start = Clock::now();
   estimator_->AddRecord(record);
+  if (const std::optional<ScanEstimate> e = estimator_->RecordEstimate()) {
+    const Time time = RecordTime(record);
+    if (run_.record_rate.empty() || run_.record_rate.poses().back().time <= time) {
+      run_.record_rate.Append(time, e->pose);
+      if (e->covariance) run_.record_rate_covariances.push_back(*e->covariance);
+    }
+  }
   for (const SyncedScan& s : sync_.Add(record)) Process(s);
   run_.wall_s += SecondsSince(start);
 }
@@ -65,6 +72,8 @@ EstimatorRun EstimatorRunner::TakeResult() {
     run_.final = std::move(final);
   }
   if (run_.covariances.size() != run_.online.size()) run_.covariances.clear();
+  if (run_.record_rate_covariances.size() != run_.record_rate.size())
+    run_.record_rate_covariances.clear();
   run_.statistics = estimator_->Statistics();
   run_.map = estimator_->map();
   run_.gyro_fallbacks = sync_.gyro_fallbacks();

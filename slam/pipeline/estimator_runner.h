@@ -25,6 +25,10 @@ struct EstimatorRun {
   /// The online pose's covariance at each scan (estimator frame), when the estimator gives one
   /// for every scan; else empty.
   std::vector<Eigen::Matrix3d> covariances;
+  /// Estimator::RecordEstimate() after every record that gave one, at the record's time, and
+  /// the covariances when every one had one; empty for estimators that only report at scans.
+  Trajectory record_rate;
+  std::vector<Eigen::Matrix3d> record_rate_covariances;
   std::vector<double> trace_time_s;                        ///< scan times of the traces, seconds
   std::map<std::string, std::vector<double>> traces;       ///< per-scan values by name
   std::map<std::string, double> statistics;                ///< Estimator::Statistics() at the end
