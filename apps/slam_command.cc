@@ -11,6 +11,7 @@
 
 #include "apps/cli_args.h"
 #include "apps/commands.h"
+#include "scenarios/plot.h"
 #include "slam/config/yaml_node.h"
 #include "slam/eval/json_writer.h"
 #include "slam/eval/map_score.h"
@@ -337,6 +338,20 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   if (!run.covariances.empty()) {
     slam::WriteFileAtomically(dir + "covariance.csv",
                               slam::CovarianceCsv(run.online, run.covariances));
+  }
+  if (encoder_only) {
+    // No map to draw the trajectory on: the path itself, x against y.
+    scenario::PlotSeries path_xy{"trajectory", {}, {}, {}, {}, scenario::PaletteColour(0)};
+    for (const StampedPose& p : run.final.poses()) {
+      path_xy.x.push_back(p.pose.x());
+      path_xy.y.push_back(p.pose.y());
+    }
+    scenario::PlotOptions plot;
+    plot.title = log_name + ": " + config.name + " from the encoders and gyro";
+    plot.x_label = "x [m]";
+    plot.y_label = "y [m]";
+    plot.y_from_zero = false;
+    slam::WriteFileAtomically(dir + "trajectory.png", scenario::RenderLinePlotPng({path_xy}, plot));
   }
   if (!encoder_only) {
     slam::WriteMapServerMap(run.map, dir + "map");
