@@ -256,19 +256,23 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
     if (c.nees.empty()) continue;
     std::vector<double> t = c.nees_time_s;
     for (double& v : t) v -= r.truth.empty() ? 0.0 : r.truth[0].time.seconds();
-    nees.push_back({c.name, t, c.nees, {}, {}, PaletteColour(i == 2 ? 4 : i)});
+    // On a log scale: an inconsistent filter's NEES runs to thousands.
+    std::vector<double> log_nees;
+    for (double v : c.nees) log_nees.push_back(std::log10(std::max(v, 1e-6)));
+    nees.push_back({c.name, t, log_nees, {}, {}, PaletteColour(i == 2 ? 4 : i)});
   }
   if (!nees.empty()) {
     const slam::NeesBounds bounds = slam::AneesBounds(3, 1);
     const std::vector<double> span = {nees.front().x.front(), nees.front().x.back()};
-    nees.push_back(
-        {"95 % lower", span, {bounds.lower, bounds.lower}, {}, {}, PaletteColour(3), false, true});
-    nees.push_back(
-        {"95 % upper", span, {bounds.upper, bounds.upper}, {}, {}, PaletteColour(3), false, true});
-    options.title = "Pose NEES e^T P^-1 e (3 dof) with the chi-square 95 % region";
-    options.y_label = "NEES";
+    const double lower = std::log10(bounds.lower), upper = std::log10(bounds.upper);
+    nees.push_back({"95 % lower", span, {lower, lower}, {}, {}, PaletteColour(3), false, true});
+    nees.push_back({"95 % upper", span, {upper, upper}, {}, {}, PaletteColour(3), false, true});
+    options.title = "Pose NEES e^T P^-1 e (3 dof, log10) with the chi-square 95 % region";
+    options.y_label = "log10 NEES";
+    options.y_from_zero = false;
     slam::WriteFileAtomically(file("nees.png"), RenderLinePlotPng(nees, options));
     html_plots += "<figure><img src=\"nees.png\"></figure>";
+    options.y_from_zero = true;
   }
 
   // Every per-scan trace the estimators report (a PF's Neff, ...), one plot per name.
