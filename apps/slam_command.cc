@@ -12,11 +12,13 @@
 #include "apps/cli_args.h"
 #include "apps/commands.h"
 #include "apps/topic_flags.h"
+#include "scenarios/plot.h"
 #include "slam/config/yaml_node.h"
 #include "slam/eval/json_writer.h"
 #include "slam/eval/map_score.h"
 #include "slam/eval/run_timing.h"
 #include "slam/eval/trajectory_metrics.h"
+#include "slam/fusion/consistency.h"
 #include "slam/io/atomic_file.h"
 #include "slam/io/log_reader.h"
 #include "slam/io/map_image.h"
@@ -241,15 +243,24 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   slam::EstimatorRun run;
   bool encoder_only = false;
   if (!has_scans) {
-    // Logs without a lidar (the shared ECE276A data): the encoders' (and gyro's) own trajectory,
-    // one pose per encoder record. Only dead reckoning can run on that.
-    if (config.algorithm != "dead-reckoning")
+    // Logs without a lidar (the shared ECE276A data): the trajectory an estimator reports at its
+    // records' rate (the EKF from encoders and gyro), or for dead reckoning the encoders' (and
+    // gyro's) own, one pose per encoder record.
+    const slam::OdometrySource source =
+        slam::ResolveOdometrySource(data.records, config.odometry.source);
+    slam::EstimatorRunner runner(config, source, seed);
+    for (const Record& r : data.records) runner.Add(r);
+    runner.Finish();
+    run = runner.TakeResult();
+    if (!run.record_rate.empty()) {
+      run.final = run.online = run.record_rate;
+      run.covariances = run.record_rate_covariances;
+    } else if (config.algorithm == "dead-reckoning") {
+      run.final = run.online = EncoderDeadReckoning(data.records, config.odometry);
+    } else {
       throw ParseError(path + ": no laser scans; " + config.algorithm +
-                       " needs them (only "
-                       "dead-reckoning runs on encoder records alone)");
-    run.name = config.name;
-    run.algorithm = config.algorithm;
-    run.final = run.online = EncoderDeadReckoning(data.records, config.odometry);
+                       " needs them (dead-reckoning and ekf run on encoder records alone)");
+    }
     if (run.final.empty()) throw ParseError(path + ": no laser scans and no wheel encoder records");
     run.odometry_source = slam::OdometrySource::kWheelTicks;
     encoder_only = true;
@@ -330,6 +341,24 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   if (online_metrics) slam::WriteTum(dir + "trajectory_online.tum", run.online);
   if (!reference.empty()) slam::WriteTum(dir + "reference.tum", reference);
   if (clouds > 0) slam::WriteFileAtomically(dir + "particles.csv", cloud_csv);
+  if (!run.covariances.empty()) {
+    slam::WriteFileAtomically(dir + "covariance.csv",
+                              slam::CovarianceCsv(run.online, run.covariances));
+  }
+  if (encoder_only) {
+    // No map to draw the trajectory on: the path itself, x against y.
+    scenario::PlotSeries path_xy{"trajectory", {}, {}, {}, {}, scenario::PaletteColour(0)};
+    for (const StampedPose& p : run.final.poses()) {
+      path_xy.x.push_back(p.pose.x());
+      path_xy.y.push_back(p.pose.y());
+    }
+    scenario::PlotOptions plot;
+    plot.title = log_name + ": " + config.name + " from the encoders and gyro";
+    plot.x_label = "x [m]";
+    plot.y_label = "y [m]";
+    plot.y_from_zero = false;
+    slam::WriteFileAtomically(dir + "trajectory.png", scenario::RenderLinePlotPng({path_xy}, plot));
+  }
   if (!encoder_only) {
     slam::WriteMapServerMap(run.map, dir + "map");
     // The reference drawn in the estimator's frame: the inverse of the ATE alignment.

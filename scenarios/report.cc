@@ -8,6 +8,7 @@
 #include "scenarios/scenario_result.h"
 #include "slam/eval/json_writer.h"
 #include "slam/eval/pose_association.h"
+#include "slam/fusion/consistency.h"
 #include "slam/io/atomic_file.h"
 #include "slam/io/map_image.h"
 #include "slam/io/map_server.h"
@@ -181,6 +182,14 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
     if (c.run.final.poses() != c.run.online.poses()) {
       slam::WriteTum(file(c.name + "_online.tum"), c.online);
     }
+    // The online poses' covariances, in the map frame as the trajectories are.
+    if (!c.run.covariances.empty()) {
+      std::vector<Eigen::Matrix3d> in_map;
+      for (const Eigen::Matrix3d& p : c.run.covariances)
+        in_map.push_back(slam::RotateCovariance(p, c.map_from_estimator.theta()));
+      slam::WriteFileAtomically(file(c.name + "_covariance.csv"),
+                                slam::CovarianceCsv(c.online, in_map));
+    }
     const Colour colour = PaletteColour(i == 2 ? 4 : i);  // skip palette green (the truth's)
     overlays.push_back({&c.estimate, c.name, colour.b, colour.g, colour.r});
     slam::WriteMapServerMap(c.run.map, file(c.name + "_map"));
@@ -239,6 +248,32 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
   std::string html_plots =
       "<figure><img src=\"position_error.png\"></figure><figure><img "
       "src=\"heading_error.png\"></figure>";
+
+  // The pose NEES over time with chi2_3's two-sided 95 % region (Bar-Shalom et al., Sec. 5.4.2).
+  std::vector<PlotSeries> nees;
+  for (std::size_t i = 0; i < r.configs.size(); ++i) {
+    const ConfigResult& c = r.configs[i];
+    if (c.nees.empty()) continue;
+    std::vector<double> t = c.nees_time_s;
+    for (double& v : t) v -= r.truth.empty() ? 0.0 : r.truth[0].time.seconds();
+    // On a log scale: an inconsistent filter's NEES runs to thousands.
+    std::vector<double> log_nees;
+    for (double v : c.nees) log_nees.push_back(std::log10(std::max(v, 1e-6)));
+    nees.push_back({c.name, t, log_nees, {}, {}, PaletteColour(i == 2 ? 4 : i)});
+  }
+  if (!nees.empty()) {
+    const slam::NeesBounds bounds = slam::AneesBounds(3, 1);
+    const std::vector<double> span = {nees.front().x.front(), nees.front().x.back()};
+    const double lower = std::log10(bounds.lower), upper = std::log10(bounds.upper);
+    nees.push_back({"95 % lower", span, {lower, lower}, {}, {}, PaletteColour(3), false, true});
+    nees.push_back({"95 % upper", span, {upper, upper}, {}, {}, PaletteColour(3), false, true});
+    options.title = "Pose NEES e^T P^-1 e (3 dof, log10) with the chi-square 95 % region";
+    options.y_label = "log10 NEES";
+    options.y_from_zero = false;
+    slam::WriteFileAtomically(file("nees.png"), RenderLinePlotPng(nees, options));
+    html_plots += "<figure><img src=\"nees.png\"></figure>";
+    options.y_from_zero = true;
+  }
 
   // Every per-scan trace the estimators report (a PF's Neff, ...), one plot per name.
   std::map<std::string, std::vector<PlotSeries>> traces;

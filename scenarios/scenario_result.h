@@ -23,6 +23,10 @@ struct ConfigResult {
   slam::EstimatorRun run;    ///< everything it produced, in its own frame (map, traces, stats)
   Pose2 map_from_estimator;  ///< the reference pose at the estimator's first scan
   std::map<std::string, double> metrics;  ///< MetricsOf() names; NaN when not applicable
+  /// The pose NEES against the reference at each scan with a covariance (empty without), and
+  /// the scans' times in seconds.
+  std::vector<double> nees_time_s;
+  std::vector<double> nees;
 };
 
 /// One checked expectation.

@@ -10,6 +10,7 @@
 #include "slam/eval/pose_association.h"
 #include "slam/eval/trajectory_error.h"
 #include "slam/eval/trajectory_metrics.h"
+#include "slam/fusion/consistency.h"
 #include "slam/pipeline/estimator_runner.h"
 #include "slam/types/error.h"
 
@@ -59,6 +60,35 @@ void ShowLive(LiveView& view, double now_s, const Runners& runners, const Pose2&
   view.Update(now_s, shown->estimator().map(), map_from_start, truth, live);
 }
 
+// The NEES of the online poses that have a covariance, against the reference at the same time:
+// the covariance turned from the estimator's frame into the map frame; scans with a singular
+// covariance (the first, pinned at the origin) are left out.
+void ScoreNees(const ScenarioResult& run, ConfigResult* c) {
+  if (c->run.covariances.size() != c->online.size()) return;
+  const std::vector<slam::PosePair> pairs = slam::AssociatePoses(c->online, run.truth);
+  std::size_t i = 0;
+  for (const slam::PosePair& p : pairs) {
+    while (i < c->online.size() && c->online[i].time < p.time) ++i;
+    if (i == c->online.size() || c->online[i].time != p.time) continue;
+    const Eigen::Matrix3d covariance =
+        slam::RotateCovariance(c->run.covariances[i], c->map_from_estimator.theta());
+    const double nees = slam::PoseNees(p.reference, p.estimate, covariance);
+    if (!std::isfinite(nees)) continue;
+    c->nees_time_s.push_back(p.time.seconds());
+    c->nees.push_back(nees);
+  }
+  if (c->nees.empty()) return;
+  double sum = 0.0;
+  for (double v : c->nees) sum += v;
+  auto& m = c->metrics;
+  m["mean_nees"] = sum / static_cast<double>(c->nees.size());
+  m["final_nees"] = c->nees.back();
+  // One run: NEES of a consistent 3-dof estimate lies in chi2_3's 95 % region.
+  const slam::NeesBounds bounds = slam::AneesBounds(3, 1);
+  m["nees_lower_95"] = bounds.lower;
+  m["nees_upper_95"] = bounds.upper;
+}
+
 // Scores of one configuration against the reference (NaN where there is none).
 void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
   auto& m = c->metrics;
@@ -76,6 +106,7 @@ void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
   m["ate_max_m"] = t.ate.translation_m.max;
   m["ate_rot_rmse_rad"] = t.ate.rotation_rad.rmse;
   m["online_ate_rmse_m"] = slam::ComputeAte(c->online, run.truth).translation_m.rmse;
+  ScoreNees(run, c);
   // Means of the pairs' translation errors; NaN when the run is too short for a spacing.
   const auto mean = [](const slam::ErrorStats& s) { return s.count ? s.mean : NAN; };
   m["rpe_m_per_scan"] = mean(t.rpe_per_scan.translation_m);

@@ -8,6 +8,7 @@
 
 #include "slam/config/fields.h"
 #include "slam/eval/json_fields.h"
+#include "slam/odometry/wheel_odometry.h"
 #include "slam/pipeline/estimator.h"
 
 namespace slamrig::slam {
@@ -15,6 +16,7 @@ namespace slamrig::slam {
 /// What every estimator is built with besides its own options.
 struct EstimatorContext {
   std::uint64_t seed = 1;  ///< the estimator's own random seed (a named stream of the run's)
+  DiffDriveParams robot;   ///< the wheel geometry of the source (for estimators that read ticks)
 };
 
 /// One algorithm's options behind one interface: a plain options struct with a VisitFields

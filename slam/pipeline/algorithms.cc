@@ -3,6 +3,7 @@
 
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/dead_reckoning_estimator.h"
+#include "slam/pipeline/ekf_estimator.h"
 #include "slam/pipeline/particle_filter_estimator.h"
 
 namespace slamrig::slam {
@@ -27,6 +28,14 @@ const std::vector<Algorithm>& Algorithms() {
              AlgorithmOptionsFor<ParticleFilterOptions, ParticleFilterEstimator>>(
              preset == "reports" ? ParticleFilterOptions::ReportsPreset()
                                  : ParticleFilterOptions{});
+       }},
+      {"ekf",
+       "EKF pose fusion: encoders and gyro predict, scan-to-local-map ICP increments correct, "
+       "the gyro bias estimated; a covariance with every pose",
+       {"default"},
+       {"gyro_bias_rad_s", "scan_updates", "zero_rate_updates", "mean_nis"},
+       [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
+         return std::make_unique<AlgorithmOptionsFor<EkfOptions, EkfEstimator>>(EkfOptions{});
        }},
   };
   return algorithms;

@@ -5,18 +5,28 @@
 namespace slamrig::slam {
 
 std::vector<std::string> DeadReckoningOptions::Validate() const {
-  return PrefixErrors("map", map.Validate());
+  std::vector<std::string> errors = PrefixErrors("map", map.Validate());
+  AppendErrors(&errors, PrefixErrors("noise", noise.Validate()));
+  return errors;
 }
 
 DeadReckoningEstimator::DeadReckoningEstimator(const DeadReckoningOptions& options,
                                                const EstimatorContext& /*context*/)
-    : map_(options.map) {}
+    : map_(options.map), noise_(options.noise) {
+  noise_.ResetPose(Pose2());
+}
 
 ScanEstimate DeadReckoningEstimator::AddScan(const SyncedScan& scan) {
-  if (started_) pose_ = pose_ * scan.increment;
+  if (started_) {
+    noise_.PredictIncrement(scan.increment, scan.increment.translation().norm(),
+                            scan.increment.theta());
+  }
   started_ = true;
-  map_.InsertScan(scan.scan, pose_);
-  return {pose_, std::nullopt, {}};
+  ScanEstimate estimate;
+  estimate.pose = noise_.pose();
+  estimate.covariance = noise_.PoseCovariance();
+  map_.InsertScan(scan.scan, estimate.pose);
+  return estimate;
 }
 
 }  // namespace slamrig::slam

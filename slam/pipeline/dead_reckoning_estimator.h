@@ -3,15 +3,18 @@
 #include <string>
 #include <vector>
 
+#include "slam/fusion/pose_ekf.h"
 #include "slam/grid/occupancy_grid.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
 
 namespace slamrig::slam {
 
-/// Options of dead reckoning: only the map built along the odometry.
+/// Options of dead reckoning: the map built along the odometry, and the odometry's noise for
+/// the propagated covariance (PoseEkf's increment model: the `increment_*` keys of `noise`).
 struct DeadReckoningOptions {
   OccupancyGridOptions map;
+  PoseEkfOptions noise;
 
   /// One message per broken rule ("map.resolution_m = 0; must be > 0").
   std::vector<std::string> Validate() const;
@@ -21,10 +24,12 @@ struct DeadReckoningOptions {
 template <typename V>
 void VisitFields(V& v, DeadReckoningOptions& o) {
   v.Struct("map", o.map);
+  v.Struct("noise", o.noise);
 }
 
 /// Dead reckoning: the odometry increments composed from the first scan, with the map built
-/// along them. The baseline every SLAM result is compared with.
+/// along them, and the odometry noise propagated into a covariance with every pose (so that its
+/// NEES can be shown). The baseline every SLAM result is compared with.
 class DeadReckoningEstimator final : public Estimator {
  public:
   DeadReckoningEstimator(const DeadReckoningOptions& options, const EstimatorContext& context);
@@ -34,7 +39,7 @@ class DeadReckoningEstimator final : public Estimator {
 
  private:
   OccupancyGrid map_;
-  Pose2 pose_;
+  PoseEkf noise_;
   bool started_ = false;
 };
 

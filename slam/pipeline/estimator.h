@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <map>
 #include <optional>
 #include <string>
@@ -24,6 +25,9 @@ struct ScanEstimate {
   Pose2 pose;                      ///< the online estimate of base_link at the scan's time
   std::optional<Pose2> mean_pose;  ///< a second estimate where there is one (a PF's mean)
   std::vector<TraceValue> trace;   ///< per-scan values for plots
+  /// Covariance of (x, y, yaw) of `pose` in the estimator's frame (m^2, m rad, rad^2), where the
+  /// estimator has one (a Kalman filter, propagated dead reckoning).
+  std::optional<Eigen::Matrix3d> covariance;
 };
 
 /// A pose hypothesis with its normalised weight (a particle).
@@ -50,6 +54,10 @@ class Estimator {
 
   /// Every record in arrival order, before any scan it completes. Default: ignored.
   virtual void AddRecord(const Record& record) { (void)record; }
+  /// The estimate right after the last AddRecord when that record moved it (an EKF predicting
+  /// from wheel ticks), else nullopt (the default). The runner keeps these as the run's
+  /// record-rate trajectory, which is all there is on a log without scans.
+  virtual std::optional<ScanEstimate> RecordEstimate() const { return std::nullopt; }
   /// One synchronised scan; returns the online estimate at its time.
   virtual ScanEstimate AddScan(const SyncedScan& scan) = 0;
   /// The end of the data (a graph back end runs its final optimisation here).

@@ -108,6 +108,7 @@ std::unique_ptr<Estimator> MakeEstimator(const EstimatorConfig& config, std::uin
   if (!errors.empty()) throw ConfigError(config.name + ": " + errors.front());
   EstimatorContext context;
   context.seed = RandomStream(run_seed, "slam." + config.name).NextU64();
+  context.robot = config.odometry.robot;
   return config.options->MakeEstimator(context);
 }
 

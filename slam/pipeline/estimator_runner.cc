@@ -27,6 +27,13 @@ void EstimatorRunner::Add(const Record& record) {
   SLAMRIG_CHECK(!finished_, "EstimatorRunner::Add after Finish");
   const auto start = Clock::now();
   estimator_->AddRecord(record);
+  if (const std::optional<ScanEstimate> e = estimator_->RecordEstimate()) {
+    const Time time = RecordTime(record);
+    if (run_.record_rate.empty() || run_.record_rate.poses().back().time <= time) {
+      run_.record_rate.Append(time, e->pose);
+      if (e->covariance) run_.record_rate_covariances.push_back(*e->covariance);
+    }
+  }
   for (const SyncedScan& s : sync_.Add(record)) Process(s);
   run_.wall_s += SecondsSince(start);
 }
@@ -46,6 +53,7 @@ void EstimatorRunner::Process(const SyncedScan& scan) {
   pose_ = estimate.pose;
   run_.online.Append(time, estimate.pose);
   if (estimate.mean_pose) run_.mean.Append(time, *estimate.mean_pose);
+  if (estimate.covariance) run_.covariances.push_back(*estimate.covariance);
   if (!estimate.trace.empty()) {
     run_.trace_time_s.push_back(time.seconds());
     for (const TraceValue& v : estimate.trace) run_.traces[v.name].push_back(v.value);
@@ -63,6 +71,9 @@ EstimatorRun EstimatorRunner::TakeResult() {
       final.Append(run_.online[i].time, (*revised)[i]);
     run_.final = std::move(final);
   }
+  if (run_.covariances.size() != run_.online.size()) run_.covariances.clear();
+  if (run_.record_rate_covariances.size() != run_.record_rate.size())
+    run_.record_rate_covariances.clear();
   run_.statistics = estimator_->Statistics();
   run_.map = estimator_->map();
   run_.gyro_fallbacks = sync_.gyro_fallbacks();

@@ -22,6 +22,13 @@ struct EstimatorRun {
   Trajectory online;      ///< the pose reported at each scan, stamped with the scan's own time
   Trajectory final;       ///< revised where the estimator revises its past, else `online`
   Trajectory mean;        ///< the second estimate at each scan (a PF's mean), else empty
+  /// The online pose's covariance at each scan (estimator frame), when the estimator gives one
+  /// for every scan; else empty.
+  std::vector<Eigen::Matrix3d> covariances;
+  /// Estimator::RecordEstimate() after every record that gave one, at the record's time, and
+  /// the covariances when every one had one; empty for estimators that only report at scans.
+  Trajectory record_rate;
+  std::vector<Eigen::Matrix3d> record_rate_covariances;
   std::vector<double> trace_time_s;                        ///< scan times of the traces, seconds
   std::map<std::string, std::vector<double>> traces;       ///< per-scan values by name
   std::map<std::string, double> statistics;                ///< Estimator::Statistics() at the end

@@ -17,7 +17,7 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
   neff_sum_ += step.neff;
   ++scans_;
   updates_ += step.updated;
-  return {step.best_pose, step.mean_pose, {{"neff", step.neff}}};
+  return {step.best_pose, step.mean_pose, {{"neff", step.neff}}, std::nullopt};
 }
 
 std::map<std::string, double> ParticleFilterEstimator::Statistics() const {

@@ -1,0 +1,161 @@
+#include "slam/fusion/pose_ekf.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <cmath>
+
+#include "slam/types/check.h"
+
+namespace slamrig::slam {
+namespace {
+
+constexpr int kN = 7;
+constexpr int kYaw = 5;
+constexpr int kBias = 6;
+
+double Squared(double v) { return v * v; }
+
+}  // namespace
+
+Eigen::MatrixXd JosephUpdate(const Eigen::MatrixXd& p, const Eigen::MatrixXd& k,
+                             const Eigen::MatrixXd& h, const Eigen::MatrixXd& r) {
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Identity(p.rows(), p.cols()) - k * h;
+  const Eigen::MatrixXd updated = a * p * a.transpose() + k * r * k.transpose();
+  return 0.5 * (updated + updated.transpose());
+}
+
+PoseEkf::PoseEkf(const PoseEkfOptions& options) : options_(options) {
+  SLAMRIG_CHECK(options.Validate().empty(), "PoseEkf: invalid options");
+  p_(kBias, kBias) = Squared(options.gyro_bias_sigma_rad_s);
+}
+
+void PoseEkf::ResetPose(const Pose2& pose) {
+  const double bias_variance = p_(kBias, kBias);
+  p_.setZero();
+  p_(kBias, kBias) = bias_variance;
+  x_.head<3>() << pose.x(), pose.y(), pose.theta();
+  x_.segment<3>(3) = x_.head<3>();
+}
+
+void PoseEkf::PredictGyro(double rate_rad_s, double dt_s) {
+  if (!(dt_s > 0.0)) return;
+  // yaw' = yaw + (rate - b) dt: F is the identity but for d yaw / d b = -dt.
+  x_(kYaw) = NormalizeAngle(x_(kYaw) + (rate_rad_s - x_(kBias)) * dt_s);
+  Eigen::Matrix<double, kN, kN> f = Eigen::Matrix<double, kN, kN>::Identity();
+  f(kYaw, kBias) = -dt_s;
+  p_ = f * p_ * f.transpose();
+  p_(kYaw, kYaw) += Squared(options_.gyro_sigma_rad_s * dt_s);
+  p_(kBias, kBias) += Squared(options_.gyro_bias_walk_rad_s_sqrt_s) * dt_s;
+}
+
+void PoseEkf::PredictWheels(double right_m, double left_m, double track_width_m,
+                            std::optional<double> gyro_yaw_rad) {
+  const double distance = 0.5 * (right_m + left_m);
+  double encoder_yaw = 0.0;
+  if (!gyro_yaw_rad) {
+    encoder_yaw = (right_m - left_m) / track_width_m;
+    x_(kYaw) = NormalizeAngle(x_(kYaw) + encoder_yaw);
+  }
+  // The mean heading of the interval: the yaw now minus half of what this interval turned.
+  const double turned = gyro_yaw_rad ? *gyro_yaw_rad : encoder_yaw;
+  const double heading = x_(kYaw) - 0.5 * turned;
+  const double c = std::cos(heading), s = std::sin(heading);
+  x_(3) += distance * c;
+  x_(4) += distance * s;
+  Eigen::Matrix<double, kN, kN> f = Eigen::Matrix<double, kN, kN>::Identity();
+  f(3, kYaw) = -distance * s;
+  f(4, kYaw) = distance * c;
+  p_ = f * p_ * f.transpose();
+  // Along-track and lateral noise, rotated into the fixed frame.
+  const double along = Squared(options_.encoder_sigma_rel * distance);
+  const double lateral = Squared(options_.encoder_lateral_sigma_rel * distance);
+  p_(3, 3) += c * c * along + s * s * lateral;
+  p_(4, 4) += s * s * along + c * c * lateral;
+  p_(3, 4) += c * s * (along - lateral);
+  p_(4, 3) = p_(3, 4);
+  if (!gyro_yaw_rad) {
+    p_(kYaw, kYaw) += Squared(options_.encoder_yaw_sigma_rel *
+                              (std::abs(right_m) + std::abs(left_m)) / track_width_m);
+  }
+}
+
+void PoseEkf::PredictIncrement(const Pose2& increment, double distance_m, double turn_rad) {
+  const Pose2 before = pose();
+  const Pose2 after = before * increment;
+  x_.segment<3>(3) << after.x(), after.y(), after.theta();
+  const double c = std::cos(before.theta()), s = std::sin(before.theta());
+  // d(after)/d(before): translation rotates with the heading.
+  Eigen::Matrix<double, kN, kN> f = Eigen::Matrix<double, kN, kN>::Identity();
+  f(3, kYaw) = -s * increment.x() - c * increment.y();
+  f(4, kYaw) = c * increment.x() - s * increment.y();
+  p_ = f * p_ * f.transpose();
+  const double distance = std::abs(distance_m);
+  const double sxy =
+      options_.increment_sigma_xy_per_m * distance + options_.increment_sigma_xy_floor_m;
+  const double syaw = options_.increment_sigma_yaw_per_rad * std::abs(turn_rad) +
+                      options_.increment_sigma_yaw_per_m * distance +
+                      options_.increment_sigma_yaw_floor_rad;
+  p_(3, 3) += sxy * sxy;
+  p_(4, 4) += sxy * sxy;
+  p_(kYaw, kYaw) += syaw * syaw;
+}
+
+EkfUpdate PoseEkf::UpdateRelativePose(const Pose2& z, const Eigen::Matrix3d& r) {
+  const Pose2 predicted = clone().Between(pose());
+  const double c = std::cos(x_(2)), s = std::sin(x_(2));
+  const Eigen::Vector2d d = x_.segment<2>(3) - x_.head<2>();
+  // h = (R(c)^T (p - c_xy), yaw - c_yaw); its Jacobian with respect to (clone, pose, bias).
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(3, kN);
+  h(0, 0) = -c;
+  h(0, 1) = -s;
+  h(1, 0) = s;
+  h(1, 1) = -c;
+  h(0, 2) = -s * d.x() + c * d.y();
+  h(1, 2) = -c * d.x() - s * d.y();
+  h(0, 3) = c;
+  h(0, 4) = s;
+  h(1, 3) = -s;
+  h(1, 4) = c;
+  h(2, 2) = -1.0;
+  h(2, kYaw) = 1.0;
+  Eigen::VectorXd innovation(3);
+  innovation << z.x() - predicted.x(), z.y() - predicted.y(),
+      NormalizeAngle(z.theta() - predicted.theta());
+  return Update(innovation, h, r);
+}
+
+EkfUpdate PoseEkf::UpdateZeroRate(double rate_rad_s) {
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(1, kN);
+  h(0, kBias) = 1.0;
+  Eigen::VectorXd innovation(1);
+  innovation << rate_rad_s - x_(kBias);
+  Eigen::MatrixXd r(1, 1);
+  r << Squared(options_.gyro_sigma_rad_s);
+  return Update(innovation, h, r);
+}
+
+EkfUpdate PoseEkf::Update(const Eigen::VectorXd& innovation, const Eigen::MatrixXd& h,
+                          const Eigen::MatrixXd& r) {
+  const Eigen::MatrixXd p = p_;
+  const Eigen::MatrixXd s = h * p * h.transpose() + r;
+  const Eigen::LDLT<Eigen::MatrixXd> s_ldlt(s);
+  // K = P H^T S^-1, through the symmetric solve S K^T = H P.
+  const Eigen::MatrixXd k = s_ldlt.solve(h * p).transpose();
+  Eigen::VectorXd dx = k * innovation;
+  x_ += dx;
+  x_(2) = NormalizeAngle(x_(2));
+  x_(kYaw) = NormalizeAngle(x_(kYaw));
+  p_ = JosephUpdate(p, k, h, r);
+  return {innovation.dot(s_ldlt.solve(innovation)), static_cast<int>(innovation.size())};
+}
+
+void PoseEkf::Clone() {
+  // c' = pose: the clone rows and columns become copies of the pose's.
+  Eigen::Matrix<double, kN, kN> j = Eigen::Matrix<double, kN, kN>::Zero();
+  j.block<3, 3>(0, 3).setIdentity();
+  j.block<4, 4>(3, 3).setIdentity();
+  x_.head<3>() = x_.segment<3>(3);
+  p_ = j * p_ * j.transpose();
+}
+
+}  // namespace slamrig::slam

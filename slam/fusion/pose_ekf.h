@@ -1,0 +1,71 @@
+// An error-state-free EKF for a planar robot with a gyro bias, predicted by wheel encoders and the
+// gyro at their own rates and corrected by relative pose measurements (scan-match increments)
+// through stochastic cloning (Roumeliotis and Burdick, "Stochastic cloning: a generalized
+// framework for processing relative state measurements", ICRA 2002, Sec. III). The update uses the
+// Joseph form (Bar-Shalom, Li and Kirubarajan, "Estimation with Applications to Tracking and
+// Navigation", 2001, Eq. 5.2.3-18), which keeps the covariance symmetric positive semi-definite.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+
+#include "slam/fusion/pose_ekf_options.h"
+#include "slam/types/pose2.h"
+
+namespace slamrig::slam {
+
+/// The Joseph-form covariance after a Kalman update with gain `k`, measurement Jacobian `h` and
+/// measurement covariance `r`: (I - K H) P (I - K H)^T + K R K^T, symmetrised.
+Eigen::MatrixXd JosephUpdate(const Eigen::MatrixXd& p, const Eigen::MatrixXd& k,
+                             const Eigen::MatrixXd& h, const Eigen::MatrixXd& r);
+
+/// What one Kalman update did.
+struct EkfUpdate {
+  double nis = 0.0;   ///< normalised innovation squared, nu^T S^-1 nu
+  int dimension = 0;  ///< the measurement's dimension (the NIS's chi-square degrees of freedom)
+};
+
+/// The filter. State: the clone c = (x, y, yaw) of the pose at the last clone, the current pose
+/// (x, y, yaw) and the gyro bias b (rad/s); 7 x 7 covariance. Poses in one fixed frame.
+/// Deterministic; not thread-safe.
+class PoseEkf {
+ public:
+  explicit PoseEkf(const PoseEkfOptions& options);
+
+  /// Sets the current pose and the clone to `pose` with zero pose covariance; the bias and its
+  /// variance stay (the estimator's frame starts here).
+  void ResetPose(const Pose2& pose);
+  /// The gyro z sample `rate_rad_s` held for `dt_s` seconds: yaw += (rate - b) dt.
+  void PredictGyro(double rate_rad_s, double dt_s);
+  /// One encoder interval: the wheels rolled `right_m` and `left_m`; `gyro_yaw_rad` is the yaw the
+  /// gyro added since the previous interval (the translation follows the mean heading), or
+  /// nullopt when no gyro sample came, and the yaw comes from the wheel difference.
+  void PredictWheels(double right_m, double left_m, double track_width_m,
+                     std::optional<double> gyro_yaw_rad);
+  /// A robot-frame increment from odometry poses, `distance_m` travelled and `turn_rad` turned.
+  void PredictIncrement(const Pose2& increment, double distance_m, double turn_rad);
+  /// Measures clone^-1 * pose = `z` with covariance `r` (x, y, yaw in the clone's frame).
+  EkfUpdate UpdateRelativePose(const Pose2& z, const Eigen::Matrix3d& r);
+  /// A gyro sample taken at standstill measures the bias: b = rate.
+  EkfUpdate UpdateZeroRate(double rate_rad_s);
+  /// The clone becomes the current pose (the next relative measurement starts here).
+  void Clone();
+
+  Pose2 pose() const { return {x_(3), x_(4), x_(5)}; }
+  Pose2 clone() const { return {x_(0), x_(1), x_(2)}; }
+  double gyro_bias() const { return x_(6); }
+  /// Covariance of (x, y, yaw) of pose().
+  Eigen::Matrix3d PoseCovariance() const { return p_.block<3, 3>(3, 3); }
+  /// The whole 7 x 7 covariance.
+  const Eigen::Matrix<double, 7, 7>& covariance() const { return p_; }
+
+ private:
+  EkfUpdate Update(const Eigen::VectorXd& innovation, const Eigen::MatrixXd& h,
+                   const Eigen::MatrixXd& r);
+
+  PoseEkfOptions options_;
+  Eigen::Matrix<double, 7, 1> x_ = Eigen::Matrix<double, 7, 1>::Zero();
+  Eigen::Matrix<double, 7, 7> p_ = Eigen::Matrix<double, 7, 7>::Zero();
+};
+
+}  // namespace slamrig::slam

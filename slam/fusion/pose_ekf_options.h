@@ -1,0 +1,55 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace slamrig::slam {
+
+/// Noise of PoseEkf's motion and bias models. Standard deviations; units in the names.
+struct PoseEkfOptions {
+  /// Travelled distance per encoder interval: sigma = encoder_sigma_rel * |distance|.
+  double encoder_sigma_rel = 0.02;
+  /// Sideways slip per encoder interval: sigma = encoder_lateral_sigma_rel * |distance|.
+  double encoder_lateral_sigma_rel = 0.01;
+  /// Yaw from the wheel difference (no gyro in the interval): sigma = rel * (|right| + |left|) /
+  /// track width.
+  double encoder_yaw_sigma_rel = 0.02;
+  /// White noise of one gyro z sample, rad/s; a sample held over dt adds (sigma * dt)^2.
+  double gyro_sigma_rad_s = 0.01;
+  /// Prior standard deviation of the gyro bias at the start, rad/s.
+  double gyro_bias_sigma_rad_s = 0.01;
+  /// Random walk of the gyro bias, rad/s per sqrt(s).
+  double gyro_bias_walk_rad_s_sqrt_s = 1e-4;
+  /// Odometry-pose increments (logs without encoders): sigma_xy = per_m * distance + floor,
+  /// sigma_yaw = per_rad * |turn| + per_m * distance + floor.
+  double increment_sigma_xy_per_m = 0.05;
+  double increment_sigma_xy_floor_m = 0.002;
+  double increment_sigma_yaw_per_rad = 0.05;
+  double increment_sigma_yaw_per_m = 0.02;
+  double increment_sigma_yaw_floor_rad = 0.001;
+  /// A gyro sample taken while the encoders report no motion measures the bias (a zero-velocity
+  /// update).
+  bool zero_rate_updates = true;
+
+  /// One message per broken rule ("gyro_sigma_rad_s = -1; must be >= 0").
+  std::vector<std::string> Validate() const;
+};
+
+/// The field table of PoseEkfOptions (slam/config/fields.h).
+template <typename V>
+void VisitFields(V& v, PoseEkfOptions& o) {
+  v("encoder_sigma_rel", o.encoder_sigma_rel);
+  v("encoder_lateral_sigma_rel", o.encoder_lateral_sigma_rel);
+  v("encoder_yaw_sigma_rel", o.encoder_yaw_sigma_rel);
+  v("gyro_sigma_rad_s", o.gyro_sigma_rad_s);
+  v("gyro_bias_sigma_rad_s", o.gyro_bias_sigma_rad_s);
+  v("gyro_bias_walk_rad_s_sqrt_s", o.gyro_bias_walk_rad_s_sqrt_s);
+  v("increment_sigma_xy_per_m", o.increment_sigma_xy_per_m);
+  v("increment_sigma_xy_floor_m", o.increment_sigma_xy_floor_m);
+  v("increment_sigma_yaw_per_rad", o.increment_sigma_yaw_per_rad);
+  v("increment_sigma_yaw_per_m", o.increment_sigma_yaw_per_m);
+  v("increment_sigma_yaw_floor_rad", o.increment_sigma_yaw_floor_rad);
+  v("zero_rate_updates", o.zero_rate_updates);
+}
+
+}  // namespace slamrig::slam

@@ -1,0 +1,149 @@
+#include "slam/pipeline/ekf_estimator.h"
+
+#include <cmath>
+#include <numeric>
+
+#include "slam/types/validation.h"
+
+namespace slamrig::slam {
+namespace {
+
+constexpr int kStillIntervals = 10;
+constexpr double kZeroRateGate = 10.83;
+
+double MeanTicks(const std::vector<std::int32_t>& ticks) {
+  if (ticks.empty()) return 0.0;
+  return std::accumulate(ticks.begin(), ticks.end(), 0.0) / static_cast<double>(ticks.size());
+}
+
+}  // namespace
+
+std::vector<std::string> EkfOptions::Validate() const {
+  std::vector<std::string> errors = filter.Validate();
+  if (!(match_covariance_scale > 0.0)) {
+    errors.push_back(
+        RuleViolation("match_covariance_scale", match_covariance_scale, "must be > 0"));
+  }
+  if (!(match_sigma_floor_xy_m >= 0.0)) {
+    errors.push_back(
+        RuleViolation("match_sigma_floor_xy_m", match_sigma_floor_xy_m, "must be >= 0"));
+  }
+  if (!(match_sigma_floor_yaw_rad >= 0.0)) {
+    errors.push_back(
+        RuleViolation("match_sigma_floor_yaw_rad", match_sigma_floor_yaw_rad, "must be >= 0"));
+  }
+  AppendErrors(&errors, PrefixErrors("map", map.Validate()));
+  return errors;
+}
+
+EkfEstimator::EkfEstimator(const EkfOptions& options, const EstimatorContext& context)
+    : options_(options),
+      robot_(context.robot),
+      ekf_(options.filter),
+      icp_(IcpOdometryOptions{}),
+      map_(options.map) {}
+
+void EkfEstimator::AddRecord(const Record& record) {
+  const auto* ticks = std::get_if<WheelTicks>(&record);
+  last_record_was_ticks_ = ticks != nullptr;
+  if (const auto* imu = std::get_if<ImuSample>(&record)) AddImu(*imu);
+  if (ticks) AddTicks(*ticks);
+}
+
+std::optional<ScanEstimate> EkfEstimator::RecordEstimate() const {
+  if (!last_record_was_ticks_) return std::nullopt;
+  ScanEstimate estimate;
+  estimate.pose = ekf_.pose();
+  estimate.covariance = ekf_.PoseCovariance();
+  return estimate;
+}
+
+void EkfEstimator::AddImu(const ImuSample& imu) {
+  const double rate = imu.angular_velocity_rad_s.z();
+  if (!std::isfinite(rate)) return;
+  // Each sample is held from the previous one (zero-order hold).
+  if (last_imu_time_) {
+    const double dt = SecondsBetween(imu.time, *last_imu_time_);
+    if (dt > 0.0) {
+      gyro_yaw_since_ticks_ += (rate - ekf_.gyro_bias()) * dt;
+      ekf_.PredictGyro(rate, dt);
+      gyro_since_ticks_ = true;
+    }
+  }
+  last_imu_time_ = imu.time;
+  // Encoder ticks are coarse (a slow turn can leave an interval without a tick), so only a run
+  // of still intervals counts, and a sample far from the bias (chi2_1 at 0.999) is no standstill.
+  if (still_intervals_ >= kStillIntervals && options_.filter.zero_rate_updates) {
+    const double innovation = rate - ekf_.gyro_bias();
+    const double variance = ekf_.covariance()(6, 6) +
+                            options_.filter.gyro_sigma_rad_s * options_.filter.gyro_sigma_rad_s;
+    if (innovation * innovation < kZeroRateGate * variance) {
+      ekf_.UpdateZeroRate(rate);
+      ++zero_rate_updates_;
+    }
+  }
+}
+
+void EkfEstimator::AddTicks(const WheelTicks& ticks) {
+  const double metres_per_tick = robot_.MetresPerTick();
+  const double right_m = MeanTicks(ticks.right_ticks) * metres_per_tick;
+  const double left_m = MeanTicks(ticks.left_ticks) * metres_per_tick;
+  ekf_.PredictWheels(
+      right_m, left_m, robot_.track_width_m,
+      gyro_since_ticks_ ? std::optional<double>(gyro_yaw_since_ticks_) : std::nullopt);
+  still_intervals_ = right_m == 0.0 && left_m == 0.0 ? still_intervals_ + 1 : 0;
+  saw_ticks_ = true;
+  gyro_since_ticks_ = false;
+  gyro_yaw_since_ticks_ = 0.0;
+}
+
+ScanEstimate EkfEstimator::AddScan(const SyncedScan& scan) {
+  const bool first = scans_ == 0;
+  ++scans_;
+  if (first) {
+    ekf_.ResetPose(Pose2());
+  } else if (!saw_ticks_) {
+    const double distance = scan.increment.translation().norm();
+    ekf_.PredictIncrement(scan.increment, distance, scan.increment.theta());
+  }
+  ScanEstimate estimate;
+  if (options_.scan_matching) {
+    const Pose2 prior = ekf_.clone().Between(ekf_.pose());
+    const IcpOdometryStep step = icp_.Add(scan.scan, prior);
+    const bool usable =
+        step.outcome == IcpOdometryOutcome::kMatched ||
+        (options_.update_on_degenerate && step.outcome == IcpOdometryOutcome::kDegenerate);
+    if (!first && usable) {
+      // The match's covariance of the absolute pose in the ICP frame, as the covariance of the
+      // increment in the previous scan's frame (that pose held fixed), inflated and floored.
+      Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+      const double c = std::cos(icp_previous_.theta()), s = std::sin(icp_previous_.theta());
+      rotation.topLeftCorner<2, 2>() << c, s, -s, c;
+      Eigen::Matrix3d r =
+          options_.match_covariance_scale * rotation * step.covariance * rotation.transpose();
+      r(0, 0) += options_.match_sigma_floor_xy_m * options_.match_sigma_floor_xy_m;
+      r(1, 1) += options_.match_sigma_floor_xy_m * options_.match_sigma_floor_xy_m;
+      r(2, 2) += options_.match_sigma_floor_yaw_rad * options_.match_sigma_floor_yaw_rad;
+      const EkfUpdate update = ekf_.UpdateRelativePose(icp_previous_.Between(step.pose), r);
+      nis_sum_ += update.nis;
+      ++scan_updates_;
+      estimate.trace.push_back({"nis", update.nis});
+    }
+    icp_previous_ = step.pose;
+  }
+  ekf_.Clone();
+  estimate.pose = ekf_.pose();
+  estimate.covariance = ekf_.PoseCovariance();
+  estimate.trace.push_back({"gyro_bias_rad_s", ekf_.gyro_bias()});
+  map_.InsertScan(scan.scan, estimate.pose);
+  return estimate;
+}
+
+std::map<std::string, double> EkfEstimator::Statistics() const {
+  return {{"gyro_bias_rad_s", ekf_.gyro_bias()},
+          {"scan_updates", scan_updates_},
+          {"zero_rate_updates", zero_rate_updates_},
+          {"mean_nis", scan_updates_ > 0 ? nis_sum_ / scan_updates_ : 0.0}};
+}
+
+}  // namespace slamrig::slam
