@@ -23,6 +23,8 @@ struct ConfigResult {
   slam::EstimatorRun run;    ///< everything it produced, in its own frame (map, traces, stats)
   Pose2 map_from_estimator;  ///< the reference pose at the estimator's first scan
   std::map<std::string, double> metrics;  ///< MetricsOf() names; NaN when not applicable
+  /// Per run.loop_closures entry: agrees with the reference (empty without one).
+  std::vector<bool> loop_is_true;
 };
 
 /// One checked expectation.

@@ -3,9 +3,11 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <queue>
+#include <set>
 #include <utility>
 
 #include "slam/matching/correlative_matcher.h"
@@ -55,6 +57,19 @@ PointRaster RasterOf(const std::vector<Eigen::Vector2d>& points, double resoluti
   }
   raster.view = GridView{raster.values.data(), width, height, lo, resolution_m};
   return raster;
+}
+
+// The first point of each voxel of size `voxel_m`, in the given order.
+std::vector<Eigen::Vector2d> Thinned(const std::vector<Eigen::Vector2d>& points, double voxel_m) {
+  std::set<std::pair<std::int64_t, std::int64_t>> seen;
+  std::vector<Eigen::Vector2d> kept;
+  for (const Eigen::Vector2d& p : points) {
+    const std::pair<std::int64_t, std::int64_t> key{
+        static_cast<std::int64_t>(std::floor(p.x() / voxel_m)),
+        static_cast<std::int64_t>(std::floor(p.y() / voxel_m))};
+    if (seen.insert(key).second) kept.push_back(p);
+  }
+  return kept;
 }
 
 }  // namespace
@@ -174,32 +189,44 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vec
 }
 
 std::vector<Eigen::Vector2d> GraphSlam::PathVariances() const {
-  // Dijkstra from the newest node on the summed (xy + yaw) variance of the edges (1 m lever).
+  // Dijkstra from the newest node on the position variance. Walking back along an edge of length
+  // l adds its own xy variance and its yaw variance times the squared lever from it to the newest
+  // node (the path length so far): a heading error at distance r moves the end by r * error.
+  struct State {
+    double xy = std::numeric_limits<double>::infinity();
+    double yaw = 0.0;
+    double length = 0.0;
+  };
   const std::size_t n = nodes_.size();
-  std::vector<std::vector<std::pair<int, Eigen::Vector2d>>> adjacent(n);
+  std::vector<std::vector<std::pair<int, std::size_t>>> adjacent(n);
   const std::vector<PoseGraphEdge>& edges = graph_.edges();
   for (std::size_t e = 0; e < edges.size(); ++e) {
-    adjacent[edges[e].from].emplace_back(edges[e].to, edge_variances_[e]);
-    adjacent[edges[e].to].emplace_back(edges[e].from, edge_variances_[e]);
+    adjacent[edges[e].from].emplace_back(edges[e].to, e);
+    adjacent[edges[e].to].emplace_back(edges[e].from, e);
   }
-  const double kInf = std::numeric_limits<double>::infinity();
-  std::vector<Eigen::Vector2d> variance(n, Eigen::Vector2d::Constant(kInf));
+  std::vector<State> state(n);
   using Item = std::pair<double, int>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-  variance[n - 1].setZero();
+  state[n - 1] = State{0.0, 0.0, 0.0};
   queue.emplace(0.0, static_cast<int>(n - 1));
   while (!queue.empty()) {
     const auto [cost, u] = queue.top();
     queue.pop();
-    if (cost > variance[u].sum()) continue;
-    for (const auto& [w, edge_variance] : adjacent[u]) {
-      const Eigen::Vector2d candidate = variance[u] + edge_variance;
-      if (candidate.sum() < variance[w].sum()) {
-        variance[w] = candidate;
-        queue.emplace(candidate.sum(), w);
+    if (cost > state[u].xy) continue;
+    for (const auto& [w, e] : adjacent[u]) {
+      const double length = state[u].length + edges[e].measurement.translation().norm();
+      const State next{
+          state[u].xy + edge_variances_[e].x() + edge_variances_[e].y() * length * length,
+          state[u].yaw + edge_variances_[e].y(), length};
+      if (next.xy < state[w].xy) {
+        state[w] = next;
+        queue.emplace(next.xy, w);
       }
     }
   }
+  std::vector<Eigen::Vector2d> variance;
+  variance.reserve(n);
+  for (const State& s : state) variance.emplace_back(s.xy, s.yaw);
   return variance;
 }
 
@@ -213,7 +240,7 @@ void GraphSlam::SearchLoops() {
   std::vector<std::pair<double, int>> candidates;
   for (int j = 0; j <= newest_candidate; ++j) {
     const double d = (graph_.pose(j).translation() - here.translation()).norm();
-    const double var_xy = variance[j].x() + variance[j].y() * d * d;
+    const double var_xy = variance[j].x();
     const double radius =
         std::min(options_.loop_max_search_radius_m,
                  options_.loop_search_radius_m + options_.loop_radius_sigmas * std::sqrt(var_xy));
@@ -242,8 +269,7 @@ void GraphSlam::SearchLoops() {
 std::optional<PoseGraphEdge> GraphSlam::TryClosure(int candidate, const Eigen::Vector2d& variance) {
   const int current = static_cast<int>(nodes_.size()) - 1;
   const Pose2 guess = graph_.pose(candidate).Between(graph_.pose(current));
-  const double d = guess.translation().norm();
-  const double var_xy = variance.x() + variance.y() * d * d;
+  const double var_xy = variance.x();
   const double var_yaw = variance.y();
 
   // The candidate's submap (its neighbours that are old enough) and the current side's points.
@@ -259,6 +285,7 @@ std::optional<PoseGraphEdge> GraphSlam::TryClosure(int candidate, const Eigen::V
     const Pose2 current_from_k = graph_.pose(current).Between(graph_.pose(k));
     for (const Eigen::Vector2d& p : nodes_[k].points) query.push_back(current_from_k * p);
   }
+  query = Thinned(query, options_.submap_resolution_m);
   if (submap.size() < 10 || query.size() < 10) return std::nullopt;
 
   // Correlative search within the uncertainty (Olson 2009), then ICP against the points.

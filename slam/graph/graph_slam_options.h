@@ -55,11 +55,11 @@ struct GraphSlamOptions {
   double loop_search_radius_m = 1.0;
   double loop_radius_sigmas = 3.0;
   double loop_max_search_radius_m = 6.0;
-  int loop_max_candidates = 2;  ///< ... the nearest few per new node
+  int loop_max_candidates = 1;  ///< ... the nearest few per new node
   /// Submap of a candidate: the scans of the nodes within +-this many of it, rastered ...
   int submap_half_keyframes = 5;
-  double submap_resolution_m = 0.05;  ///< ... at this resolution, each point blurred by ...
-  double submap_blur_m = 0.05;        ///< ... a Gaussian of this standard deviation
+  double submap_resolution_m = 0.1;  ///< ... at this resolution, each point blurred by ...
+  double submap_blur_m = 0.1;        ///< ... a Gaussian of this standard deviation
   /// The current side: this many last nodes' points in the current node's frame.
   int query_keyframes = 3;
   /// Correlative search (windows per candidate from the uncertainty, capped by these).

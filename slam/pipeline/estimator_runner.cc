@@ -64,6 +64,7 @@ EstimatorRun EstimatorRunner::TakeResult() {
     run_.final = std::move(final);
   }
   run_.statistics = estimator_->Statistics();
+  run_.loop_closures = estimator_->LoopClosures();
   run_.map = estimator_->map();
   run_.gyro_fallbacks = sync_.gyro_fallbacks();
   run_.scans_without_odometry = sync_.scans_without_odometry();
