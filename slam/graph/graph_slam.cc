@@ -1,6 +1,7 @@
 #include "slam/graph/graph_slam.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -116,6 +117,11 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
     errors.push_back(RuleViolation("loop_min_icp_score", loop_min_icp_score, "must be in [0, 1]"));
   }
   positive("loop_max_refinement_m", loop_max_refinement_m);
+  positive("loop_max_search_stddev_m", loop_max_search_stddev_m);
+  if (!(loop_max_covariance_ratio > 1.0)) {
+    errors.push_back(
+        RuleViolation("loop_max_covariance_ratio", loop_max_covariance_ratio, "must be > 1"));
+  }
   positive("loop_chi2_gate", loop_chi2_gate);
   positive("loop_sigma_xy_floor_m", loop_sigma_xy_floor_m);
   positive("loop_sigma_yaw_floor_rad", loop_sigma_yaw_floor_rad);
@@ -304,6 +310,18 @@ std::optional<PoseGraphEdge> GraphSlam::TryClosure(int candidate, const Eigen::V
   if (!fine || fine->score < options_.loop_min_icp_score ||
       (fine->pose.translation() - coarse->pose.translation()).norm() >
           options_.loop_max_refinement_m) {
+    return std::nullopt;
+  }
+
+  // Ambiguity: a flat score or an elongated ICP covariance (a corridor) says nothing reliable.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> coarse_spread(
+      coarse->covariance.topLeftCorner<2, 2>());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> fine_spread(
+      fine->covariance.topLeftCorner<2, 2>());
+  if (coarse_spread.eigenvalues()[1] >
+          options_.loop_max_search_stddev_m * options_.loop_max_search_stddev_m ||
+      fine_spread.eigenvalues()[1] >
+          options_.loop_max_covariance_ratio * std::max(fine_spread.eigenvalues()[0], 1e-300)) {
     return std::nullopt;
   }
 

@@ -74,6 +74,11 @@ struct GraphSlamOptions {
       .max_correspondence_distance_m = 0.3, .trim_fraction = 0.9, .kernel = RobustKernel::kCauchy};
   double loop_min_icp_score = 0.7;     ///< inlier share of the refined match
   double loop_max_refinement_m = 0.3;  ///< ICP may move the correlative pose at most this far
+  /// Ambiguity: the correlative score's spread (Olson's covariance) along its worst direction
+  /// must stay below this standard deviation (a corridor slides along its axis) ...
+  double loop_max_search_stddev_m = 0.15;
+  /// ... and ICP's covariance may not be more elongated than this eigenvalue ratio.
+  double loop_max_covariance_ratio = 100.0;
   /// Geometric verification: the closure's Mahalanobis distance to the graph's own relative pose
   /// (with the accumulated and the match covariance) must be below this chi2 (3 dof; 99.9 %).
   double loop_chi2_gate = 16.27;
@@ -114,6 +119,8 @@ void VisitFields(V& v, GraphSlamOptions& o) {
   v.Struct("loop_icp", o.loop_icp);
   v("loop_min_icp_score", o.loop_min_icp_score);
   v("loop_max_refinement_m", o.loop_max_refinement_m);
+  v("loop_max_search_stddev_m", o.loop_max_search_stddev_m);
+  v("loop_max_covariance_ratio", o.loop_max_covariance_ratio);
   v("loop_chi2_gate", o.loop_chi2_gate);
   v("loop_sigma_xy_floor_m", o.loop_sigma_xy_floor_m);
   v("loop_sigma_yaw_floor_rad", o.loop_sigma_yaw_floor_rad);
