@@ -57,7 +57,9 @@ void RunWhole(benchmark::State& state, ParticleFilterOptions options) {
   double rmse = 0.0;
   for (auto _ : state) {
     // Through the Estimator interface, as every command runs it.
-    ParticleFilterEstimator estimator(options, EstimatorContext{1});
+    EstimatorContext context;
+    context.seed = 1;
+    ParticleFilterEstimator estimator(options, context);
     Trajectory trajectory;
     for (const SyncedScan& s : run.scans) trajectory.Append(s.scan.time, estimator.AddScan(s).pose);
     rmse = PositionRmse(trajectory, run.truth);

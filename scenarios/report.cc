@@ -218,6 +218,21 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
       estimate_overlay.trajectory = &estimate_local;
       slam::MapImageOptions own;
       own.title = c.name + ": its own map and trajectory";
+      // Its loop closures: green when they agree with the reference (or there is none), red not.
+      const auto& final_poses = c.run.final.poses();
+      for (std::size_t k = 0; k < c.run.loop_closures.size(); ++k) {
+        const slam::LoopClosure& loop = c.run.loop_closures[k];
+        if (loop.from_scan < 0 || loop.to_scan < 0 ||
+            static_cast<std::size_t>(std::max(loop.from_scan, loop.to_scan)) >=
+                final_poses.size()) {
+          continue;
+        }
+        const bool ok = k >= c.loop_is_true.size() || c.loop_is_true[k];
+        own.segments.push_back({final_poses[loop.from_scan].pose.translation(),
+                                final_poses[loop.to_scan].pose.translation(), 0,
+                                static_cast<std::uint8_t>(ok ? 170 : 0),
+                                static_cast<std::uint8_t>(ok ? 0 : 220)});
+      }
       slam::WriteMapPng(file(c.name + "_map.png"), c.run.map, {truth_overlay, estimate_overlay},
                         own);
       html_maps += "<figure><img src=\"" + c.name + "_map.png\"><figcaption>" + Html(c.name) +

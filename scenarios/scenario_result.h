@@ -27,6 +27,8 @@ struct ConfigResult {
   /// the scans' times in seconds.
   std::vector<double> nees_time_s;
   std::vector<double> nees;
+  /// Per run.loop_closures entry: agrees with the reference (empty without one).
+  std::vector<bool> loop_is_true;
 };
 
 /// One checked expectation.

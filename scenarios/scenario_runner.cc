@@ -6,6 +6,7 @@
 
 #include "scenarios/live_view.h"
 #include "sim/simulator.h"
+#include "slam/eval/loop_closure_score.h"
 #include "slam/eval/map_score.h"
 #include "slam/eval/pose_association.h"
 #include "slam/eval/trajectory_error.h"
@@ -118,6 +119,16 @@ void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
   if (!pairs.empty()) {
     m["final_error_m"] =
         (pairs.back().reference.translation() - pairs.back().estimate.translation()).norm();
+  }
+  // Loop closures against the reference: one reference pose per scan, in scan order.
+  if (run.truth.size() == c->estimate.size()) {
+    std::vector<Pose2> reference;
+    for (const StampedPose& p : run.truth.poses()) reference.push_back(p.pose);
+    const slam::LoopClosureScore loops = slam::ScoreLoopClosures(c->run.loop_closures, reference);
+    m["loop_precision"] = loops.precision;
+    m["loop_recall"] = loops.recall;
+    m["false_loop_closures"] = loops.false_closures;
+    c->loop_is_true = loops.is_true;
   }
   if (run.truth_map) {
     // A simulation's map is scored where the estimate starts (on the truth); a log's reference

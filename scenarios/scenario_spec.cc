@@ -115,12 +115,30 @@ std::vector<sim::ObstacleSpec> MakeCrowd(const YamlNode& node, const sim::DriveO
 }  // namespace
 
 const std::vector<std::string>& KnownMetrics() {
-  static const std::vector<std::string> metrics = {
-      "ate_rmse_m",        "ate_mean_m",     "ate_median_m", "ate_max_m",     "ate_rot_rmse_rad",
-      "online_ate_rmse_m", "rpe_m_per_scan", "rpe_m_per_1m", "rpe_m_per_10m", "rpe_rad_per_10m",
-      "final_error_m",     "map_f1",         "map_iou",      "map_precision", "map_recall",
-      "realtime_factor",   "scans",          "mean_nees",    "final_nees",    "nees_lower_95",
-      "nees_upper_95"};
+  static const std::vector<std::string> metrics = {"ate_rmse_m",
+                                                   "ate_mean_m",
+                                                   "ate_median_m",
+                                                   "ate_max_m",
+                                                   "ate_rot_rmse_rad",
+                                                   "online_ate_rmse_m",
+                                                   "rpe_m_per_scan",
+                                                   "rpe_m_per_1m",
+                                                   "rpe_m_per_10m",
+                                                   "rpe_rad_per_10m",
+                                                   "final_error_m",
+                                                   "map_f1",
+                                                   "map_iou",
+                                                   "map_precision",
+                                                   "map_recall",
+                                                   "realtime_factor",
+                                                   "scans",
+                                                   "mean_nees",
+                                                   "final_nees",
+                                                   "nees_lower_95",
+                                                   "nees_upper_95",
+                                                   "loop_precision",
+                                                   "loop_recall",
+                                                   "false_loop_closures"};
   return metrics;
 }
 

@@ -111,6 +111,14 @@ std::string RenderMapPng(const OccupancyGrid& grid, const std::vector<Trajectory
     if (!points.empty())
       cv::circle(image, points.front(), 3 * thickness, colour, cv::FILLED, cv::LINE_AA);
   }
+  // Segments (loop closures), thin, over the trajectories.
+  for (const SegmentOverlay& segment : options.segments) {
+    const cv::Point2d a = to_pixel(segment.a), b = to_pixel(segment.b);
+    cv::line(image, {static_cast<int>(std::lround(a.x)), static_cast<int>(std::lround(a.y))},
+             {static_cast<int>(std::lround(b.x)), static_cast<int>(std::lround(b.y))},
+             cv::Scalar(segment.blue, segment.green, segment.red), std::max(1, thickness / 2),
+             cv::LINE_AA);
+  }
   // Legend: title, one line per trajectory, scale bar.
   int y = 24;
   if (!options.title.empty()) {

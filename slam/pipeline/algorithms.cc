@@ -4,6 +4,8 @@
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/dead_reckoning_estimator.h"
 #include "slam/pipeline/ekf_estimator.h"
+#include "slam/pipeline/graph_slam_estimator.h"
+#include "slam/pipeline/icp_odometry_estimator.h"
 #include "slam/pipeline/particle_filter_estimator.h"
 
 namespace slamrig::slam {
@@ -36,6 +38,25 @@ const std::vector<Algorithm>& Algorithms() {
        {"gyro_bias_rad_s", "scan_updates", "zero_rate_updates", "mean_nis"},
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<AlgorithmOptionsFor<EkfOptions, EkfEstimator>>(EkfOptions{});
+       }},
+      {"icp-odometry",
+       "scan-to-local-map point-to-line ICP with the wheel odometry as prior, the map along it",
+       {"default"},
+       {"matched", "degenerate", "failed"},
+       [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
+         return std::make_unique<
+             AlgorithmOptionsFor<IcpOdometryEstimatorOptions, IcpOdometryEstimator>>(
+             IcpOdometryEstimatorOptions{});
+       }},
+      {"graph",
+       "graph SLAM: ICP odometry keyframes, loop closures by correlative matching verified by "
+       "ICP and a chi2 gate, Ceres with a robust loss",
+       {"default"},
+       {"keyframes", "loop_closures", "loop_candidates", "rejected", "optimizations", "final_chi2"},
+       [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
+         return std::make_unique<
+             AlgorithmOptionsFor<GraphSlamEstimatorOptions, GraphSlamEstimator>>(
+             GraphSlamEstimatorOptions{});
        }},
   };
   return algorithms;

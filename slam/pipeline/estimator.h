@@ -8,6 +8,7 @@
 
 #include "slam/grid/occupancy_grid.h"
 #include "slam/odometry/scan_sync.h"
+#include "slam/types/loop_closure.h"
 #include "slam/types/pose2.h"
 #include "slam/types/records.h"
 #include "slam/types/trajectory.h"
@@ -70,6 +71,8 @@ class Estimator {
   virtual const OccupancyGrid& map() const = 0;
   /// Named statistics for metrics.json (e.g. "mean_neff", "resamples", "loop_closures").
   virtual std::map<std::string, double> Statistics() const { return {}; }
+  /// The loop closures it accepted (scan indices in AddScan order), for scoring; default none.
+  virtual std::vector<LoopClosure> LoopClosures() const { return {}; }
   /// Extras for the live view.
   virtual EstimatorView View() const { return {}; }
 };

@@ -32,6 +32,7 @@ struct EstimatorRun {
   std::vector<double> trace_time_s;                        ///< scan times of the traces, seconds
   std::map<std::string, std::vector<double>> traces;       ///< per-scan values by name
   std::map<std::string, double> statistics;                ///< Estimator::Statistics() at the end
+  std::vector<LoopClosure> loop_closures;                  ///< Estimator::LoopClosures() at the end
   OccupancyGrid map{OccupancyGridOptions{}};               ///< the final map
   OdometrySource odometry_source = OdometrySource::kNone;  ///< the odometry used
   int gyro_fallbacks = 0;          ///< intervals without IMU samples (ScanSynchronizer)

@@ -1,0 +1,360 @@
+#include "slam/graph/graph_slam.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <set>
+#include <utility>
+
+#include "slam/matching/correlative_matcher.h"
+#include "slam/matching/grid_view.h"
+#include "slam/matching/icp_matcher.h"
+#include "slam/matching/scan_points.h"
+#include "slam/types/check.h"
+#include "slam/types/validation.h"
+
+namespace slamrig::slam {
+namespace {
+
+// A raster of `points` with each point blurred by a Gaussian of `sigma_m` (the maximum where they
+// overlap): Olson 2009's rasterised cost, a likelihood field up to scale, values in [0, 1].
+struct PointRaster {
+  std::vector<float> values;
+  GridView view;
+};
+
+PointRaster RasterOf(const std::vector<Eigen::Vector2d>& points, double resolution_m,
+                     double sigma_m) {
+  PointRaster raster;
+  Eigen::Vector2d lo = points.front(), hi = points.front();
+  for (const Eigen::Vector2d& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const int reach = static_cast<int>(std::ceil(3.0 * sigma_m / resolution_m));
+  const double margin = (reach + 1) * resolution_m;
+  lo -= Eigen::Vector2d::Constant(margin);
+  hi += Eigen::Vector2d::Constant(margin);
+  const int width = static_cast<int>(std::ceil((hi.x() - lo.x()) / resolution_m));
+  const int height = static_cast<int>(std::ceil((hi.y() - lo.y()) / resolution_m));
+  raster.values.assign(static_cast<std::size_t>(width) * height, 0.0f);
+  const double inv_two_var = 1.0 / (2.0 * sigma_m * sigma_m);
+  for (const Eigen::Vector2d& p : points) {
+    const int cx = static_cast<int>(std::floor((p.x() - lo.x()) / resolution_m));
+    const int cy = static_cast<int>(std::floor((p.y() - lo.y()) / resolution_m));
+    for (int iy = std::max(0, cy - reach); iy <= std::min(height - 1, cy + reach); ++iy) {
+      for (int ix = std::max(0, cx - reach); ix <= std::min(width - 1, cx + reach); ++ix) {
+        const Eigen::Vector2d center = lo + resolution_m * Eigen::Vector2d(ix + 0.5, iy + 0.5);
+        const auto value = static_cast<float>(std::exp(-(center - p).squaredNorm() * inv_two_var));
+        float& cell = raster.values[static_cast<std::size_t>(iy) * width + ix];
+        cell = std::max(cell, value);
+      }
+    }
+  }
+  raster.view = GridView{raster.values.data(), width, height, lo, resolution_m};
+  return raster;
+}
+
+// The first point of each voxel of size `voxel_m`, in the given order.
+std::vector<Eigen::Vector2d> Thinned(const std::vector<Eigen::Vector2d>& points, double voxel_m) {
+  std::set<std::pair<std::int64_t, std::int64_t>> seen;
+  std::vector<Eigen::Vector2d> kept;
+  for (const Eigen::Vector2d& p : points) {
+    const std::pair<std::int64_t, std::int64_t> key{
+        static_cast<std::int64_t>(std::floor(p.x() / voxel_m)),
+        static_cast<std::int64_t>(std::floor(p.y() / voxel_m))};
+    if (seen.insert(key).second) kept.push_back(p);
+  }
+  return kept;
+}
+
+}  // namespace
+
+std::vector<std::string> GraphSlamOptions::Validate() const {
+  std::vector<std::string> errors;
+  const std::string prefix = "icp_odometry.";
+  for (std::string e : odometry.Validate()) {
+    errors.push_back("odometry_icp." + (e.rfind(prefix, 0) == 0 ? e.substr(prefix.size()) : e));
+  }
+  auto positive = [&](const char* field, double value) {
+    if (!(value > 0.0)) errors.push_back(RuleViolation(field, value, "must be > 0"));
+  };
+  auto non_negative = [&](const char* field, double value) {
+    if (!(value >= 0.0)) errors.push_back(RuleViolation(field, value, "must be >= 0"));
+  };
+  non_negative("keyframe_distance_m", keyframe_distance_m);
+  non_negative("keyframe_angle_rad", keyframe_angle_rad);
+  non_negative("edge_sigma_xy_per_m", edge_sigma_xy_per_m);
+  positive("edge_sigma_xy_floor_m", edge_sigma_xy_floor_m);
+  non_negative("edge_sigma_yaw_per_rad", edge_sigma_yaw_per_rad);
+  non_negative("edge_sigma_yaw_per_m", edge_sigma_yaw_per_m);
+  positive("edge_sigma_yaw_floor_rad", edge_sigma_yaw_floor_rad);
+  if (loop_skip_keyframes < 1) {
+    errors.push_back(RuleViolation("loop_skip_keyframes", loop_skip_keyframes, "must be >= 1"));
+  }
+  non_negative("loop_search_radius_m", loop_search_radius_m);
+  non_negative("loop_radius_sigmas", loop_radius_sigmas);
+  positive("loop_max_search_radius_m", loop_max_search_radius_m);
+  if (loop_max_candidates < 0) {
+    errors.push_back(RuleViolation("loop_max_candidates", loop_max_candidates, "must be >= 0"));
+  }
+  if (submap_half_keyframes < 0) {
+    errors.push_back(RuleViolation("submap_half_keyframes", submap_half_keyframes, "must be >= 0"));
+  }
+  positive("submap_resolution_m", submap_resolution_m);
+  positive("submap_blur_m", submap_blur_m);
+  if (query_keyframes < 1) {
+    errors.push_back(RuleViolation("query_keyframes", query_keyframes, "must be >= 1"));
+  }
+  AppendErrors(&errors, correlative.Validate());
+  for (std::string e : loop_icp.Validate()) errors.push_back("loop_" + e);
+  if (!(loop_min_icp_score >= 0.0 && loop_min_icp_score <= 1.0)) {
+    errors.push_back(RuleViolation("loop_min_icp_score", loop_min_icp_score, "must be in [0, 1]"));
+  }
+  positive("loop_max_refinement_m", loop_max_refinement_m);
+  positive("loop_max_search_stddev_m", loop_max_search_stddev_m);
+  if (!(loop_max_covariance_ratio > 1.0)) {
+    errors.push_back(
+        RuleViolation("loop_max_covariance_ratio", loop_max_covariance_ratio, "must be > 1"));
+  }
+  positive("loop_chi2_gate", loop_chi2_gate);
+  positive("loop_sigma_xy_floor_m", loop_sigma_xy_floor_m);
+  positive("loop_sigma_yaw_floor_rad", loop_sigma_yaw_floor_rad);
+  if (optimize_every_keyframes < 1) {
+    errors.push_back(
+        RuleViolation("optimize_every_keyframes", optimize_every_keyframes, "must be >= 1"));
+  }
+  AppendErrors(&errors, PrefixErrors("optimizer", optimizer.Validate()));
+  return errors;
+}
+
+GraphSlam::GraphSlam(const GraphSlamOptions& options)
+    : options_(options), odometry_(options.odometry), optimizer_(options.optimizer) {
+  SLAMRIG_CHECK(options_.Validate().empty(), "invalid GraphSlamOptions");
+}
+
+Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment) {
+  const IcpOdometryStep step = odometry_.Add(scan, odometry_increment);
+  const int index = static_cast<int>(scan_node_.size());
+  const Pose2 since = nodes_.empty() ? Pose2() : nodes_.back().odom_pose.Between(step.pose);
+  if (nodes_.empty() || since.translation().norm() >= options_.keyframe_distance_m ||
+      std::abs(since.theta()) >= options_.keyframe_angle_rad) {
+    std::vector<Eigen::Vector2d> points = ScanToBasePoints(scan, options_.odometry.points);
+    if (nodes_.empty() || !points.empty()) {
+      AddNode(index, step.pose, std::move(points));
+      SearchLoops();
+      const int added = static_cast<int>(nodes_.size()) - nodes_at_last_optimization_;
+      if (pending_closure_ && added >= options_.optimize_every_keyframes) Optimize();
+    }
+  }
+  scan_node_.push_back(static_cast<int>(nodes_.size()) - 1);
+  scan_from_node_.push_back(nodes_.back().odom_pose.Between(step.pose));
+  return graph_.pose(scan_node_.back()) * scan_from_node_.back();
+}
+
+void GraphSlam::Finish() {
+  if (pending_closure_) Optimize();
+}
+
+std::vector<Pose2> GraphSlam::Poses() const {
+  std::vector<Pose2> poses;
+  poses.reserve(scan_node_.size());
+  for (std::size_t i = 0; i < scan_node_.size(); ++i) {
+    poses.push_back(graph_.pose(scan_node_[i]) * scan_from_node_[i]);
+  }
+  return poses;
+}
+
+void GraphSlam::AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vector2d> points) {
+  const int id = static_cast<int>(nodes_.size());
+  Node node{scan, odom_pose, std::move(points), Eigen::Vector2d::Zero()};
+  if (nodes_.empty()) {
+    graph_.AddVertex(id, Pose2(), /*fixed=*/true);
+  } else {
+    const Pose2 relative = nodes_.back().odom_pose.Between(odom_pose);
+    const double d = relative.translation().norm();
+    const double sxy = options_.edge_sigma_xy_per_m * d + options_.edge_sigma_xy_floor_m;
+    const double syaw = options_.edge_sigma_yaw_per_rad * std::abs(relative.theta()) +
+                        options_.edge_sigma_yaw_per_m * d + options_.edge_sigma_yaw_floor_rad;
+    node.edge_variance = {sxy * sxy, syaw * syaw};
+    graph_.AddVertex(id, graph_.pose(id - 1) * relative);
+    PoseGraphEdge edge{
+        id - 1, id, relative,
+        Eigen::Vector3d(1.0 / (sxy * sxy), 1.0 / (sxy * sxy), 1.0 / (syaw * syaw)).asDiagonal(),
+        EdgeKind::kOdometry};
+    graph_.AddEdge(edge);
+    edge_variances_.push_back(node.edge_variance);
+  }
+  nodes_.push_back(std::move(node));
+  ++counts_.keyframes;
+}
+
+std::vector<Eigen::Vector2d> GraphSlam::PathVariances() const {
+  // Dijkstra from the newest node on the position variance. Walking back along an edge of length
+  // l adds its own xy variance and its yaw variance times the squared lever from it to the newest
+  // node (the path length so far): a heading error at distance r moves the end by r * error.
+  struct State {
+    double xy = std::numeric_limits<double>::infinity();
+    double yaw = 0.0;
+    double length = 0.0;
+  };
+  const std::size_t n = nodes_.size();
+  std::vector<std::vector<std::pair<int, std::size_t>>> adjacent(n);
+  const std::vector<PoseGraphEdge>& edges = graph_.edges();
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    adjacent[edges[e].from].emplace_back(edges[e].to, e);
+    adjacent[edges[e].to].emplace_back(edges[e].from, e);
+  }
+  std::vector<State> state(n);
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  state[n - 1] = State{0.0, 0.0, 0.0};
+  queue.emplace(0.0, static_cast<int>(n - 1));
+  while (!queue.empty()) {
+    const auto [cost, u] = queue.top();
+    queue.pop();
+    if (cost > state[u].xy) continue;
+    for (const auto& [w, e] : adjacent[u]) {
+      const double length = state[u].length + edges[e].measurement.translation().norm();
+      const State next{
+          state[u].xy + edge_variances_[e].x() + edge_variances_[e].y() * length * length,
+          state[u].yaw + edge_variances_[e].y(), length};
+      if (next.xy < state[w].xy) {
+        state[w] = next;
+        queue.emplace(next.xy, w);
+      }
+    }
+  }
+  std::vector<Eigen::Vector2d> variance;
+  variance.reserve(n);
+  for (const State& s : state) variance.emplace_back(s.xy, s.yaw);
+  return variance;
+}
+
+void GraphSlam::SearchLoops() {
+  const int current = static_cast<int>(nodes_.size()) - 1;
+  const int newest_candidate = current - options_.loop_skip_keyframes;
+  if (newest_candidate < 0 || options_.loop_max_candidates == 0) return;
+  const std::vector<Eigen::Vector2d> variance = PathVariances();
+  const Pose2& here = graph_.pose(current);
+  // Candidates: within the radius grown by the uncertainty accumulated since them, nearest first.
+  std::vector<std::pair<double, int>> candidates;
+  for (int j = 0; j <= newest_candidate; ++j) {
+    const double d = (graph_.pose(j).translation() - here.translation()).norm();
+    const double var_xy = variance[j].x();
+    const double radius =
+        std::min(options_.loop_max_search_radius_m,
+                 options_.loop_search_radius_m + options_.loop_radius_sigmas * std::sqrt(var_xy));
+    if (d <= radius) candidates.emplace_back(d, j);
+  }
+  std::sort(candidates.begin(), candidates.end());
+  if (static_cast<int>(candidates.size()) > options_.loop_max_candidates) {
+    candidates.resize(static_cast<std::size_t>(options_.loop_max_candidates));
+  }
+  for (const auto& [d, j] : candidates) {
+    ++counts_.loop_candidates;
+    std::optional<PoseGraphEdge> edge = TryClosure(j, variance[j]);
+    if (!edge) {
+      ++counts_.rejected;
+      continue;
+    }
+    graph_.AddEdge(*edge);
+    const Eigen::Matrix3d covariance = edge->information.inverse();
+    edge_variances_.emplace_back(covariance(0, 0) + covariance(1, 1), covariance(2, 2));
+    closures_.push_back({nodes_[j].scan, nodes_[current].scan, edge->measurement});
+    ++counts_.loop_closures;
+    pending_closure_ = true;
+  }
+}
+
+std::optional<PoseGraphEdge> GraphSlam::TryClosure(int candidate, const Eigen::Vector2d& variance) {
+  const int current = static_cast<int>(nodes_.size()) - 1;
+  const Pose2 guess = graph_.pose(candidate).Between(graph_.pose(current));
+  const double var_xy = variance.x();
+  const double var_yaw = variance.y();
+
+  // The candidate's submap (its neighbours that are old enough) and the current side's points.
+  std::vector<Eigen::Vector2d> submap;
+  const int newest = current - options_.loop_skip_keyframes;
+  for (int k = std::max(0, candidate - options_.submap_half_keyframes);
+       k <= std::min(newest, candidate + options_.submap_half_keyframes); ++k) {
+    const Pose2 candidate_from_k = graph_.pose(candidate).Between(graph_.pose(k));
+    for (const Eigen::Vector2d& p : nodes_[k].points) submap.push_back(candidate_from_k * p);
+  }
+  std::vector<Eigen::Vector2d> query;
+  for (int k = std::max(0, current - options_.query_keyframes + 1); k <= current; ++k) {
+    const Pose2 current_from_k = graph_.pose(current).Between(graph_.pose(k));
+    for (const Eigen::Vector2d& p : nodes_[k].points) query.push_back(current_from_k * p);
+  }
+  query = Thinned(query, options_.submap_resolution_m);
+  if (submap.size() < 10 || query.size() < 10) return std::nullopt;
+
+  // Correlative search within the uncertainty (Olson 2009), then ICP against the points.
+  const PointRaster raster = RasterOf(submap, options_.submap_resolution_m, options_.submap_blur_m);
+  CorrelativeMatcherOptions search = options_.correlative;
+  search.linear_window_m =
+      std::min(search.linear_window_m,
+               options_.loop_search_radius_m + options_.loop_radius_sigmas * std::sqrt(var_xy));
+  search.angular_window_rad =
+      std::min(search.angular_window_rad, 0.1 + options_.loop_radius_sigmas * std::sqrt(var_yaw));
+  const std::optional<MatchResult> coarse =
+      CorrelativeMatcher(search, raster.view).Match(query, guess);
+  if (!coarse) return std::nullopt;
+  const std::optional<MatchResult> fine =
+      IcpMatcher(options_.loop_icp, submap).Match(query, coarse->pose);
+  if (!fine || fine->score < options_.loop_min_icp_score ||
+      (fine->pose.translation() - coarse->pose.translation()).norm() >
+          options_.loop_max_refinement_m) {
+    return std::nullopt;
+  }
+
+  // Ambiguity: a flat score or an elongated ICP covariance (a corridor) says nothing reliable.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> coarse_spread(
+      coarse->covariance.topLeftCorner<2, 2>());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> fine_spread(
+      fine->covariance.topLeftCorner<2, 2>());
+  if (coarse_spread.eigenvalues()[1] >
+          options_.loop_max_search_stddev_m * options_.loop_max_search_stddev_m ||
+      fine_spread.eigenvalues()[1] >
+          options_.loop_max_covariance_ratio * std::max(fine_spread.eigenvalues()[0], 1e-300)) {
+    return std::nullopt;
+  }
+
+  // Geometric verification: the closure must agree with the graph within its uncertainty.
+  Eigen::Matrix3d measurement_covariance = fine->covariance;
+  measurement_covariance(0, 0) += options_.loop_sigma_xy_floor_m * options_.loop_sigma_xy_floor_m;
+  measurement_covariance(1, 1) += options_.loop_sigma_xy_floor_m * options_.loop_sigma_xy_floor_m;
+  measurement_covariance(2, 2) +=
+      options_.loop_sigma_yaw_floor_rad * options_.loop_sigma_yaw_floor_rad;
+  const Eigen::Matrix3d gate_covariance =
+      measurement_covariance +
+      Eigen::Vector3d(var_xy, var_xy, var_yaw).asDiagonal().toDenseMatrix();
+  const Eigen::Vector3d error(fine->pose.x() - guess.x(), fine->pose.y() - guess.y(),
+                              NormalizeAngle(fine->pose.theta() - guess.theta()));
+  const double chi2 = error.dot(gate_covariance.ldlt().solve(error));
+  if (!(chi2 <= options_.loop_chi2_gate)) return std::nullopt;
+
+  PoseGraphEdge edge;
+  edge.from = candidate;
+  edge.to = current;
+  edge.measurement = fine->pose;
+  edge.information = measurement_covariance.inverse();
+  edge.information = 0.5 * (edge.information + edge.information.transpose());
+  edge.kind = EdgeKind::kLoopClosure;
+  return edge;
+}
+
+void GraphSlam::Optimize() {
+  const PoseGraphSummary summary = optimizer_.Optimize(&graph_);
+  counts_.final_chi2 = summary.final_chi2;
+  ++counts_.optimizations;
+  pending_closure_ = false;
+  nodes_at_last_optimization_ = static_cast<int>(nodes_.size());
+}
+
+}  // namespace slamrig::slam

@@ -1,0 +1,87 @@
+#pragma once
+
+// Graph SLAM with verified loop closures: a keyframe pose graph (Lu and Milios, "Globally
+// consistent range scan alignment for environment mapping", 1997; Grisetti et al., "A Tutorial on
+// Graph-Based SLAM", 2010, Sec. III) whose odometry edges come from scan-to-local-map ICP
+// (Censi 2008) and whose loop closures are found by correlative matching against a submap
+// (Olson 2009; Hess et al. 2016, Sec. V), refined by ICP and accepted only when they agree with
+// the graph within a chi2 gate on the accumulated uncertainty (the Mahalanobis test of
+// Neira and Tardos, "Data association in stochastic mapping using the joint compatibility
+// test", 2001, eq. 6, for a single pairing). Optimised with Ceres (g2o's error, eq. 1-2 of
+// Kümmerle et al. 2011) and a robust loss on loop closures.
+
+#include <Eigen/Core>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "slam/graph/graph_slam_options.h"
+#include "slam/graph/pose_graph.h"
+#include "slam/graph/pose_graph_optimizer.h"
+#include "slam/matching/icp_odometry.h"
+#include "slam/types/loop_closure.h"
+#include "slam/types/pose2.h"
+#include "slam/types/records.h"
+
+namespace slamrig::slam {
+
+/// Counts of what GraphSlam did.
+struct GraphSlamCounts {
+  int keyframes = 0;
+  int loop_candidates = 0;  ///< candidate pairs matched
+  int loop_closures = 0;    ///< accepted
+  int rejected = 0;         ///< candidates that failed a match or a check
+  int optimizations = 0;
+  double final_chi2 = 0.0;  ///< chi2 of the last optimisation
+};
+
+/// Online graph SLAM over laser scans with an odometry increment each. Deterministic; not
+/// thread-safe.
+class GraphSlam {
+ public:
+  /// SLAMRIG_CHECKs that options.Validate() is empty.
+  explicit GraphSlam(const GraphSlamOptions& options);
+
+  /// Adds one scan taken after `odometry_increment` (previous base to this base, wheel odometry)
+  /// and returns its pose in the graph's frame (the first scan's base frame).
+  Pose2 Add(const LaserScan& scan, const Pose2& odometry_increment);
+  /// Final optimisation.
+  void Finish();
+
+  /// The current estimate of every scan so far: its node's pose composed with the scan's pose
+  /// relative to that node.
+  std::vector<Pose2> Poses() const;
+  const std::vector<LoopClosure>& loop_closures() const { return closures_; }
+  const GraphSlamCounts& counts() const { return counts_; }
+  const PoseGraph& graph() const { return graph_; }
+
+ private:
+  struct Node {
+    int scan = 0;                         // index of its scan
+    Pose2 odom_pose;                      // IcpOdometry's pose
+    std::vector<Eigen::Vector2d> points;  // base frame
+    Eigen::Vector2d edge_variance{0, 0};  // (xy, yaw) variance of the edge from the previous
+  };
+  // Variances (xy, yaw) along the least uncertain graph path from the newest node to every node.
+  std::vector<Eigen::Vector2d> PathVariances() const;
+  void AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vector2d> points);
+  void SearchLoops();
+  std::optional<PoseGraphEdge> TryClosure(int candidate, const Eigen::Vector2d& variance);
+  void Optimize();
+
+  GraphSlamOptions options_;
+  IcpOdometry odometry_;
+  PoseGraph graph_;
+  PoseGraphOptimizer optimizer_;
+  std::vector<Node> nodes_;
+  std::vector<int> scan_node_;                   // node of each scan
+  std::vector<Pose2> scan_from_node_;            // each scan in its node's frame
+  std::vector<Eigen::Vector2d> edge_variances_;  // (xy, yaw) of each graph edge, in order
+  std::vector<LoopClosure> closures_;
+  GraphSlamCounts counts_;
+  bool pending_closure_ = false;
+  int nodes_at_last_optimization_ = 0;
+};
+
+}  // namespace slamrig::slam

@@ -1,0 +1,131 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "slam/graph/pose_graph_optimizer_options.h"
+#include "slam/matching/correlative_matcher.h"
+#include "slam/matching/icp_matcher.h"
+#include "slam/matching/icp_odometry.h"
+#include "slam/matching/matching_fields.h"
+
+namespace slamrig::slam {
+
+/// The field table of PoseGraphOptimizerOptions (slam/config/fields.h).
+template <typename V>
+void VisitFields(V& v, PoseGraphOptimizerOptions& o) {
+  v("max_iterations", o.max_iterations);
+  v.Enum("trust_region", o.trust_region,
+         {{TrustRegion::kLevenbergMarquardt, "levenberg_marquardt"},
+          {TrustRegion::kDogleg, "dogleg"}});
+  v("initial_trust_region_radius", o.initial_trust_region_radius);
+  v.Enum("robust_loss", o.robust_loss,
+         {{RobustLoss::kNone, "none"},
+          {RobustLoss::kHuber, "huber"},
+          {RobustLoss::kCauchy, "cauchy"}});
+  v("robust_loss_scale", o.robust_loss_scale);
+  v("robust_loss_on_all_edges", o.robust_loss_on_all_edges);
+  v("function_tolerance", o.function_tolerance);
+  v("gradient_tolerance", o.gradient_tolerance);
+  v("parameter_tolerance", o.parameter_tolerance);
+}
+
+/// Parameters of GraphSlam: the front end (ICP odometry, keyframes), the loop-closure search and
+/// its verification, and the back end.
+struct GraphSlamOptions {
+  /// Scan-to-local-map ICP odometry between keyframes (its own keyframes build its local map).
+  IcpOdometryOptions odometry;
+  double keyframe_distance_m = 0.5;  ///< a scan becomes a graph node after moving this far ...
+  double keyframe_angle_rad = 0.35;  ///< ... or turning this much since the last node
+  /// Odometry edge noise between consecutive nodes (d: distance, |turn|: heading change):
+  /// sigma_xy = edge_sigma_xy_per_m * d + edge_sigma_xy_floor_m, sigma_yaw =
+  /// edge_sigma_yaw_per_rad * |turn| + edge_sigma_yaw_per_m * d + edge_sigma_yaw_floor_rad. The
+  /// information is its inverse (the floors keep it regular). The translation and turn terms
+  /// are IcpOdometry's own increment noise model; heading drift per metre is ICP's, far below
+  /// the wheels'.
+  double edge_sigma_xy_per_m = 0.05;
+  double edge_sigma_xy_floor_m = 0.005;
+  double edge_sigma_yaw_per_rad = 0.05;
+  double edge_sigma_yaw_per_m = 0.005;
+  double edge_sigma_yaw_floor_rad = 0.002;
+
+  /// Loop closures are searched among nodes older than the last loop_skip_keyframes ...
+  int loop_skip_keyframes = 30;
+  /// ... within loop_search_radius_m + loop_radius_sigmas * sigma_xy (the position uncertainty
+  /// accumulated along the graph's least uncertain path since that node), at most
+  /// loop_max_search_radius_m ...
+  double loop_search_radius_m = 1.0;
+  double loop_radius_sigmas = 3.0;
+  double loop_max_search_radius_m = 6.0;
+  int loop_max_candidates = 1;  ///< ... the nearest few per new node
+  /// Submap of a candidate: the scans of the nodes within +-this many of it, rastered ...
+  int submap_half_keyframes = 5;
+  double submap_resolution_m = 0.1;  ///< ... at this resolution, each point blurred by ...
+  double submap_blur_m = 0.1;        ///< ... a Gaussian of this standard deviation
+  /// The current side: this many last nodes' points in the current node's frame.
+  int query_keyframes = 3;
+  /// Correlative search (windows per candidate from the uncertainty, capped by these).
+  CorrelativeMatcherOptions correlative = {.linear_window_m = 6.0,
+                                           .angular_window_rad = 0.8,
+                                           .branch_and_bound_depth = 6,
+                                           .min_score = 0.55};
+  /// ICP refinement of the correlative pose against the submap's points.
+  IcpOptions loop_icp = {
+      .max_correspondence_distance_m = 0.3, .trim_fraction = 0.9, .kernel = RobustKernel::kCauchy};
+  double loop_min_icp_score = 0.7;     ///< inlier share of the refined match
+  double loop_max_refinement_m = 0.3;  ///< ICP may move the correlative pose at most this far
+  /// Ambiguity: the correlative score's spread (Olson's covariance) along its worst direction
+  /// must stay below this standard deviation (a corridor slides along its axis) ...
+  double loop_max_search_stddev_m = 0.15;
+  /// ... and ICP's covariance may not be more elongated than this eigenvalue ratio.
+  double loop_max_covariance_ratio = 100.0;
+  /// Geometric verification: the closure's Mahalanobis distance to the graph's own relative pose
+  /// (with the accumulated and the match covariance) must be below this chi2 (3 dof; 99.9 %).
+  double loop_chi2_gate = 16.27;
+  /// The loop edge's covariance: ICP's, raised to at least these standard deviations.
+  double loop_sigma_xy_floor_m = 0.02;
+  double loop_sigma_yaw_floor_rad = 0.005;
+  /// Optimise when a closure was accepted and this many nodes were added since the last run.
+  int optimize_every_keyframes = 10;
+  /// The back end; Cauchy on loop closures only, by default.
+  PoseGraphOptimizerOptions optimizer = {
+      .max_iterations = 50, .robust_loss = RobustLoss::kCauchy, .robust_loss_scale = 1.0};
+
+  /// One message per broken rule, named by the field table's keys.
+  std::vector<std::string> Validate() const;
+};
+
+/// The field table of GraphSlamOptions.
+template <typename V>
+void VisitFields(V& v, GraphSlamOptions& o) {
+  v.Struct("odometry_icp", o.odometry);
+  v("keyframe_distance_m", o.keyframe_distance_m);
+  v("keyframe_angle_rad", o.keyframe_angle_rad);
+  v("edge_sigma_xy_per_m", o.edge_sigma_xy_per_m);
+  v("edge_sigma_xy_floor_m", o.edge_sigma_xy_floor_m);
+  v("edge_sigma_yaw_per_rad", o.edge_sigma_yaw_per_rad);
+  v("edge_sigma_yaw_per_m", o.edge_sigma_yaw_per_m);
+  v("edge_sigma_yaw_floor_rad", o.edge_sigma_yaw_floor_rad);
+  v("loop_skip_keyframes", o.loop_skip_keyframes);
+  v("loop_search_radius_m", o.loop_search_radius_m);
+  v("loop_radius_sigmas", o.loop_radius_sigmas);
+  v("loop_max_search_radius_m", o.loop_max_search_radius_m);
+  v("loop_max_candidates", o.loop_max_candidates);
+  v("submap_half_keyframes", o.submap_half_keyframes);
+  v("submap_resolution_m", o.submap_resolution_m);
+  v("submap_blur_m", o.submap_blur_m);
+  v("query_keyframes", o.query_keyframes);
+  v.Struct("correlative", o.correlative);
+  v.Struct("loop_icp", o.loop_icp);
+  v("loop_min_icp_score", o.loop_min_icp_score);
+  v("loop_max_refinement_m", o.loop_max_refinement_m);
+  v("loop_max_search_stddev_m", o.loop_max_search_stddev_m);
+  v("loop_max_covariance_ratio", o.loop_max_covariance_ratio);
+  v("loop_chi2_gate", o.loop_chi2_gate);
+  v("loop_sigma_xy_floor_m", o.loop_sigma_xy_floor_m);
+  v("loop_sigma_yaw_floor_rad", o.loop_sigma_yaw_floor_rad);
+  v("optimize_every_keyframes", o.optimize_every_keyframes);
+  v.Struct("optimizer", o.optimizer);
+}
+
+}  // namespace slamrig::slam

@@ -1,0 +1,123 @@
+#include "slam/graph/graph_slam.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "slam/eval/loop_closure_score.h"
+#include "slam/matching/testing/segment_world.h"
+#include "slam/odometry/scan_sync.h"
+#include "slam/pf/testing/synthetic_run.h"
+
+namespace slamrig::slam {
+namespace {
+
+// RMSE of the positions of `poses` against `truth` expressed from its first pose (both start at
+// the identity; no alignment, so drift counts in full).
+double PositionRmse(const std::vector<Pose2>& poses, const std::vector<Pose2>& truth) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    sum += (truth[0].Between(truth[i]).translation() - poses[i].translation()).squaredNorm();
+  }
+  return std::sqrt(sum / static_cast<double>(poses.size()));
+}
+
+// Truth at each scan, from the run's truth channel (one sample per scan, in order).
+std::vector<Pose2> TruthAtScans(const testing::SyntheticRun& run) {
+  std::vector<Pose2> truth;
+  for (const GroundTruthPose& t : run.truth) truth.push_back(t.map_from_base);
+  return truth;
+}
+
+TEST(GraphSlamTest, ClosesTheOfficeLoopAndBeatsOdometry) {
+  testing::SyntheticRunOptions options;
+  options.waypoints = testing::OfficeLoop();
+  options.laps = 2;
+  options.max_duration_s = 140.0;  // 70 m: one lap and a third
+  options.scan_rate_hz = 10.0;
+  options.lidar.num_beams = 181;
+  options.lidar.angle_increment_rad = 1.5 * M_PI / 180.0;
+  options.right_scale_error = 0.03;  // strong systematic drift
+  const testing::SyntheticRun run =
+      testing::MakeSyntheticRun(testing::SegmentWorld::Office(), options);
+  const ScanSyncResult synced = SyncToScans(run.records, ScanSyncOptions{});
+  const std::vector<Pose2> truth = TruthAtScans(run);
+  ASSERT_EQ(truth.size(), synced.scans.size());
+
+  GraphSlam slam{GraphSlamOptions{}};
+  for (const SyncedScan& s : synced.scans) slam.Add(s.scan, s.increment);
+  slam.Finish();
+  const std::vector<Pose2> poses = slam.Poses();
+  ASSERT_EQ(poses.size(), synced.scans.size());
+
+  const double graph = PositionRmse(poses, truth);
+  const double odometry = PositionRmse(DeadReckoningPoses(synced.scans), truth);
+  EXPECT_GT(slam.counts().loop_closures, 0);
+  EXPECT_GT(slam.counts().optimizations, 0);
+  EXPECT_LT(graph, 0.1);
+  EXPECT_LT(graph, 0.25 * odometry) << "odometry " << odometry;
+
+  // Every accepted closure agrees with the truth.
+  std::vector<Pose2> reference;
+  for (const Pose2& t : truth) reference.push_back(truth[0].Between(t));
+  const LoopClosureScore score = ScoreLoopClosures(slam.loop_closures(), reference);
+  EXPECT_EQ(score.false_closures, 0);
+  EXPECT_GE(score.recall, 0.8);
+}
+
+// Two identical rooms 8 m apart. The robot circles room A twice, moves to room B (honest
+// odometry) and circles it twice. The loop search is made generous (a 10 m radius and window), so
+// room B's nodes are matched against room A's submaps and the correlative search finds the
+// aliased pose 8 m away; the chi2 gate must reject it, as it disagrees with the graph by far
+// more than the graph's uncertainty.
+TEST(GraphSlamTest, IdenticalRoomsYieldNoFalseClosure) {
+  testing::SegmentWorld world({});
+  for (const double x0 : {0.0, 8.0}) {
+    world.AddBox(x0, 0.0, x0 + 4.0, 4.0);
+    world.AddBox(x0 + 1.0, 2.5, x0 + 1.6, 3.1);  // the same desk in each
+    world.AddBox(x0 + 2.8, 0.8, x0 + 3.2, 1.2);  // and the same pillar
+  }
+  testing::RangeFinderSpec lidar;
+  lidar.num_beams = 181;
+  lidar.angle_increment_rad = 1.5 * M_PI / 180.0;
+  lidar.angle_min_rad = -M_PI / 2.0 * 1.5;
+  RandomEngine rng(3);
+  // A circle in a room, 40 poses, then (without scans) a jump to the other room.
+  std::vector<Pose2> truth;
+  for (const double x0 : {0.0, 8.0}) {
+    for (int lap = 0; lap < 2; ++lap) {
+      for (int k = 0; k < 40; ++k) {
+        const double a = 2.0 * M_PI * k / 40.0;
+        truth.emplace_back(x0 + 2.0 + 0.8 * std::cos(a), 2.0 + 0.8 * std::sin(a), a + M_PI / 2.0);
+      }
+    }
+  }
+  GraphSlamOptions options;
+  options.loop_skip_keyframes = 10;
+  options.loop_search_radius_m = 10.0;
+  options.loop_max_search_radius_m = 10.0;
+  options.correlative.linear_window_m = 10.0;
+  options.loop_max_candidates = 3;
+  GraphSlam slam{options};
+  Pose2 previous = truth[0];
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    Pose2 increment = previous.Between(truth[i]);
+    slam.Add(world.Scan(truth[i], Time(static_cast<std::int64_t>(i) * 100'000'000), lidar, &rng),
+             increment);
+    previous = truth[i];
+  }
+  slam.Finish();
+  std::vector<Pose2> reference;
+  for (const Pose2& t : truth) reference.push_back(truth[0].Between(t));
+  const LoopClosureScore score = ScoreLoopClosures(slam.loop_closures(), reference);
+  EXPECT_GT(slam.counts().loop_closures, 0);  // within each room
+  EXPECT_GT(slam.counts().rejected, 0);       // room B was searched against room A
+  EXPECT_EQ(score.false_closures, 0);
+  for (const LoopClosure& c : slam.loop_closures()) {
+    EXPECT_EQ(c.from_scan < 80, c.to_scan < 80) << c.from_scan << " -> " << c.to_scan;
+  }
+}
+
+}  // namespace
+}  // namespace slamrig::slam

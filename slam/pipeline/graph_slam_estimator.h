@@ -1,0 +1,54 @@
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "slam/graph/graph_slam.h"
+#include "slam/graph/graph_slam_options.h"
+#include "slam/grid/occupancy_grid.h"
+#include "slam/pipeline/algorithm.h"
+#include "slam/pipeline/estimator.h"
+
+namespace slamrig::slam {
+
+/// Options of the `graph` algorithm: GraphSlam's and the map's.
+struct GraphSlamEstimatorOptions {
+  GraphSlamOptions graph;
+  OccupancyGridOptions map;
+
+  /// One message per broken rule ("loop_chi2_gate = 0; must be > 0").
+  std::vector<std::string> Validate() const;
+};
+
+/// The field table of GraphSlamEstimatorOptions: GraphSlam's keys at the top level.
+template <typename V>
+void VisitFields(V& v, GraphSlamEstimatorOptions& o) {
+  VisitFields(v, o.graph);
+  v.Struct("map", o.map);
+}
+
+/// Graph SLAM with verified loop closures (GraphSlam) behind the Estimator interface. The online
+/// map is built along the online poses; Finish() optimises once more and rebuilds the map from
+/// the revised poses.
+class GraphSlamEstimator final : public Estimator {
+ public:
+  GraphSlamEstimator(const GraphSlamEstimatorOptions& options, const EstimatorContext& context);
+
+  ScanEstimate AddScan(const SyncedScan& scan) override;
+  void Finish() override;
+  std::optional<std::vector<Pose2>> RevisedPoses() const override { return slam_.Poses(); }
+  const OccupancyGrid& map() const override { return map_; }
+  /// keyframes, loop_closures, loop_candidates, rejected, optimizations, final_chi2.
+  std::map<std::string, double> Statistics() const override;
+  std::vector<LoopClosure> LoopClosures() const override { return slam_.loop_closures(); }
+
+ private:
+  GraphSlamEstimatorOptions options_;
+  GraphSlam slam_;
+  OccupancyGrid map_;
+  std::vector<LaserScan> scans_;  // for the final map
+};
+
+}  // namespace slamrig::slam

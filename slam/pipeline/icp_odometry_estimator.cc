@@ -1,0 +1,35 @@
+#include "slam/pipeline/icp_odometry_estimator.h"
+
+#include <string>
+
+#include "slam/types/validation.h"
+
+namespace slamrig::slam {
+
+std::vector<std::string> IcpOdometryEstimatorOptions::Validate() const {
+  // The odometry's keys sit at the top level of this table: drop its own "icp_odometry." prefix.
+  std::vector<std::string> errors;
+  const std::string prefix = "icp_odometry.";
+  for (std::string e : icp_odometry.Validate()) {
+    errors.push_back(e.rfind(prefix, 0) == 0 ? e.substr(prefix.size()) : e);
+  }
+  AppendErrors(&errors, PrefixErrors("map", map.Validate()));
+  return errors;
+}
+
+IcpOdometryEstimator::IcpOdometryEstimator(const IcpOdometryEstimatorOptions& options,
+                                           const EstimatorContext& /*context*/)
+    : odometry_(options.icp_odometry), map_(options.map) {}
+
+ScanEstimate IcpOdometryEstimator::AddScan(const SyncedScan& scan) {
+  const IcpOdometryStep step = odometry_.Add(scan.scan, scan.increment);
+  map_.InsertScan(scan.scan, step.pose);
+  return {step.pose, std::nullopt, {}, std::nullopt};
+}
+
+std::map<std::string, double> IcpOdometryEstimator::Statistics() const {
+  const IcpOdometryCounts& c = odometry_.counts();
+  return {{"matched", c.matched}, {"degenerate", c.degenerate}, {"failed", c.failed + c.no_points}};
+}
+
+}  // namespace slamrig::slam
