@@ -8,7 +8,7 @@ packages=(
   libbox2d-dev libeigen3-dev libopencv-dev libmujoco-dev libyaml-cpp-dev libceres-dev
   libgtest-dev libgmock-dev libbenchmark-dev libsqlite3-dev zlib1g-dev libnanoflann-dev
   libzstd-dev liblz4-dev
-  clang libclang-rt-14-dev nodejs npm
+  clang libclang-rt-14-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri
   slurm-wlm munge
 )
@@ -19,6 +19,13 @@ for p in "${packages[@]}"; do
     missing+=("$p")
   fi
 done
+
+# Node.js and npm (the ROS 2 bag cross-check runs Foxglove's readers): Debian's nodejs and npm,
+# unless a Node.js with its npm is already installed (a nodejs package that bundles npm conflicts
+# with Debian's npm).
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  missing+=(nodejs npm)
+fi
 
 if ((${#missing[@]} == 0)); then
   echo "install_deps: all ${#packages[@]} packages present"
