@@ -8,10 +8,10 @@
 
 #include "apps/cli_args.h"
 #include "apps/commands.h"
-#include "slam/io/log_reader.h"
 #include "slam/graph/g2o_io.h"
 #include "slam/graph/graph_initialization.h"
 #include "slam/graph/pose_graph_optimizer.h"
+#include "slam/io/log_reader.h"
 #include "slam/types/error.h"
 
 namespace slamrig::app {
