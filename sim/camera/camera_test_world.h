@@ -17,22 +17,24 @@ inline void WriteSolidPng(const std::string& dir, const std::string& name, cv::V
   cv::imwrite(dir + "/" + name, cv::Mat3b(16, 16, cv::Vec3b(rgb[2], rgb[1], rgb[0])));
 }
 
+/// An axis-aligned box shape centred at (cx, cy) with sides (sx, sy), metres.
+inline ShapeSpec Box(double cx, double cy, double sx, double sy) {
+  ShapeSpec s;
+  s.center_m = {cx, cy};
+  s.size_m = {sx, sy};
+  return s;
+}
+
 /// A 6 m x 4 m room (inner faces x in [-1, 5], y in [-2, 2]) with a red zone x in [2, 3],
 /// y in [0, 1] (not symmetric, so a mirrored texture shows), as a WorldSpec.
 inline WorldSpec SmallRoom() {
   WorldSpec w;
   w.name = "small_room";
-  const auto box = [](double cx, double cy, double sx, double sy) {
-    ShapeSpec s;
-    s.center_m = {cx, cy};
-    s.size_m = {sx, sy};
-    return s;
-  };
-  w.walls = {box(2.0, -2.1, 6.4, 0.2), box(2.0, 2.1, 6.4, 0.2), box(-1.1, 0.0, 0.2, 4.0),
-             box(5.1, 0.0, 0.2, 4.0)};
+  w.walls = {Box(2.0, -2.1, 6.4, 0.2), Box(2.0, 2.1, 6.4, 0.2), Box(-1.1, 0.0, 0.2, 4.0),
+             Box(5.1, 0.0, 0.2, 4.0)};
   ZoneSpec zone;
   zone.name = "red rug";
-  zone.shape = box(2.5, 0.5, 1.0, 1.0);
+  zone.shape = Box(2.5, 0.5, 1.0, 1.0);
   w.zones = {zone};
   return w;
 }

@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim/camera/camera_test_world.h"
 #include "sim/camera/rgbd_camera.h"
 #include "slam/texture/texture_map.h"
 #include "slam/texture/texture_score.h"
@@ -17,17 +18,11 @@ TEST(TextureMappingTest, StraightDriveWithTruePosesMatchesTheFloor) {
   // half resolution.
   WorldSpec world;
   world.name = "tiny";
-  const auto box = [](double cx, double cy, double sx, double sy) {
-    ShapeSpec s;
-    s.center_m = {cx, cy};
-    s.size_m = {sx, sy};
-    return s;
-  };
-  world.walls = {box(3.0, -0.1, 6.2, 0.2), box(3.0, 4.1, 6.2, 0.2), box(-0.1, 2.0, 0.2, 4.2),
-                 box(6.1, 2.0, 0.2, 4.2)};
+  world.walls = {testing::Box(3.0, -0.1, 6.2, 0.2), testing::Box(3.0, 4.1, 6.2, 0.2),
+                 testing::Box(-0.1, 2.0, 0.2, 4.2), testing::Box(6.1, 2.0, 0.2, 4.2)};
   ZoneSpec carpet;
   carpet.name = "carpet";
-  carpet.shape = box(3.5, 2.0, 1.5, 4.0);
+  carpet.shape = testing::Box(3.5, 2.0, 1.5, 4.0);
   world.zones = {carpet};
   CameraSpec spec;
   spec.width_px = 320;
