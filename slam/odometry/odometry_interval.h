@@ -24,6 +24,7 @@ class OdometryInterval {
     ++gyro_count_;
   }
 
+  /// True once any tick record was added (Clear() keeps it: it says whether ticks ever came).
   bool has_ticks() const { return has_ticks_; }
   int gyro_samples() const { return gyro_count_; }
 

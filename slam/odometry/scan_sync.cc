@@ -69,7 +69,6 @@ std::vector<SyncedScan> ScanSynchronizer::Add(const Record& record) {
     case OdometrySource::kWheelTicks:
       if (const auto* ticks = std::get_if<WheelTicks>(&record)) {
         interval_.AddTicks(*ticks);
-        seen_ticks_ = true;
       } else if (const auto* imu = std::get_if<ImuSample>(&record)) {
         interval_.AddGyro(imu->angular_velocity_rad_s.z());
       } else if (const auto* scan = std::get_if<LaserScan>(&record)) {
@@ -116,8 +115,8 @@ SyncedScan ScanSynchronizer::CompleteTicks(const LaserScan& scan) {
     synced.yaw_change_rad = motion.yaw_rad;
     synced.increment = DiffDriveIncrement(synced.distance_m, motion.yaw_rad, options_.integration);
     pose_ = pose_ * synced.increment;
-    if (!seen_ticks_) ++scans_without_odometry_;
-  } else if (!seen_ticks_) {
+    if (!interval_.has_ticks()) ++scans_without_odometry_;
+  } else if (!interval_.has_ticks()) {
     ++scans_without_odometry_;
   }
   synced.odom_from_base = pose_;

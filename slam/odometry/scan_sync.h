@@ -96,7 +96,6 @@ class ScanSynchronizer {
   std::optional<Time> last_scan_time_;
   // Wheel ticks: sums since the previous scan.
   OdometryInterval interval_;
-  bool seen_ticks_ = false;
   std::optional<double> held_rate_;  // last interval's mean gyro rate, for dropouts
   Pose2 pose_;
   // Odometry poses: the last one seen, and scans waiting for the next one.
