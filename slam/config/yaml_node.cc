@@ -222,11 +222,19 @@ void YamlNode::CheckUsedRecursive(const YAML::Node& node, const std::string& pat
       const std::string key = kv.first.Scalar();
       const std::string child_path = path.empty() ? key : path + "." + key;
       if (used == usage_->used_keys.end() || !used->second.count(key)) {
-        const auto overridden = usage_->overridden.find(child_path);
-        throw ConfigError((overridden != usage_->overridden.end()
-                               ? overridden->second
-                               : MarkString(usage_->file, kv.first.Mark())) +
-                          ": " + child_path + ": unknown key");
+        // A key an override created (itself, or a map on the way to the overridden value) is
+        // located by the override.
+        std::string where = MarkString(usage_->file, kv.first.Mark());
+        for (const auto& [set_path, origin] : usage_->overridden) {
+          if (set_path == child_path ||
+              (set_path.size() > child_path.size() &&
+               set_path.compare(0, child_path.size(), child_path) == 0 &&
+               (set_path[child_path.size()] == '.' || set_path[child_path.size()] == '['))) {
+            where = origin;
+            break;
+          }
+        }
+        throw ConfigError(where + ": " + child_path + ": unknown key");
       }
       CheckUsedRecursive(kv.second, child_path);
     }

@@ -77,5 +77,15 @@ TEST(YamlNodeTest, OverridesSetNestedKeysAndListElements) {
   EXPECT_THAT(ErrorOf([&] { root.Override("list[7]", "1"); }), HasSubstr("no list element [7]"));
 }
 
+// Errors about what an override set, or about a map it created on the way, name the override.
+TEST(YamlNodeTest, ErrorsAboutOverriddenValuesNameTheOverride) {
+  YamlNode root = YamlNode::LoadString("a: {b: 1}\n", "o.yaml");
+  root.Override("a.b", "x", "--set a.b=x");
+  root.Override("c.d", "2", "--set c.d=2");
+  EXPECT_EQ(ErrorOf([&] { root.Required("a").Get<int>("b"); }).substr(0, 17), "--set a.b=x: a.b:");
+  root.Required("a").Required("b");
+  EXPECT_EQ(ErrorOf([&] { root.CheckAllKeysUsed(); }), "--set c.d=2: c: unknown key");
+}
+
 }  // namespace
 }  // namespace slamrig
