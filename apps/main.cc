@@ -3,11 +3,13 @@
 
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "apps/commands.h"
 #include "slam/types/error.h"
+#include "slam/types/interrupt.h"
 
 namespace slamrig::app {
 
@@ -31,6 +33,15 @@ namespace {
 
 constexpr int kExitUsage = 2;
 constexpr int kExitDataError = 1;
+/// An output could not be written (EX_IOERR of sysexits.h): a sweep runs such a run again.
+constexpr int kExitOutputError = 74;
+
+// Exit code of a command stopped by `signal`: the shell's convention, 128 + signal.
+int ReportInterrupted(int signal) {
+  std::fprintf(stderr, "slamrig: interrupted by %s; no partial output was left in place\n",
+               SignalName(signal).c_str());
+  return 128 + signal;
+}
 
 void PrintHelp() {
   std::string help =
@@ -49,6 +60,7 @@ void PrintHelp() {
 }
 
 int Main(int argc, char** argv) {
+  InstallInterruptHandlers();
   const std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) {
     PrintHelp();
@@ -72,12 +84,20 @@ int Main(int argc, char** argv) {
   for (const Command& c : Commands()) {
     if (command != c.name) continue;
     try {
-      return c.run(command_args);
-    } catch (const ConfigError& e) {
-      std::fprintf(stderr, "slamrig: error: %s\n", e.what());
-      return kExitUsage;
+      const int code = c.run(command_args);
+      // A signal after the last check: the outputs are complete, but the caller asked to stop
+      // and must not take this for a finished command (a sweep would record the run).
+      if (InterruptSignal() != 0) return ReportInterrupted(InterruptSignal());
+      return code;
     } catch (const std::exception& e) {
+      // Whatever failed after a signal failed because of it (a wait cut short, a child gone).
+      if (InterruptSignal() != 0) return ReportInterrupted(InterruptSignal());
       std::fprintf(stderr, "slamrig: error: %s\n", e.what());
+      if (dynamic_cast<const ConfigError*>(&e) != nullptr) return kExitUsage;
+      if (dynamic_cast<const OutputError*>(&e) != nullptr ||
+          dynamic_cast<const std::filesystem::filesystem_error*>(&e) != nullptr) {
+        return kExitOutputError;
+      }
       return kExitDataError;
     }
   }

@@ -10,6 +10,7 @@
 #include "apps/commands.h"
 #include "scenarios/scenario_runner.h"
 #include "scenarios/scenario_spec.h"
+#include "slam/io/atomic_file.h"
 #include "slam/types/error.h"
 
 namespace slamrig::app {
@@ -61,6 +62,7 @@ int RunRunCommand(const std::vector<std::string>& args) {
       scenario::LoadScenario(scenario::FindScenarioFile(scenario_path), overrides,
                              has_seed ? std::optional<std::uint64_t>(seed) : std::nullopt);
   if (out_dir.empty()) out_dir = "out/" + spec.name;
+  slam::CheckOutputFolder(out_dir);
 
   scenario::RunnerOptions options;
   options.view = view;

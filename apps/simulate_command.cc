@@ -15,6 +15,7 @@
 #include "sim/presets.h"
 #include "sim/robot_yaml.h"
 #include "sim/world_yaml.h"
+#include "slam/io/atomic_file.h"
 #include "slam/io/bag/bag_writer.h"
 #include "slam/types/error.h"
 
@@ -95,6 +96,7 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
                       "' has no drive; give --duration S");
   }
 
+  slam::CheckOutputFolder(out_dir);
   const auto start = std::chrono::steady_clock::now();
   const scenario::RunSummary summary = scenario::RecordSimulation(options, run, out_dir, recording);
   const double seconds =

@@ -196,6 +196,7 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   parser.AddFlag("quiet", "no progress output", &quiet);
   if (!parser.Parse(args)) return 0;
   if (out_dir.empty()) throw ConfigError("slamrig slam: --out DIR is required");
+  slam::CheckOutputFolder(out_dir);
   if (max_scans < 0)
     throw ConfigError("slamrig slam: --max-scans = " + std::to_string(max_scans) +
                       "; must be >= 0");
@@ -336,6 +337,8 @@ int RunSlamCommand(const std::vector<std::string>& args) {
 
   std::filesystem::create_directories(out_dir);
   const std::string dir = out_dir + "/";
+  // metrics.json, written last, marks a complete folder (as for `slamrig run`).
+  std::filesystem::remove(dir + "metrics.json");
   slam::WriteTum(dir + "trajectory.tum", run.final);
   if (!run.mean.empty()) slam::WriteTum(dir + "trajectory_mean.tum", run.mean);
   if (online_metrics) slam::WriteTum(dir + "trajectory_online.tum", run.online);

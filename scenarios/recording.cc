@@ -14,6 +14,7 @@
 #include "slam/io/tum_io.h"
 #include "slam/types/check.h"
 #include "slam/types/error.h"
+#include "slam/types/interrupt.h"
 #include "slam/types/trajectory.h"
 #include "slam/types/validation.h"
 
@@ -63,6 +64,9 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
   namespace fs = std::filesystem;
   fs::create_directories(out_dir);
   const std::string dir = fs::path(out_dir).string() + "/";
+  // sim.yaml, written last, marks a complete folder: an earlier recording's must not vouch for
+  // a log this one only half replaced.
+  fs::remove(dir + "sim.yaml");
   RunSummary summary;
 
   sim::Simulator sim(options);
@@ -118,6 +122,7 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
   const double limit_s = run.duration_s > 0.0 ? run.duration_s : run.max_duration_s;
   Pose2 previous = sim.Truth().map_from_base;
   while (sim.time().seconds() < limit_s - 0.5 * sim.step_s()) {
+    ThrowIfInterrupted();  // the sinks' destructors remove their temporary files
     if (run.duration_s == 0.0 && sim.drive_finished()) break;
     consume(sim.Step());
     const Pose2 now = sim.Truth().map_from_base;

@@ -62,9 +62,11 @@ struct RunSummary {
 ///    robot odometry on /odom and /tf, the truth at every scan on /ground_truth/odom); a bag
 ///    folder left by an earlier run is replaced;
 ///  - in every format, truth.tum: ground truth at every scan time (TUM format); world.yaml,
-///    robot.yaml: the resolved world and robot; sim.yaml: seed, rates, duration.
+///    robot.yaml: the resolved world and robot; sim.yaml: seed, rates, duration, written last
+///    (an earlier one removed first), so that a folder with a sim.yaml is complete.
 /// Equal options give byte-identical files. Throws ConfigError for invalid `recording`
-/// options, std::runtime_error when a file cannot be written.
+/// options, OutputError naming the file that cannot be written, Interrupted after
+/// SIGINT/SIGTERM (the log's temporary file is removed).
 RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptions& run,
                             const std::string& out_dir, const RecordingOptions& recording = {});
 

@@ -170,6 +170,9 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
   fs::create_directories(out_dir);
   const fs::path dir(out_dir);
   auto file = [&](const std::string& name) { return (dir / name).string(); };
+  // metrics.json, written last, marks a complete folder: an earlier run's must not vouch for
+  // files this one only half replaced.
+  fs::remove(file("metrics.json"));
   slam::WriteFileAtomically(file("config.yaml"), r.spec->resolved_yaml);
   slam::WriteTum(file("truth.tum"), r.truth);
 
@@ -377,8 +380,8 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
     h << "</ul>";
   }
   h << "<h2>Maps</h2>" << html_maps << "<h2>Errors</h2>" << html_plots << "</body></html>\n";
-  slam::WriteFileAtomically(file("metrics.json"), MetricsJson(r));
   slam::WriteFileAtomically(file("report.html"), h.str());
+  slam::WriteFileAtomically(file("metrics.json"), MetricsJson(r));
 }
 
 }  // namespace slamrig::scenario

@@ -65,7 +65,10 @@ void CheckExpectations(ScenarioResult* result);
 
 /// Writes the report folder: config.yaml (resolved), metrics.json, truth.tum and
 /// <config>.tum, maps (<config>_map.pgm/.yaml, map.png with truth and estimates), plots
-/// (errors over time, Neff over time, metrics per configuration) and report.html.
+/// (errors over time, Neff over time, metrics per configuration) and report.html. Every file is
+/// written atomically and metrics.json last (an earlier one is removed first), so a folder with
+/// a metrics.json is complete. Throws OutputError naming the file that cannot be written,
+/// Interrupted after SIGINT/SIGTERM.
 void WriteReport(const ScenarioResult& result, const std::string& out_dir);
 
 /// The pass/fail table printed at the end of `slamrig run`.

@@ -14,6 +14,7 @@
 #include "slam/fusion/consistency.h"
 #include "slam/pipeline/estimator_runner.h"
 #include "slam/types/error.h"
+#include "slam/types/interrupt.h"
 
 namespace slamrig::scenario {
 namespace {
@@ -209,6 +210,7 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
   };
 
   while (simulator.time() < end && !simulator.drive_finished()) {
+    ThrowIfInterrupted();
     if (next_kidnap < source.kidnaps.size() &&
         simulator.time().seconds() >= source.kidnaps[next_kidnap].at_s) {
       simulator.Teleport(source.kidnaps[next_kidnap++].to);
@@ -252,6 +254,7 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
     const Time t = RecordTime(record);
     if (!first_time) first_time = t;
     if (limited && SecondsBetween(t, *first_time) > spec.duration_s) break;
+    ThrowIfInterrupted();
     if (const auto* scan = std::get_if<LaserScan>(&record)) {
       if (scans < data.reference.size()) {
         const Pose2& reference = data.reference[scans].map_from_base;

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "slam/types/error.h"
+
 namespace slamrig::slam {
 namespace {
 
@@ -36,7 +38,7 @@ constexpr std::size_t kFlushBytes = 1 << 20;
 CarmenWriter::CarmenWriter(std::string path)
     : path_(std::move(path)), tmp_path_(path_ + ".tmp" + std::to_string(::getpid())) {
   std::FILE* f = std::fopen(tmp_path_.c_str(), "wb");
-  if (f == nullptr) throw std::runtime_error(path_ + ": cannot write: " + std::strerror(errno));
+  if (f == nullptr) throw OutputError(path_ + ": cannot write: " + std::strerror(errno));
   file_ = f;
   buffer_.reserve(2 * kFlushBytes);
   buffer_ += "# CARMEN log written by slamrig\n";
@@ -59,7 +61,7 @@ void CarmenWriter::EndLine() {
 void CarmenWriter::Flush() {
   auto* f = static_cast<std::FILE*>(file_);
   if (std::fwrite(buffer_.data(), 1, buffer_.size(), f) != buffer_.size()) {
-    throw std::runtime_error(path_ + ": write failed: " + std::strerror(errno));
+    throw OutputError(path_ + ": write failed: " + std::strerror(errno));
   }
   buffer_.clear();
 }
@@ -120,11 +122,12 @@ void CarmenWriter::Commit() {
   file_ = nullptr;
   const bool ok = std::fflush(f) == 0;
   const bool closed = std::fclose(f) == 0;
+  const std::string reason = std::strerror(errno);
   std::error_code ec;
   if (ok && closed) std::filesystem::rename(tmp_path_, path_, ec);
   if (!ok || !closed || ec) {
     std::remove(tmp_path_.c_str());
-    throw std::runtime_error(path_ + ": cannot finish writing the log");
+    throw OutputError(path_ + ": cannot finish writing the log: " + (ec ? ec.message() : reason));
   }
 }
 

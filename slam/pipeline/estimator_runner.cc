@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "slam/types/check.h"
+#include "slam/types/interrupt.h"
 
 namespace slamrig::slam {
 namespace {
@@ -48,6 +49,7 @@ void EstimatorRunner::Finish() {
 }
 
 void EstimatorRunner::Process(const SyncedScan& scan) {
+  ThrowIfInterrupted();  // a scan is the unit of work; SIGINT/SIGTERM stop between two
   const ScanEstimate estimate = estimator_->AddScan(scan);
   const Time time = scan.scan.time;
   pose_ = estimate.pose;

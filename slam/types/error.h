@@ -19,4 +19,12 @@ class ParseError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// An output that cannot be written: a full disk, a read-only folder, a failed rename. The
+/// message names the file. main exits with code 74 (EX_IOERR) for it, so that a sweep tells "the
+/// run could not write its results" (not a result: run it again) from a run that failed.
+class OutputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 }  // namespace slamrig

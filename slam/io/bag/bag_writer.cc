@@ -171,7 +171,7 @@ BagWriter::BagWriter(std::string folder, BagWriterOptions options)
   fs::remove_all(tmp_folder_);
   std::error_code ec;
   fs::create_directories(tmp_folder_, ec);
-  if (ec) throw std::runtime_error(tmp_folder_ + ": cannot create: " + ec.message());
+  if (ec) throw OutputError(tmp_folder_ + ": cannot create: " + ec.message());
   const std::string name = fs::path(folder_).filename().string();
   file_name_ = name + (options_.storage == BagStorage::kMcap ? "_0.mcap" : "_0.db3");
   const std::string path = tmp_folder_ + "/" + file_name_;
@@ -351,7 +351,7 @@ void BagWriter::Commit() {
   WriteFileAtomically(tmp_folder_ + "/metadata.yaml", metadata);
   std::error_code ec;
   std::filesystem::rename(tmp_folder_, folder_, ec);
-  if (ec) throw std::runtime_error(folder_ + ": cannot rename into place: " + ec.message());
+  if (ec) throw OutputError(folder_ + ": cannot rename into place: " + ec.message());
   committed_ = true;
 }
 

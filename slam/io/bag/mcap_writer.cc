@@ -52,7 +52,7 @@ McapWriter::McapWriter(std::string path, McapWriterOptions options)
   const std::vector<std::string> errors = options_.Validate();
   if (!errors.empty()) throw ConfigError("mcap writer: " + errors.front());
   file_ = std::fopen(path_.c_str(), "wb");
-  if (file_ == nullptr) throw std::runtime_error(path_ + ": cannot write: " + std::strerror(errno));
+  if (file_ == nullptr) throw OutputError(path_ + ": cannot write: " + std::strerror(errno));
   std::setvbuf(file_, nullptr, _IOFBF, 1 << 20);
   if (options_.compression == McapCompression::kZstd) {
     ZSTD_CCtx* ctx = ZSTD_createCCtx();
@@ -77,7 +77,7 @@ McapWriter::~McapWriter() {
 
 void McapWriter::Write(std::string_view bytes) {
   if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) {
-    throw std::runtime_error(path_ + ": write failed: " + std::strerror(errno));
+    throw OutputError(path_ + ": write failed: " + std::strerror(errno));
   }
   crc_ = crc32_z(crc_, reinterpret_cast<const Bytef*>(bytes.data()), bytes.size());
   offset_ += bytes.size();
@@ -300,7 +300,7 @@ void McapWriter::Close() {
   Write(record);
   if (std::fflush(file_) != 0 || std::fclose(file_) != 0) {
     file_ = nullptr;
-    throw std::runtime_error(path_ + ": write failed: " + std::strerror(errno));
+    throw OutputError(path_ + ": write failed: " + std::strerror(errno));
   }
   file_ = nullptr;
   closed_ = true;

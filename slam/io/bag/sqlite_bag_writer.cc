@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "slam/types/error.h"
+
 namespace slamrig::slam {
 namespace {
 
@@ -47,8 +49,8 @@ SqliteBagWriter::~SqliteBagWriter() {
 
 void SqliteBagWriter::Check(int rc, const char* what) {
   if (rc == SQLITE_OK || rc == SQLITE_DONE || rc == SQLITE_ROW) return;
-  throw std::runtime_error(path_ + ": sqlite3 " + what + ": " +
-                           (db_ != nullptr ? sqlite3_errmsg(db_) : sqlite3_errstr(rc)));
+  throw OutputError(path_ + ": sqlite3 " + what + ": " +
+                    (db_ != nullptr ? sqlite3_errmsg(db_) : sqlite3_errstr(rc)));
 }
 
 void SqliteBagWriter::Exec(const char* sql) {
@@ -57,7 +59,7 @@ void SqliteBagWriter::Exec(const char* sql) {
   if (rc != SQLITE_OK) {
     const std::string text = message != nullptr ? message : sqlite3_errstr(rc);
     sqlite3_free(message);
-    throw std::runtime_error(path_ + ": sqlite3: " + text);
+    throw OutputError(path_ + ": sqlite3: " + text);
   }
 }
 
