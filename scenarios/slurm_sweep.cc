@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "slam/io/atomic_file.h"
+#include "slam/types/interrupt.h"
 
 namespace slamrig::scenario {
 namespace {
@@ -50,6 +51,10 @@ std::string RowLine(const std::string& path) {
 }
 
 }  // namespace
+
+std::string SlurmTaskLogPath(const std::string& out_dir, std::size_t row) {
+  return (fs::path(out_dir) / "slurm" / ("task_" + std::to_string(row) + ".log")).string();
+}
 
 std::string SlurmArrayIndices(const std::vector<std::size_t>& rows) {
   std::string out;
@@ -96,10 +101,23 @@ std::vector<std::string> RunRowsOnSlurm(const SweepRunnerOptions& options,
   }
 
   // Follow the job until squeue lists none of its tasks (or no longer knows the job).
+  auto queued = [&job] {
+    const CommandResult queue = Run("squeue -h -j " + job + " -o %i 2>/dev/null");
+    return queue.exit_code == 0 && queue.output.find_first_not_of(" \n") != std::string::npos;
+  };
   std::size_t last_done = 0;
   while (true) {
-    const CommandResult queue = Run("squeue -h -j " + job + " -o %i 2>/dev/null");
-    if (queue.exit_code != 0 || queue.output.find_first_not_of(" \n") == std::string::npos) break;
+    if (const int signal = InterruptSignal(); signal != 0) {
+      // Ctrl-C: the tasks must not go on running rows nobody waits for.
+      const CommandResult cancel = Run("scancel " + job);
+      std::fprintf(stderr, "slurm: %s job %s\n",
+                   cancel.exit_code == 0 ? "cancelled" : "could not cancel (scancel failed)",
+                   job.c_str());
+      for (int i = 0; i < 60 && cancel.exit_code == 0 && queued(); ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(500));
+      throw Interrupted(signal);
+    }
+    if (!queued()) break;
     if (options.progress) {
       std::size_t done = 0;
       for (const std::size_t row : rows)

@@ -15,15 +15,19 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include "scenarios/plot.h"
 #include "scenarios/scenario_spec.h"
 #include "scenarios/slurm_sweep.h"
 #include "slam/io/atomic_file.h"
 #include "slam/types/error.h"
+#include "slam/types/interrupt.h"
 
 namespace slamrig::scenario {
 namespace {
@@ -110,7 +114,7 @@ void AppendLine(int fd, const std::string& line, const std::string& path) {
   const std::string text = line + "\n";
   if (::write(fd, text.data(), text.size()) != static_cast<ssize_t>(text.size()) ||
       ::fsync(fd) != 0) {
-    throw std::runtime_error(path + ": cannot append: " + std::strerror(errno));
+    throw OutputError(path + ": cannot append: " + std::strerror(errno));
   }
 }
 
@@ -129,9 +133,150 @@ std::vector<std::string> DefaultMetrics(const SweepSpec& spec) {
   return metrics;
 }
 
+// A running `slamrig run`. Its stdout goes to runs/<n>/log.txt; its stderr comes through a
+// pipe, so that its error line reaches the sweep even when log.txt cannot be written (a full
+// disk), and is appended to log.txt when it ends.
 struct Child {
-  std::size_t run;
+  std::size_t run = 0;
   Clock::time_point start;
+  pid_t pid = -1;
+  int stderr_fd = -1;  ///< read end of the child's stderr, non-blocking
+  std::string log_path;
+  std::string stderr_text;  ///< what it wrote there (the last 64 KiB)
+};
+
+// Exit code of `slamrig run` when it could not write its output (apps/main.cc).
+constexpr int kExitOutputError = 74;
+
+// How a child `slamrig run` ended, as far as results.csv is concerned.
+enum class ChildEnd {
+  kResult,       ///< it ran to a verdict or failed by itself: its row is recorded
+  kStopped,      ///< a signal stopped it: no row, the next sweep runs it again
+  kOutputError,  ///< it could not write its folder: no row, and the sweep stops
+};
+
+ChildEnd ClassifyEnd(int status) {
+  if (WIFSIGNALED(status)) {
+    const int s = WTERMSIG(status);
+    // A crash is the run's own failure; these come from outside (a user, scancel, the OOM killer).
+    return s == SIGTERM || s == SIGINT || s == SIGKILL || s == SIGHUP ? ChildEnd::kStopped
+                                                                      : ChildEnd::kResult;
+  }
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 0;
+  if (code == 128 + SIGINT || code == 128 + SIGTERM) return ChildEnd::kStopped;
+  if (code == kExitOutputError) return ChildEnd::kOutputError;
+  return ChildEnd::kResult;
+}
+
+// The last non-empty line a child wrote to stderr (its error line, without slamrig's prefix),
+// or `fallback`.
+std::string LastErrorLine(const Child& child, const std::string& fallback) {
+  std::istringstream in(child.stderr_text);
+  std::string line, last;
+  while (std::getline(in, line)) {
+    if (!line.empty()) last = line;
+  }
+  const std::string prefix = "slamrig: error: ";
+  if (last.rfind(prefix, 0) == 0) last = last.substr(prefix.size());
+  return last.empty() ? fallback : last;
+}
+
+// Reads what is there on the child's stderr pipe; closes it at end of file.
+void DrainStderr(Child* child) {
+  char buffer[4096];
+  while (child->stderr_fd >= 0) {
+    const ssize_t n = ::read(child->stderr_fd, buffer, sizeof(buffer));
+    if (n > 0) {
+      child->stderr_text.append(buffer, static_cast<std::size_t>(n));
+      constexpr std::size_t kKeep = 64 * 1024;
+      if (child->stderr_text.size() > kKeep)
+        child->stderr_text.erase(0, child->stderr_text.size() - kKeep);
+      continue;
+    }
+    if (n < 0 && (errno == EAGAIN || errno == EINTR)) return;
+    ::close(child->stderr_fd);  // end of file, or an error: nothing more will come
+    child->stderr_fd = -1;
+  }
+}
+
+// A child that ended: the rest of its stderr, appended to its log.txt (best effort: the disk
+// may be full; the text stays in `child` for the sweep's error line).
+void FinishChild(Child* child) {
+  while (child->stderr_fd >= 0) {
+    DrainStderr(child);
+    if (child->stderr_fd >= 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  if (child->stderr_text.empty()) return;
+  std::ofstream log(child->log_path, std::ios::app | std::ios::binary);
+  log << child->stderr_text;
+}
+
+// The child processes of a sweep. However the sweep ends (done, interrupted, an error thrown),
+// the ones still running are sent SIGTERM, so that they remove their temporary files, and are
+// waited for: nothing of a stopped sweep goes on writing behind its back.
+class Children {
+ public:
+  Children() = default;
+  Children(const Children&) = delete;
+  Children& operator=(const Children&) = delete;
+  ~Children() { StopAll(); }
+
+  void Add(const Child& child) { running_[child.pid] = child; }
+  std::size_t size() const { return running_.size(); }
+  bool empty() const { return running_.empty(); }
+
+  /// Waits until a child ends and returns it with its wait status; nullopt when none is left
+  /// or SIGINT/SIGTERM arrived (polled every 20 ms: a signal between a check and a blocking
+  /// waitpid would otherwise wait for the next child to end).
+  std::optional<std::pair<Child, int>> WaitAny() {
+    while (!running_.empty() && InterruptSignal() == 0) {
+      for (auto& [pid, child] : running_) DrainStderr(&child);
+      int status = 0;
+      const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+      if (pid < 0 && errno != EINTR) return std::nullopt;
+      if (pid <= 0) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        continue;
+      }
+      const auto it = running_.find(pid);
+      if (it == running_.end()) continue;
+      Child child = std::move(it->second);
+      running_.erase(it);
+      FinishChild(&child);
+      return std::make_pair(std::move(child), status);
+    }
+    return std::nullopt;
+  }
+
+  /// SIGTERM to every running child, then waits for them (SIGKILL after 10 s).
+  void StopAll() {
+    for (const auto& [pid, child] : running_) ::kill(pid, SIGTERM);
+    const Clock::time_point deadline = Clock::now() + std::chrono::seconds(10);
+    while (!running_.empty()) {
+      for (auto& [pid, child] : running_) DrainStderr(&child);
+      int status = 0;
+      const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+      if (pid > 0) {
+        if (const auto it = running_.find(pid); it != running_.end()) {
+          FinishChild(&it->second);
+          running_.erase(it);
+        }
+      } else if (pid < 0 && errno == ECHILD) {
+        break;
+      } else if (Clock::now() > deadline) {
+        for (const auto& [p, child] : running_) ::kill(p, SIGKILL);
+      } else {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+    }
+    for (auto& [pid, child] : running_) {
+      if (child.stderr_fd >= 0) ::close(child.stderr_fd);
+    }
+    running_.clear();
+  }
+
+ private:
+  std::map<pid_t, Child> running_;
 };
 
 std::vector<std::string> MetricsOf(const SweepSpec& spec) {
@@ -145,8 +290,8 @@ std::string RunDir(const std::string& out_dir, std::size_t index) {
 }
 
 // Starts `slamrig run SCENARIO --out runs/<n> --seed S --set key=value ... --quiet` for grid
-// row `index`, its output in runs/<n>/log.txt, and returns the child's pid.
-pid_t SpawnRun(const SweepSpec& spec, const SweepRunnerOptions& options, const SweepRun& run,
+// row `index`, its output in runs/<n>/log.txt (stderr through a pipe, see Child).
+Child SpawnRun(const SweepSpec& spec, const SweepRunnerOptions& options, const SweepRun& run,
                std::size_t index) {
   namespace fs = std::filesystem;
   const std::string dir = RunDir(options.out_dir, index);
@@ -159,17 +304,24 @@ pid_t SpawnRun(const SweepSpec& spec, const SweepRunnerOptions& options, const S
     args.push_back("--set");
     args.push_back(spec.parameters[p].key + "=" + spec.parameters[p].values[run.value_index[p]]);
   }
-  const std::string log_path = dir + "/log.txt";
+  Child child;
+  child.run = index;
+  child.start = Clock::now();
+  child.log_path = dir + "/log.txt";
+  int pipe_fds[2];
+  if (::pipe2(pipe_fds, O_CLOEXEC) != 0)
+    throw std::runtime_error(std::string("pipe failed: ") + std::strerror(errno));
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) throw std::runtime_error(std::string("fork failed: ") + std::strerror(errno));
   if (pid == 0) {
-    // A child never outlives a killed sweep: it would finish a run nobody records.
-    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-    const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (log >= 0) {
-      ::dup2(log, STDOUT_FILENO);
-      ::dup2(log, STDERR_FILENO);
-    }
+    // A child never outlives a killed sweep: it would finish a run nobody records. SIGTERM
+    // (not SIGKILL), so that it still removes its temporary files.
+    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (::getppid() != parent) ::_exit(128 + SIGTERM);  // the sweep died before prctl
+    const int log = ::open(child.log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (log >= 0) ::dup2(log, STDOUT_FILENO);
+    ::dup2(pipe_fds[1], STDERR_FILENO);  // dup2 clears O_CLOEXEC on the copy
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -177,7 +329,11 @@ pid_t SpawnRun(const SweepSpec& spec, const SweepRunnerOptions& options, const S
     std::perror("execv");
     ::_exit(127);
   }
-  return pid;
+  ::close(pipe_fds[1]);
+  ::fcntl(pipe_fds[0], F_SETFL, O_NONBLOCK);
+  child.pid = pid;
+  child.stderr_fd = pipe_fds[0];
+  return child;
 }
 
 // The results.csv row of a finished run (wait status `status`, `wall_s` seconds); `*state` is
@@ -228,6 +384,7 @@ SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) 
   const std::vector<SweepRun> runs = ExpandSweep(spec);
   SweepSummary summary;
   summary.total = static_cast<int>(runs.size());
+  slam::CheckOutputFolder(options.out_dir);
   fs::create_directories(fs::path(options.out_dir) / "runs");
   const std::string csv_path = (fs::path(options.out_dir) / "results.csv").string();
 
@@ -264,13 +421,17 @@ SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) 
     }
   }
   const int fd = ::open(csv_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-  if (fd < 0) throw std::runtime_error(csv_path + ": cannot open: " + std::strerror(errno));
+  if (fd < 0) throw OutputError(csv_path + ": cannot open: " + std::strerror(errno));
+  const std::unique_ptr<int, void (*)(int*)> close_fd(new int(fd), [](int* f) {
+    ::close(*f);
+    delete f;
+  });
   if (header.empty()) AppendLine(fd, JoinCsv(ResultsHeader(spec, metrics)), csv_path);
 
   const int jobs = options.jobs > 0
                        ? options.jobs
                        : std::max(1, static_cast<int>(::sysconf(_SC_NPROCESSORS_ONLN)));
-  std::map<pid_t, Child> running;
+  Children running;
   std::size_t next = 0;
   int finished_now = 0;
   const Clock::time_point sweep_start = Clock::now();
@@ -292,7 +453,7 @@ SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) 
   };
 
   auto start_run = [&](std::size_t index) {
-    running[SpawnRun(spec, options, runs[index], index)] = {index, Clock::now()};
+    running.Add(SpawnRun(spec, options, runs[index], index));
   };
 
   if (options.backend == SweepBackend::kSlurm) {
@@ -304,39 +465,50 @@ SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) 
           fields[spec.parameters.size() + 2] != "pass") {
         ++summary.failed;
       }
-      if (lines[k].empty()) continue;  // the task left no row: the next sweep runs it again
+      if (lines[k].empty()) {  // the task left no row: the next sweep runs it again
+        std::fprintf(stderr, "slurm: row %zu left no result (see %s); the next sweep runs it\n",
+                     todo[k], SlurmTaskLogPath(options.out_dir, todo[k]).c_str());
+        continue;
+      }
       AppendLine(fd, lines[k], csv_path);
       ++summary.ran;
     }
-    ::close(fd);
     WriteSweepSummary(spec, options.out_dir);
     return summary;
   }
 
   report();
   while (next < todo.size() || !running.empty()) {
-    while (next < todo.size() && static_cast<int>(running.size()) < jobs) start_run(todo[next++]);
-    int status = 0;
-    const pid_t pid = ::waitpid(-1, &status, 0);
-    if (pid < 0) {
-      if (errno == EINTR) continue;
-      break;
+    while (next < todo.size() && static_cast<int>(running.size()) < jobs && InterruptSignal() == 0)
+      start_run(todo[next++]);
+    const auto ended = running.WaitAny();
+    // SIGINT/SIGTERM: `running` stops the children on the way out, and their rows stay missing.
+    ThrowIfInterrupted();
+    if (!ended) break;
+    const auto& [child, status] = *ended;
+    const std::string run_dir = RunDir(options.out_dir, child.run);
+    switch (ClassifyEnd(status)) {
+      case ChildEnd::kStopped:
+        ++summary.failed;
+        std::fprintf(stderr, "%s: stopped by a signal; the next sweep runs it again\n",
+                     run_dir.c_str());
+        continue;
+      case ChildEnd::kOutputError:
+        // The disk is full or the folder read-only: every other run would fail the same way.
+        throw OutputError(LastErrorLine(child, run_dir + ": the run could not write its output"));
+      case ChildEnd::kResult:
+        break;
     }
-    const auto it = running.find(pid);
-    if (it == running.end()) continue;
-    const Child child = it->second;
-    running.erase(it);
     const double wall = std::chrono::duration<double>(Clock::now() - child.start).count();
     std::string state;
-    const std::vector<std::string> row = ResultRow(
-        spec, metrics, runs[child.run], RunDir(options.out_dir, child.run), status, wall, &state);
+    const std::vector<std::string> row =
+        ResultRow(spec, metrics, runs[child.run], run_dir, status, wall, &state);
     if (state != "pass") ++summary.failed;
     AppendLine(fd, JoinCsv(row), csv_path);
     ++finished_now;
     ++summary.ran;
     report();
   }
-  ::close(fd);
   if (options.progress && tty) std::fputc('\n', stderr);
   WriteSweepSummary(spec, options.out_dir);
   return summary;
@@ -350,15 +522,26 @@ bool RunSweepRow(const SweepSpec& spec, const SweepRunnerOptions& options, std::
   }
   const std::vector<std::string> metrics = MetricsOf(spec);
   const Clock::time_point start = Clock::now();
-  const pid_t pid = SpawnRun(spec, options, runs[row], row);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) throw std::runtime_error(std::string("waitpid: ") + std::strerror(errno));
+  Children running;
+  running.Add(SpawnRun(spec, options, runs[row], row));
+  const auto ended = running.WaitAny();
+  // scancel: SIGTERM to the task and its child; no row file, so a resumed sweep runs it again.
+  ThrowIfInterrupted();
+  if (!ended) throw std::runtime_error("waitpid: " + std::string(std::strerror(errno)));
+  const auto& [child, status] = *ended;
+  const std::string run_dir = RunDir(options.out_dir, row);
+  switch (ClassifyEnd(status)) {
+    case ChildEnd::kStopped:
+      throw std::runtime_error(run_dir + ": stopped by a signal; its row is not written");
+    case ChildEnd::kOutputError:
+      throw OutputError(LastErrorLine(child, run_dir + ": the run could not write its output"));
+    case ChildEnd::kResult:
+      break;
   }
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   std::string state;
   const std::vector<std::string> fields =
-      ResultRow(spec, metrics, runs[row], RunDir(options.out_dir, row), status, wall, &state);
+      ResultRow(spec, metrics, runs[row], run_dir, status, wall, &state);
   const std::string path = SweepRowPath(options.out_dir, row);
   std::filesystem::create_directories(std::filesystem::path(path).parent_path());
   slam::WriteFileAtomically(path,
