@@ -19,7 +19,7 @@ lines_head=12   # first lines of a log (its PARAM header and first messages)
 lines_middle=6  # and a few from its middle
 
 rm -rf "$out"
-targets=(carmen npz ece276a_csv tum map_server world_yaml robot_yaml scenario_yaml sweep_yaml)
+targets=(carmen npz ece276a_csv tum map_server world_yaml robot_yaml scenario_yaml sweep_yaml bag)
 for t in "${targets[@]}"; do mkdir -p "$out/$t"; done
 
 # Line `from` .. `from + count - 1` of a plain or gzip file.
@@ -129,6 +129,29 @@ cp "$repo"/worlds/*.yaml "$out/world_yaml/"
 cp "$repo"/robots/*.yaml "$out/robot_yaml/"
 cp "$repo"/scenarios/*.yaml "$out/scenario_yaml/"
 cp "$repo"/scenarios/sweeps/*.yaml "$out/sweep_yaml/"
+
+# ROS 2 bags as the simulator writes them, in both storages and every MCAP compression: 0.1 and
+# 0.3 s of the small robot (360 beams at 10 Hz) with its lidar cut to 32 beams,
+# so that a seed is 18 to 80 KiB. Needs BUILD_DIR/apps/slamrig (run_fuzzers.sh builds it).
+slamrig=$1/apps/slamrig
+if [[ -x $slamrig ]]; then
+  bags=$(mktemp -d)
+  sed 's/^  num_beams: .*/  num_beams: 32/; s/^  beams_per_revolution: .*/  beams_per_revolution: 32/' \
+    "$repo/robots/small_diff.yaml" >"$bags/tiny.yaml"
+  for format in mcap:none mcap:zstd mcap:lz4 sqlite3:; do
+    storage=${format%%:*}
+    compression=${format#*:}
+    args=(--format "$storage")
+    if [[ -n $compression ]]; then args+=(--compression "$compression"); fi
+    for duration in 0.1 0.3; do
+      name=$storage$compression$duration
+      ASAN_OPTIONS=detect_leaks=0 "$slamrig" simulate office --robot "$bags/tiny.yaml" \
+        --duration "$duration" --out "$bags/$name" "${args[@]}" >/dev/null
+      cp "$bags/$name"/run/run_0.* "$out/bag/$name.bag"
+    done
+  done
+  rm -rf "$bags"
+fi
 
 for t in "${targets[@]}"; do
   printf 'make_corpora: %-14s %3d seeds\n' "$t" "$(find "$out/$t" -type f | wc -l)"

@@ -31,7 +31,7 @@ struct ReaderEntry {
 };
 
 /// Every reader of outside data: carmen, npz, ece276a_csv, tum, map_server, world_yaml,
-/// robot_yaml, scenario_yaml, sweep_yaml.
+/// robot_yaml, scenario_yaml, sweep_yaml, bag.
 const std::vector<ReaderEntry>& ReaderEntries();
 
 /// The entry named `name`, or nullptr.

@@ -26,7 +26,7 @@ if (($# > 0)); then
     shift
   fi
 fi
-all_targets=(carmen npz ece276a_csv tum map_server world_yaml robot_yaml scenario_yaml sweep_yaml)
+all_targets=(carmen npz ece276a_csv tum map_server world_yaml robot_yaml scenario_yaml sweep_yaml bag)
 targets=("$@")
 if ((${#targets[@]} == 0)); then targets=("${all_targets[@]}"); fi
 
@@ -38,6 +38,8 @@ if [[ ! -f $build/CMakeCache.txt ]]; then
 fi
 build_targets=()
 for t in "${targets[@]}"; do build_targets+=(--target "fuzz_$t"); done
+# The bag seeds are bags the simulator writes (fuzz/make_corpora.sh runs this build's slamrig).
+if [[ " ${targets[*]} " == *" bag "* ]]; then build_targets+=(--target slamrig); fi
 cmake --build "$build" -j"$jobs" "${build_targets[@]}" >"$build/fuzz_build.log" 2>&1 ||
   {
     tail -n 40 "$build/fuzz_build.log"
@@ -60,7 +62,10 @@ for t in "${targets[@]}"; do
   if ((corpus_only)); then
     flags+=(-runs=0)
   else
-    flags+=("-max_total_time=$seconds" -max_len=8192)
+    # A bag seed holds its message definitions (schemas) besides a few messages: 128 KiB.
+    max_len=8192
+    if [[ $t == bag ]]; then max_len=131072; fi
+    flags+=("-max_total_time=$seconds" "-max_len=$max_len")
     if [[ ${SLAMRIG_FUZZ_KEEP_GOING:-0} == 1 ]]; then
       flags+=(-fork=1 -ignore_crashes=1 -ignore_ooms=1 -ignore_timeouts=1)
     fi
