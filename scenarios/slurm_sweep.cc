@@ -107,6 +107,9 @@ std::vector<std::string> RunRowsOnSlurm(const SweepRunnerOptions& options,
   };
   std::size_t last_done = 0;
   while (true) {
+    // Asked before the signal check: Ctrl-C reaches squeue too, which then fails as if the job
+    // were gone.
+    const bool still_queued = queued();
     if (const int signal = InterruptSignal(); signal != 0) {
       // Ctrl-C: the tasks must not go on running rows nobody waits for.
       const CommandResult cancel = Run("scancel " + job);
@@ -117,7 +120,7 @@ std::vector<std::string> RunRowsOnSlurm(const SweepRunnerOptions& options,
         std::this_thread::sleep_for(std::chrono::milliseconds(500));
       throw Interrupted(signal);
     }
-    if (!queued()) break;
+    if (!still_queued) break;
     if (options.progress) {
       std::size_t done = 0;
       for (const std::size_t row : rows)
