@@ -1,6 +1,8 @@
 // slamrig: the one command line of the test bench. Each subcommand lives in its own
 // *_command.cc; this file dispatches and turns every error into one line and an exit code.
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -38,6 +40,8 @@ constexpr int kExitOutputError = 74;
 
 // Exit code of a command stopped by `signal`: the shell's convention, 128 + signal.
 int ReportInterrupted(int signal) {
+  // On a terminal the line may follow a progress line that ends in '\r' and the echoed ^C.
+  if (::isatty(STDERR_FILENO) != 0) std::fputc('\n', stderr);
   std::fprintf(stderr, "slamrig: interrupted by %s; no partial output was left in place\n",
                SignalName(signal).c_str());
   return 128 + signal;
