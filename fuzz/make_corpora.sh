@@ -5,11 +5,12 @@
 # slices are made afresh on every run (the hand-made seeds live in fuzz/corpus/<target>/).
 # A missing dataset folder only leaves its slices out (the repository's own files still seed).
 #
-#   fuzz/make_corpora.sh BUILD_DIR
+#   fuzz/make_corpora.sh BUILD_DIR [TARGET...]   # TARGETs: whose costly seeds to make (bag);
+#                                                # default all
 set -euo pipefail
 
-if (($# != 1)); then
-  echo "usage: $0 BUILD_DIR" >&2
+if (($# < 1)); then
+  echo "usage: $0 BUILD_DIR [TARGET...]" >&2
   exit 2
 fi
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -134,7 +135,7 @@ cp "$repo"/scenarios/sweeps/*.yaml "$out/sweep_yaml/"
 # 0.3 s of the small robot (360 beams at 10 Hz) with its lidar cut to 32 beams,
 # so that a seed is 18 to 80 KiB. Needs BUILD_DIR/apps/slamrig (run_fuzzers.sh builds it).
 slamrig=$1/apps/slamrig
-if [[ -x $slamrig ]]; then
+if [[ -x $slamrig ]] && { (($# == 1)) || [[ " ${*:2} " == *" bag "* ]]; }; then
   bags=$(mktemp -d)
   sed 's/^  num_beams: .*/  num_beams: 32/; s/^  beams_per_revolution: .*/  beams_per_revolution: 32/' \
     "$repo/robots/small_diff.yaml" >"$bags/tiny.yaml"

@@ -45,7 +45,7 @@ cmake --build "$build" -j"$jobs" "${build_targets[@]}" >"$build/fuzz_build.log" 
     tail -n 40 "$build/fuzz_build.log"
     exit 1
   }
-bash fuzz/make_corpora.sh "$build" >/dev/null
+bash fuzz/make_corpora.sh "$build" "${targets[@]}" >/dev/null
 
 mkdir -p "$build/fuzz_logs"
 failed=()
