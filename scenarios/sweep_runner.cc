@@ -202,9 +202,16 @@ void DrainStderr(Child* child) {
 // A child that ended: the rest of its stderr, appended to its log.txt (best effort: the disk
 // may be full; the text stays in `child` for the sweep's error line).
 void FinishChild(Child* child) {
-  while (child->stderr_fd >= 0) {
+  // Only the child held the pipe's write end (O_CLOEXEC elsewhere), so end of file is near; a
+  // deadline all the same, should a process it started keep the pipe open.
+  const Clock::time_point deadline = Clock::now() + std::chrono::seconds(2);
+  while (child->stderr_fd >= 0 && Clock::now() < deadline) {
     DrainStderr(child);
     if (child->stderr_fd >= 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  if (child->stderr_fd >= 0) {
+    ::close(child->stderr_fd);
+    child->stderr_fd = -1;
   }
   if (child->stderr_text.empty()) return;
   std::ofstream log(child->log_path, std::ios::app | std::ios::binary);

@@ -50,8 +50,8 @@ metrics: [pf.ate_rmse_m, dead_reckoning.ate_rmse_m]
 YAML
 command_of() { # name out_dir
   case $1 in
-  simulate) echo "$binary simulate office --duration 15 --out $2" ;;
-  simulate_mcap) echo "$binary simulate office --duration 15 --format mcap --out $2" ;;
+  simulate) echo "$binary simulate office --duration 30 --out $2" ;;
+  simulate_mcap) echo "$binary simulate office --duration 30 --format mcap --out $2" ;;
   slam) echo "$binary slam $work/ref/simulate/run.log --particles 20 --quiet --out $2" ;;
   run) echo "$binary run office_loop --set duration_s=6 --set slam.pf.particles=20 --quiet --out $2" ;;
   sweep) echo "$binary sweep $work/sweep.yaml --jobs 2 --quiet --out $2" ;;
@@ -151,12 +151,13 @@ check_resume() { # dir what
   [[ -z $ids ]] || fail "$2: rows run twice: $ids"
 }
 
-# 1. Signals at random points: delays in [5 %, 90 %] of the command's uninterrupted work time.
+# 1. Signals at random points: delays in [5 %, 60 %] of the command's uninterrupted work time
+# (the reference's time varies with the machine's load, so not up to its end).
 interrupted=0 finished=0
 for name in simulate simulate_mcap slam run sweep; do
   stopped=0
   for signal in TERM INT TERM INT; do
-    delay_ms=$((work_ms[$name] * (5 + RANDOM % 86) / 100))
+    delay_ms=$((work_ms[$name] * (5 + RANDOM % 56) / 100))
     out=$work/signal/$name.$signal.$delay_ms
     mkdir -p "$(dirname "$out")"
     what="$name, SIG$signal after $delay_ms ms"
@@ -186,9 +187,10 @@ for name in simulate simulate_mcap slam run sweep; do
     interrupted=$((interrupted + 1))
     stopped=$((stopped + 1))
   done
-  # A command done before its signal proves nothing; each must have been stopped at least twice.
-  ((stopped >= 2)) || fail "$name: only $stopped of 4 signals came before it was done"
+  # A command done before its signal proves nothing: each must have been stopped.
+  ((stopped >= 1)) || fail "$name: all 4 signals came after it was done"
 done
+((interrupted >= 10)) || fail "only $interrupted of 20 signals came before the command was done"
 
 # 2. A full disk: a tmpfs of about half of what the command writes.
 for name in simulate simulate_mcap slam run sweep; do
