@@ -29,6 +29,17 @@ void GraphSlamEstimator::Finish() {
   for (std::size_t i = 0; i < scans_.size(); ++i) map_.InsertScan(scans_[i], poses[i]);
 }
 
+EstimatorView GraphSlamEstimator::View() const {
+  EstimatorView view;
+  const PoseGraph& graph = slam_.graph();
+  view.edges.reserve(graph.edges().size());
+  for (const PoseGraphEdge& e : graph.edges()) {
+    view.edges.push_back({graph.pose(e.from).translation(), graph.pose(e.to).translation(),
+                          e.kind == EdgeKind::kLoopClosure});
+  }
+  return view;
+}
+
 std::map<std::string, double> GraphSlamEstimator::Statistics() const {
   const GraphSlamCounts& c = slam_.counts();
   return {{"keyframes", c.keyframes},

@@ -43,6 +43,8 @@ class GraphSlamEstimator final : public Estimator {
   /// keyframes, loop_closures, loop_candidates, rejected, optimizations, final_chi2.
   std::map<std::string, double> Statistics() const override;
   std::vector<LoopClosure> LoopClosures() const override { return slam_.loop_closures(); }
+  /// The graph's odometry and loop-closure edges at the current estimate.
+  EstimatorView View() const override;
 
  private:
   GraphSlamEstimatorOptions options_;
