@@ -170,6 +170,16 @@ std::vector<Pose2> GraphSlam::Poses() const {
   return poses;
 }
 
+std::vector<LoopClosure> GraphSlam::loop_closures() const {
+  std::vector<LoopClosure> kept;
+  for (std::size_t i = 0; i < closures_.size(); ++i) {
+    const std::size_t e = closure_edges_[i];
+    if (e < switches_.size() && switches_[e] < 0.5) continue;
+    kept.push_back(closures_[i]);
+  }
+  return kept;
+}
+
 void GraphSlam::AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vector2d> points) {
   const int id = static_cast<int>(nodes_.size());
   Node node{scan, odom_pose, std::move(points), Eigen::Vector2d::Zero()};
@@ -263,6 +273,7 @@ void GraphSlam::SearchLoops() {
       ++counts_.rejected;
       continue;
     }
+    closure_edges_.push_back(graph_.edges().size());
     graph_.AddEdge(*edge);
     const Eigen::Matrix3d covariance = edge->information.inverse();
     edge_variances_.emplace_back(covariance(0, 0) + covariance(1, 1), covariance(2, 2));
@@ -352,6 +363,11 @@ std::optional<PoseGraphEdge> GraphSlam::TryClosure(int candidate, const Eigen::V
 void GraphSlam::Optimize() {
   const PoseGraphSummary summary = optimizer_.Optimize(&graph_);
   counts_.final_chi2 = summary.final_chi2;
+  switches_ = summary.switches;
+  counts_.switched_off = 0;
+  for (const std::size_t e : closure_edges_) {
+    counts_.switched_off += e < switches_.size() && switches_[e] < 0.5;
+  }
   ++counts_.optimizations;
   pending_closure_ = false;
   nodes_at_last_optimization_ = static_cast<int>(nodes_.size());

@@ -34,6 +34,9 @@ struct GraphSlamCounts {
   int rejected = 0;         ///< candidates that failed a match or a check
   int optimizations = 0;
   double final_chi2 = 0.0;  ///< chi2 of the last optimisation
+  /// Accepted closures whose switch the last optimisation turned off (below 0.5), with the
+  /// switchable robust loss; they no longer count as loop closures.
+  int switched_off = 0;
 };
 
 /// Online graph SLAM over laser scans with an odometry increment each. Deterministic; not
@@ -52,7 +55,9 @@ class GraphSlam {
   /// The current estimate of every scan so far: its node's pose composed with the scan's pose
   /// relative to that node.
   std::vector<Pose2> Poses() const;
-  const std::vector<LoopClosure>& loop_closures() const { return closures_; }
+  /// The accepted loop closures the back end keeps (all of them, or with switchable constraints
+  /// those whose switch is on).
+  std::vector<LoopClosure> loop_closures() const;
   const GraphSlamCounts& counts() const { return counts_; }
   const PoseGraph& graph() const { return graph_; }
 
@@ -79,6 +84,8 @@ class GraphSlam {
   std::vector<Pose2> scan_from_node_;            // each scan in its node's frame
   std::vector<Eigen::Vector2d> edge_variances_;  // (xy, yaw) of each graph edge, in order
   std::vector<LoopClosure> closures_;
+  std::vector<std::size_t> closure_edges_;  // graph edge of each closure
+  std::vector<double> switches_;            // of each graph edge, from the last optimisation
   GraphSlamCounts counts_;
   bool pending_closure_ = false;
   int nodes_at_last_optimization_ = 0;

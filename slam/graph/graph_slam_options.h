@@ -22,7 +22,8 @@ void VisitFields(V& v, PoseGraphOptimizerOptions& o) {
   v.Enum("robust_loss", o.robust_loss,
          {{RobustLoss::kNone, "none"},
           {RobustLoss::kHuber, "huber"},
-          {RobustLoss::kCauchy, "cauchy"}});
+          {RobustLoss::kCauchy, "cauchy"},
+          {RobustLoss::kSwitchable, "switchable"}});
   v("robust_loss_scale", o.robust_loss_scale);
   v("robust_loss_on_all_edges", o.robust_loss_on_all_edges);
   v("function_tolerance", o.function_tolerance);

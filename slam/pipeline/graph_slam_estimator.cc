@@ -47,7 +47,8 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"loop_candidates", c.loop_candidates},
           {"rejected", c.rejected},
           {"optimizations", c.optimizations},
-          {"final_chi2", c.final_chi2}};
+          {"final_chi2", c.final_chi2},
+          {"switched_off", c.switched_off}};
 }
 
 }  // namespace slamrig::slam
