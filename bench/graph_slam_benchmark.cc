@@ -6,8 +6,8 @@
 // CPU figure is the one to compare), the median and the worst single scan (wall), the ATE
 // and the loop closures, so a fast but wrong run shows.
 //
-//   build/bench/graph_slam_benchmark --benchmark_filter=intel --benchmark_repetitions=5 \
-//       --benchmark_report_aggregates_only=true
+//   build/bench/graph_slam_benchmark --benchmark_filter=intel --benchmark_repetitions=5
+//       --benchmark_report_aggregates_only=true   (one command line)
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
