@@ -29,9 +29,9 @@ void VisitFields(V& v, GraphSlamEstimatorOptions& o) {
   v.Struct("map", o.map);
 }
 
-/// Graph SLAM with verified loop closures (GraphSlam) behind the Estimator interface. The online
-/// map is built along the online poses; Finish() optimises once more and rebuilds the map from
-/// the revised poses.
+/// Graph SLAM with verified loop closures (GraphSlam) behind the Estimator interface. The map
+/// holds the scans of the graph's nodes (keyframes), online at their online poses; Finish()
+/// optimises once more and rebuilds it from the nodes' revised poses.
 class GraphSlamEstimator final : public Estimator {
  public:
   GraphSlamEstimator(const GraphSlamEstimatorOptions& options, const EstimatorContext& context);
@@ -51,7 +51,7 @@ class GraphSlamEstimator final : public Estimator {
   GraphSlamEstimatorOptions options_;
   GraphSlam slam_;
   OccupancyGrid map_;
-  std::vector<LaserScan> scans_;  // for the final map
+  std::vector<LaserScan> node_scans_;  // the scan of each graph node (vertex id), for the map
 };
 
 }  // namespace slamrig::slam
