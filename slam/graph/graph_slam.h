@@ -37,6 +37,7 @@ struct GraphSlamCounts {
   /// Accepted closures whose switch the last optimisation turned off (below 0.5), with the
   /// switchable robust loss; they no longer count as loop closures.
   int switched_off = 0;
+  int odometry_rematched = 0;  ///< odometry edges the odometry check replaced
 };
 
 /// Online graph SLAM over laser scans with an odometry increment each. Deterministic; not
@@ -71,6 +72,9 @@ class GraphSlam {
   // Variances (xy, yaw) along the least uncertain graph path from the newest node to every node.
   std::vector<Eigen::Vector2d> PathVariances() const;
   void AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vector2d> points);
+  // The pose of `points` in the newest node's frame: `relative` (ICP odometry's), or the
+  // odometry check's re-match when it fits the last nodes clearly better.
+  Pose2 CheckedRelative(const Pose2& relative, const std::vector<Eigen::Vector2d>& points);
   void SearchLoops();
   std::optional<PoseGraphEdge> TryClosure(int candidate, const Eigen::Vector2d& variance);
   void Optimize();

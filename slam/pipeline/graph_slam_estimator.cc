@@ -55,7 +55,8 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"rejected", c.rejected},
           {"optimizations", c.optimizations},
           {"final_chi2", c.final_chi2},
-          {"switched_off", c.switched_off}};
+          {"switched_off", c.switched_off},
+          {"odometry_rematched", c.odometry_rematched}};
 }
 
 }  // namespace slamrig::slam
