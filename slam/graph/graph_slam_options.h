@@ -57,7 +57,7 @@ struct GraphSlamOptions {
   int odometry_check_nodes = 3;
   double odometry_check_window_m = 0.3;
   double odometry_check_window_rad = 0.35;
-  double odometry_check_min_gain = 0.05;
+  double odometry_check_min_gain = 0.1;
 
   /// Loop closures are searched among nodes older than the last loop_skip_keyframes ...
   int loop_skip_keyframes = 30;
