@@ -28,9 +28,12 @@ PoseGraphOptimizerOptions ParseChoices(const std::string& robust, const std::str
     options.robust_loss = slam::RobustLoss::kHuber;
   } else if (robust == "cauchy") {
     options.robust_loss = slam::RobustLoss::kCauchy;
+  } else if (robust == "switchable") {
+    options.robust_loss = slam::RobustLoss::kSwitchable;
   } else {
-    throw ConfigError("slamrig optimize: --robust: expected none, huber or cauchy, got '" + robust +
-                      "'");
+    throw ConfigError(
+        "slamrig optimize: --robust: expected none, huber, cauchy or switchable, got '" + robust +
+        "'");
   }
   if (strategy == "lm") {
     options.trust_region = slam::TrustRegion::kLevenbergMarquardt;
@@ -65,7 +68,8 @@ int RunOptimizeCommand(const std::vector<std::string>& args) {
                    "odometry (compose the consecutive-id edges), chordal (Carlone et al. 2015) or "
                    "file (the file's vertex estimates)",
                    &init);
-  parser.AddOption("robust", "LOSS", "none, huber or cauchy, on loop-closure edges", &robust);
+  parser.AddOption("robust", "LOSS", "none, huber, cauchy or switchable, on loop-closure edges",
+                   &robust);
   parser.AddOption("robust-scale", "S", "robust loss scale, in whitened error units",
                    &options.robust_loss_scale);
   parser.AddFlag("robust-all", "apply the robust loss to every edge, odometry too",

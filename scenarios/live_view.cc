@@ -31,31 +31,35 @@ LiveView::LiveView(const std::string& title, double max_fps)
 
 LiveView::~LiveView() { cv::destroyWindow(title_); }
 
-void LiveView::Update(double sim_time_s, const slam::OccupancyGrid& map,
-                      const Pose2& world_from_map, const Pose2& truth,
-                      const std::vector<LiveEstimate>& estimates) {
-  truth_path_.push_back(truth);
-  estimate_paths_.resize(estimates.size());
-  for (std::size_t i = 0; i < estimates.size(); ++i)
-    estimate_paths_[i].push_back(estimates[i].pose);
-  const double now = WallSeconds();
-  if (now - last_draw_s_ < min_period_s_) return;
-  last_draw_s_ = now;
+Eigen::Vector2i LiveFrame::PixelOf(const Eigen::Vector2d& p) const {
+  return {static_cast<int>((p.x() - min_world.x()) * px_per_m),
+          static_cast<int>(height_px - (p.y() - min_world.y()) * px_per_m)};
+}
 
+LiveFrame DrawLiveFrame(double sim_time_s, const slam::OccupancyGrid& map,
+                        const Pose2& world_from_map, const std::vector<Pose2>& truth_path,
+                        const std::vector<LiveEstimate>& estimates,
+                        const std::vector<std::vector<Pose2>>& estimate_paths) {
   // Frame the robot's whereabouts with 5 m around them (the map may reach much further).
   Eigen::AlignedBox2d box;
-  for (const Pose2& p : truth_path_) box.extend(p.translation());
-  for (const auto& path : estimate_paths_) {
+  for (const Pose2& p : truth_path) box.extend(p.translation());
+  for (const auto& path : estimate_paths) {
     for (const Pose2& p : path) box.extend(p.translation());
   }
+  if (box.isEmpty()) box.extend(Eigen::Vector2d::Zero());
   box.min() -= Eigen::Vector2d::Constant(5.0);
   box.max() += Eigen::Vector2d::Constant(5.0);
-  const double scale = kSizePx / std::max(box.sizes().maxCoeff(), 10.0);
+  LiveFrame frame;
+  frame.width_px = kSizePx;
+  frame.height_px = kSizePx;
+  frame.min_world = box.min();
+  frame.px_per_m = kSizePx / std::max(box.sizes().maxCoeff(), 10.0);
+  const double scale = frame.px_per_m;
   cv::Mat image(kSizePx, kSizePx, CV_8UC3, cv::Scalar(205, 205, 205));
   const Pose2 map_from_world = world_from_map.Inverse();
   const auto px = [&](const Eigen::Vector2d& p) {
-    return cv::Point(static_cast<int>((p.x() - box.min().x()) * scale),
-                     static_cast<int>(kSizePx - (p.y() - box.min().y()) * scale));
+    const Eigen::Vector2i c = frame.PixelOf(p);
+    return cv::Point(c.x(), c.y());
   };
   for (int row = 0; row < kSizePx; ++row) {
     auto* out = image.ptr<cv::Vec3b>(row);
@@ -80,23 +84,48 @@ void LiveView::Update(double sim_time_s, const slam::OccupancyGrid& map,
     cv::circle(image, c, 5, colour, 2, cv::LINE_AA);
     cv::line(image, c, tip, colour, 2, cv::LINE_AA);
   };
-  draw_path(truth_path_, cv::Scalar(40, 160, 40));
-  draw_pose(truth, cv::Scalar(40, 160, 40));
+  const cv::Scalar truth_colour(40, 160, 40);
+  draw_path(truth_path, truth_colour);
+  if (!truth_path.empty()) draw_pose(truth_path.back(), truth_colour);
+  const cv::Scalar loop_colour(kLoopClosureBgr[0], kLoopClosureBgr[1], kLoopClosureBgr[2]);
   for (std::size_t i = 0; i < estimates.size(); ++i) {
     const Colour c = PaletteColour(i == 2 ? 4 : i);
     const cv::Scalar colour(c.b, c.g, c.r);
+    // Odometry edges first, so the loop closures stay visible on top of the chain.
+    for (const LiveEdge& e : estimates[i].edges) {
+      if (!e.loop_closure) cv::line(image, px(e.from), px(e.to), colour, 1, cv::LINE_8);
+    }
+    for (const LiveEdge& e : estimates[i].edges) {
+      if (e.loop_closure) cv::line(image, px(e.from), px(e.to), loop_colour, 1, cv::LINE_8);
+    }
     for (const Pose2& p : estimates[i].particles)
       cv::circle(image, px(p.translation()), 1, colour, cv::FILLED);
-    draw_path(estimate_paths_[i], colour);
+    if (i < estimate_paths.size() && estimates[i].edges.empty())
+      draw_path(estimate_paths[i], colour);
     if (estimates[i].has_pose) draw_pose(estimates[i].pose, colour);
     cv::putText(image, estimates[i].name, {10, 44 + 20 * static_cast<int>(i)},
                 cv::FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv::LINE_AA);
   }
   char text[64];
   std::snprintf(text, sizeof(text), "t = %.1f s   truth", sim_time_s);
-  cv::putText(image, text, {10, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(40, 160, 40), 1,
-              cv::LINE_AA);
-  cv::imshow(title_, image);
+  cv::putText(image, text, {10, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.5, truth_colour, 1, cv::LINE_AA);
+  frame.bgr.assign(image.data, image.data + image.total() * image.elemSize());
+  return frame;
+}
+
+void LiveView::Update(double sim_time_s, const slam::OccupancyGrid& map,
+                      const Pose2& world_from_map, const Pose2& truth,
+                      const std::vector<LiveEstimate>& estimates) {
+  truth_path_.push_back(truth);
+  estimate_paths_.resize(estimates.size());
+  for (std::size_t i = 0; i < estimates.size(); ++i)
+    estimate_paths_[i].push_back(estimates[i].pose);
+  const double now = WallSeconds();
+  if (now - last_draw_s_ < min_period_s_) return;
+  last_draw_s_ = now;
+  LiveFrame frame =
+      DrawLiveFrame(sim_time_s, map, world_from_map, truth_path_, estimates, estimate_paths_);
+  cv::imshow(title_, cv::Mat(frame.height_px, frame.width_px, CV_8UC3, frame.bgr.data()));
   cv::waitKey(1);
 }
 

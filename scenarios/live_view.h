@@ -1,5 +1,7 @@
 #pragma once
 
+#include <Eigen/Core>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -8,13 +10,47 @@
 
 namespace slamrig::scenario {
 
-/// One estimate to draw: its pose, its recent path and, for a particle filter, its particles.
+/// A pose-graph edge to draw, world frame.
+struct LiveEdge {
+  Eigen::Vector2d from = Eigen::Vector2d::Zero();
+  Eigen::Vector2d to = Eigen::Vector2d::Zero();
+  bool loop_closure = false;  ///< drawn in kLoopClosureBgr, else thin in the estimate's colour
+};
+
+/// One estimate to draw: its pose, its recent path and, for a particle filter, its particles,
+/// for a graph estimator its edges.
 struct LiveEstimate {
   std::string name;
   bool has_pose = false;  ///< false until the estimator has processed its first scan
   Pose2 pose;
   std::vector<Pose2> particles;
+  std::vector<LiveEdge> edges;
 };
+
+/// The colour of loop-closure edges in the live view (orange), blue-green-red.
+inline constexpr std::uint8_t kLoopClosureBgr[3] = {0, 140, 255};
+
+/// One drawn frame of the live view: 8-bit blue-green-red pixels, rows top to bottom.
+struct LiveFrame {
+  int width_px = 0;
+  int height_px = 0;
+  std::vector<std::uint8_t> bgr;
+  /// The pixel (column, row) that world point `p` falls in.
+  Eigen::Vector2i PixelOf(const Eigen::Vector2d& p) const;
+
+  Eigen::Vector2d min_world = Eigen::Vector2d::Zero();  ///< world point at the bottom-left
+  double px_per_m = 1.0;
+};
+
+/// Draws what LiveView shows, without a window (so it can be tested and saved offscreen): `map`
+/// (whose frame sits at `world_from_map` in the world) in grey, the true path (its last pose is
+/// the truth now) in green, each estimate with its path (`estimate_paths`, one per estimate) and
+/// particles in its colour; a graph estimate's edges replace its path (the odometry edges are its
+/// revised path), loop closures in kLoopClosureBgr.
+LiveFrame DrawLiveFrame(double sim_time_s, const slam::OccupancyGrid& map,
+                        const Pose2& world_from_map, const std::vector<Pose2>& truth_path,
+                        const std::vector<LiveEstimate>& estimates,
+                        const std::vector<std::vector<Pose2>>& estimate_paths);
 
 /// A window (OpenCV highgui) showing a run as it happens: the map being built, the particles,
 /// the true and estimated poses and their paths. It needs a display (an X server or Xvfb);

@@ -47,6 +47,7 @@ bool InBlackout(const SimulatedSource& source, Time t) {
 void ShowLive(LiveView& view, double now_s, const Runners& runners, const Pose2& map_from_start,
               bool started, const Pose2& truth) {
   const slam::EstimatorRunner* shown = runners.front().get();
+  bool shown_has_particles = !shown->estimator().View().particles.empty();
   std::vector<LiveEstimate> live;
   for (const auto& r : runners) {
     LiveEstimate e;
@@ -56,7 +57,13 @@ void ShowLive(LiveView& view, double now_s, const Runners& runners, const Pose2&
     const slam::EstimatorView extras = r->estimator().View();
     for (const slam::WeightedPose& p : extras.particles)
       e.particles.push_back(map_from_start * p.pose);
-    if (!extras.particles.empty() && shown->estimator().View().particles.empty()) shown = r.get();
+    for (const slam::ViewEdge& edge : extras.edges) {
+      e.edges.push_back({map_from_start * edge.from, map_from_start * edge.to, edge.loop_closure});
+    }
+    if (!extras.particles.empty() && !shown_has_particles) {
+      shown = r.get();
+      shown_has_particles = true;
+    }
     live.push_back(std::move(e));
   }
   view.Update(now_s, shown->estimator().map(), map_from_start, truth, live);

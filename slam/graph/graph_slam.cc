@@ -60,6 +60,20 @@ PointRaster RasterOf(const std::vector<Eigen::Vector2d>& points, double resoluti
   return raster;
 }
 
+// The mean raster value over `points` placed at `pose` (cells outside read 0): the correlative
+// matcher's score at one pose.
+double RasterScore(const PointRaster& raster, const std::vector<Eigen::Vector2d>& points,
+                   const Pose2& pose) {
+  const GridView& v = raster.view;
+  double sum = 0.0;
+  for (const Eigen::Vector2d& p : points) {
+    const Eigen::Vector2d q = pose * p;
+    sum += v.At(static_cast<int>(std::floor((q.x() - v.origin.x()) / v.resolution)),
+                static_cast<int>(std::floor((q.y() - v.origin.y()) / v.resolution)));
+  }
+  return points.empty() ? 0.0 : sum / static_cast<double>(points.size());
+}
+
 // The first point of each voxel of size `voxel_m`, in the given order.
 std::vector<Eigen::Vector2d> Thinned(const std::vector<Eigen::Vector2d>& points, double voxel_m) {
   std::set<std::pair<std::int64_t, std::int64_t>> seen;
@@ -94,6 +108,12 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
   non_negative("edge_sigma_yaw_per_rad", edge_sigma_yaw_per_rad);
   non_negative("edge_sigma_yaw_per_m", edge_sigma_yaw_per_m);
   positive("edge_sigma_yaw_floor_rad", edge_sigma_yaw_floor_rad);
+  if (odometry_check_nodes < 0) {
+    errors.push_back(RuleViolation("odometry_check_nodes", odometry_check_nodes, "must be >= 0"));
+  }
+  positive("odometry_check_window_m", odometry_check_window_m);
+  positive("odometry_check_window_rad", odometry_check_window_rad);
+  non_negative("odometry_check_min_gain", odometry_check_min_gain);
   if (loop_skip_keyframes < 1) {
     errors.push_back(RuleViolation("loop_skip_keyframes", loop_skip_keyframes, "must be >= 1"));
   }
@@ -170,13 +190,23 @@ std::vector<Pose2> GraphSlam::Poses() const {
   return poses;
 }
 
+std::vector<LoopClosure> GraphSlam::loop_closures() const {
+  std::vector<LoopClosure> kept;
+  for (std::size_t i = 0; i < closures_.size(); ++i) {
+    const std::size_t e = closure_edges_[i];
+    if (e < switches_.size() && switches_[e] < 0.5) continue;
+    kept.push_back(closures_[i]);
+  }
+  return kept;
+}
+
 void GraphSlam::AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vector2d> points) {
   const int id = static_cast<int>(nodes_.size());
   Node node{scan, odom_pose, std::move(points), Eigen::Vector2d::Zero()};
   if (nodes_.empty()) {
     graph_.AddVertex(id, Pose2(), /*fixed=*/true);
   } else {
-    const Pose2 relative = nodes_.back().odom_pose.Between(odom_pose);
+    const Pose2 relative = CheckedRelative(nodes_.back().odom_pose.Between(odom_pose), node.points);
     const double d = relative.translation().norm();
     const double sxy = options_.edge_sigma_xy_per_m * d + options_.edge_sigma_xy_floor_m;
     const double syaw = options_.edge_sigma_yaw_per_rad * std::abs(relative.theta()) +
@@ -192,6 +222,36 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vec
   }
   nodes_.push_back(std::move(node));
   ++counts_.keyframes;
+}
+
+Pose2 GraphSlam::CheckedRelative(const Pose2& relative,
+                                 const std::vector<Eigen::Vector2d>& points) {
+  const int newest = static_cast<int>(nodes_.size()) - 1;
+  if (options_.odometry_check_nodes == 0 || points.size() < 10) return relative;
+  std::vector<Eigen::Vector2d> reference;
+  for (int k = std::max(0, newest - options_.odometry_check_nodes + 1); k <= newest; ++k) {
+    const Pose2 newest_from_k = graph_.pose(newest).Between(graph_.pose(k));
+    for (const Eigen::Vector2d& p : nodes_[k].points) reference.push_back(newest_from_k * p);
+  }
+  if (reference.size() < 10) return relative;
+  const PointRaster raster =
+      RasterOf(reference, options_.submap_resolution_m, options_.submap_blur_m);
+  CorrelativeMatcherOptions search = options_.correlative;
+  search.linear_window_m = options_.odometry_check_window_m;
+  search.angular_window_rad = options_.odometry_check_window_rad;
+  const std::vector<Eigen::Vector2d> query = Thinned(points, options_.submap_resolution_m);
+  const std::optional<MatchResult> coarse =
+      CorrelativeMatcher(search, raster.view).Match(query, relative);
+  if (!coarse) return relative;
+  const std::optional<MatchResult> fine =
+      IcpMatcher(options_.loop_icp, reference).Match(points, coarse->pose);
+  if (!fine || fine->score < options_.loop_min_icp_score) return relative;
+  if (!(RasterScore(raster, query, fine->pose) >
+        RasterScore(raster, query, relative) + options_.odometry_check_min_gain)) {
+    return relative;
+  }
+  ++counts_.odometry_rematched;
+  return fine->pose;
 }
 
 std::vector<Eigen::Vector2d> GraphSlam::PathVariances() const {
@@ -263,6 +323,7 @@ void GraphSlam::SearchLoops() {
       ++counts_.rejected;
       continue;
     }
+    closure_edges_.push_back(graph_.edges().size());
     graph_.AddEdge(*edge);
     const Eigen::Matrix3d covariance = edge->information.inverse();
     edge_variances_.emplace_back(covariance(0, 0) + covariance(1, 1), covariance(2, 2));
@@ -352,6 +413,11 @@ std::optional<PoseGraphEdge> GraphSlam::TryClosure(int candidate, const Eigen::V
 void GraphSlam::Optimize() {
   const PoseGraphSummary summary = optimizer_.Optimize(&graph_);
   counts_.final_chi2 = summary.final_chi2;
+  switches_ = summary.switches;
+  counts_.switched_off = 0;
+  for (const std::size_t e : closure_edges_) {
+    counts_.switched_off += e < switches_.size() && switches_[e] < 0.5;
+  }
   ++counts_.optimizations;
   pending_closure_ = false;
   nodes_at_last_optimization_ = static_cast<int>(nodes_.size());

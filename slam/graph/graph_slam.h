@@ -34,6 +34,10 @@ struct GraphSlamCounts {
   int rejected = 0;         ///< candidates that failed a match or a check
   int optimizations = 0;
   double final_chi2 = 0.0;  ///< chi2 of the last optimisation
+  /// Accepted closures whose switch the last optimisation turned off (below 0.5), with the
+  /// switchable robust loss; they no longer count as loop closures.
+  int switched_off = 0;
+  int odometry_rematched = 0;  ///< odometry edges the odometry check replaced
 };
 
 /// Online graph SLAM over laser scans with an odometry increment each. Deterministic; not
@@ -52,7 +56,9 @@ class GraphSlam {
   /// The current estimate of every scan so far: its node's pose composed with the scan's pose
   /// relative to that node.
   std::vector<Pose2> Poses() const;
-  const std::vector<LoopClosure>& loop_closures() const { return closures_; }
+  /// The accepted loop closures the back end keeps (all of them, or with switchable constraints
+  /// those whose switch is on).
+  std::vector<LoopClosure> loop_closures() const;
   const GraphSlamCounts& counts() const { return counts_; }
   const PoseGraph& graph() const { return graph_; }
 
@@ -66,6 +72,9 @@ class GraphSlam {
   // Variances (xy, yaw) along the least uncertain graph path from the newest node to every node.
   std::vector<Eigen::Vector2d> PathVariances() const;
   void AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vector2d> points);
+  // The pose of `points` in the newest node's frame: `relative` (ICP odometry's), or the
+  // odometry check's re-match when it fits the last nodes clearly better.
+  Pose2 CheckedRelative(const Pose2& relative, const std::vector<Eigen::Vector2d>& points);
   void SearchLoops();
   std::optional<PoseGraphEdge> TryClosure(int candidate, const Eigen::Vector2d& variance);
   void Optimize();
@@ -79,6 +88,8 @@ class GraphSlam {
   std::vector<Pose2> scan_from_node_;            // each scan in its node's frame
   std::vector<Eigen::Vector2d> edge_variances_;  // (xy, yaw) of each graph edge, in order
   std::vector<LoopClosure> closures_;
+  std::vector<std::size_t> closure_edges_;  // graph edge of each closure
+  std::vector<double> switches_;            // of each graph edge, from the last optimisation
   GraphSlamCounts counts_;
   bool pending_closure_ = false;
   int nodes_at_last_optimization_ = 0;

@@ -22,7 +22,8 @@ void VisitFields(V& v, PoseGraphOptimizerOptions& o) {
   v.Enum("robust_loss", o.robust_loss,
          {{RobustLoss::kNone, "none"},
           {RobustLoss::kHuber, "huber"},
-          {RobustLoss::kCauchy, "cauchy"}});
+          {RobustLoss::kCauchy, "cauchy"},
+          {RobustLoss::kSwitchable, "switchable"}});
   v("robust_loss_scale", o.robust_loss_scale);
   v("robust_loss_on_all_edges", o.robust_loss_on_all_edges);
   v("function_tolerance", o.function_tolerance);
@@ -48,6 +49,15 @@ struct GraphSlamOptions {
   double edge_sigma_yaw_per_rad = 0.05;
   double edge_sigma_yaw_per_m = 0.005;
   double edge_sigma_yaw_floor_rad = 0.002;
+  /// Odometry check: each new node's ICP-odometry pose is re-searched by the correlative matcher
+  /// against the last odometry_check_nodes nodes' points (0: off), within +-window of it, and
+  /// refined by loop_icp; the re-match replaces the edge when its blurred-raster score beats the
+  /// ICP odometry pose's by odometry_check_min_gain (ICP's local minima: a turn between scans a
+  /// metre apart locked onto the wrong wall).
+  int odometry_check_nodes = 3;
+  double odometry_check_window_m = 0.3;
+  double odometry_check_window_rad = 0.35;
+  double odometry_check_min_gain = 0.1;
 
   /// Loop closures are searched among nodes older than the last loop_skip_keyframes ...
   int loop_skip_keyframes = 30;
@@ -106,6 +116,10 @@ void VisitFields(V& v, GraphSlamOptions& o) {
   v("edge_sigma_yaw_per_rad", o.edge_sigma_yaw_per_rad);
   v("edge_sigma_yaw_per_m", o.edge_sigma_yaw_per_m);
   v("edge_sigma_yaw_floor_rad", o.edge_sigma_yaw_floor_rad);
+  v("odometry_check_nodes", o.odometry_check_nodes);
+  v("odometry_check_window_m", o.odometry_check_window_m);
+  v("odometry_check_window_rad", o.odometry_check_window_rad);
+  v("odometry_check_min_gain", o.odometry_check_min_gain);
   v("loop_skip_keyframes", o.loop_skip_keyframes);
   v("loop_search_radius_m", o.loop_search_radius_m);
   v("loop_radius_sigmas", o.loop_radius_sigmas);

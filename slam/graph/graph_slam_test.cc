@@ -119,5 +119,48 @@ TEST(GraphSlamTest, IdenticalRoomsYieldNoFalseClosure) {
   }
 }
 
+// One odometry increment 0.25 rad and 0.15 m off, with ICP odometry's correction gate too tight to
+// fix it (its prior stands, as when ICP falls into a local minimum): the odometry check re-matches
+// the node against the last nodes and repairs the edge; without it the heading error stays.
+TEST(GraphSlamTest, OdometryCheckRepairsAWrongOdometryEdge) {
+  testing::SegmentWorld world({});
+  world.AddBox(0.0, 0.0, 6.0, 4.0);
+  world.AddBox(1.0, 2.5, 1.6, 3.1);
+  world.AddBox(4.2, 0.8, 4.6, 1.4);
+  testing::RangeFinderSpec lidar;
+  lidar.num_beams = 181;
+  lidar.angle_increment_rad = 1.5 * M_PI / 180.0;
+  lidar.angle_min_rad = -M_PI / 2.0 * 1.5;
+  std::vector<Pose2> truth;
+  for (int k = 0; k < 30; ++k) truth.emplace_back(1.0 + 0.13 * k, 1.5, 0.02 * k);
+  const int wrong = 15;
+  auto run = [&](int check_nodes) {
+    GraphSlamOptions options;
+    options.keyframe_distance_m = 0.1;
+    options.odometry.max_correction_m = 0.02;
+    options.odometry.max_correction_rad = 0.02;
+    options.loop_max_candidates = 0;
+    options.odometry_check_nodes = check_nodes;
+    GraphSlam slam{options};
+    RandomEngine rng(4);
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      Pose2 increment = i == 0 ? Pose2() : truth[i - 1].Between(truth[i]);
+      if (static_cast<int>(i) == wrong) increment = increment * Pose2(0.15, 0.0, 0.25);
+      slam.Add(world.Scan(truth[i], Time(static_cast<std::int64_t>(i) * 100'000'000), lidar, &rng),
+               increment);
+    }
+    slam.Finish();
+    const Pose2 error = truth[0].Between(truth.back()).Between(slam.Poses().back());
+    return std::pair{slam.counts().odometry_rematched, error};
+  };
+  const auto [rematched_off, error_off] = run(0);
+  const auto [rematched_on, error_on] = run(3);
+  EXPECT_EQ(rematched_off, 0);
+  EXPECT_GT(std::abs(error_off.theta()), 0.2);
+  EXPECT_GE(rematched_on, 1);
+  EXPECT_LT(std::abs(error_on.theta()), 0.03);
+  EXPECT_LT(error_on.translation().norm(), 0.05);
+}
+
 }  // namespace
 }  // namespace slamrig::slam

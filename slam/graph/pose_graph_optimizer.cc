@@ -6,6 +6,7 @@
 #include <array>
 #include <memory>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include "slam/graph/edge_error.h"
@@ -46,6 +47,60 @@ class EdgeCost final : public ceres::SizedCostFunction<3, 3, 3> {
  private:
   Pose2 measurement_;
   Eigen::Matrix3d sqrt_information_;
+};
+
+// A switchable edge (Sünderhauf and Protzel 2012, eq. 4): the residual w S e, its switch w the
+// third parameter block.
+class SwitchedEdgeCost final : public ceres::SizedCostFunction<3, 3, 3, 1> {
+ public:
+  SwitchedEdgeCost(const Pose2& measurement, const Eigen::Matrix3d& information)
+      : edge_(measurement, information) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double w = parameters[2][0];
+    double* edge_jacobians[2] = {nullptr, nullptr};
+    double storage[2][9];
+    if (jacobians != nullptr) {
+      for (int k = 0; k < 2; ++k)
+        edge_jacobians[k] = jacobians[k] != nullptr ? storage[k] : nullptr;
+    }
+    Eigen::Vector3d r;
+    if (!edge_.Evaluate(parameters, r.data(), jacobians != nullptr ? edge_jacobians : nullptr)) {
+      return false;
+    }
+    for (int i = 0; i < 3; ++i) residuals[i] = w * r[i];
+    if (jacobians != nullptr) {
+      for (int k = 0; k < 2; ++k) {
+        if (jacobians[k] != nullptr) {
+          for (int i = 0; i < 9; ++i) jacobians[k][i] = w * storage[k][i];
+        }
+      }
+      if (jacobians[2] != nullptr) {
+        for (int i = 0; i < 3; ++i) jacobians[2][i] = r[i];
+      }
+    }
+    return true;
+  }
+
+ private:
+  EdgeCost edge_;
+};
+
+// The switch's prior: scale (1 - w), pulling every switch towards on.
+class SwitchPriorCost final : public ceres::SizedCostFunction<1, 1> {
+ public:
+  explicit SwitchPriorCost(double scale) : scale_(scale) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    residuals[0] = scale_ * (1.0 - parameters[0][0]);
+    if (jacobians != nullptr && jacobians[0] != nullptr) jacobians[0][0] = -scale_;
+    return true;
+  }
+
+ private:
+  double scale_;
 };
 
 // The same residual, templated for Ceres's automatic differentiation (the cross-check of the
@@ -116,6 +171,8 @@ std::unique_ptr<ceres::LossFunction> MakeLoss(RobustLoss loss, double scale) {
       return std::make_unique<ceres::HuberLoss>(scale);
     case RobustLoss::kCauchy:
       return std::make_unique<ceres::CauchyLoss>(scale);
+    case RobustLoss::kSwitchable:
+      return nullptr;  // a switch variable per edge instead (SwitchedEdgeCost)
   }
   return nullptr;
 }
@@ -168,8 +225,21 @@ PoseGraphSummary PoseGraphOptimizer::Optimize(PoseGraph* graph) const {
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
-  for (const PoseGraphEdge& e : graph->edges()) {
+  const bool switchable = options_.robust_loss == RobustLoss::kSwitchable;
+  // Every switch starts on: the solve turns off the edges the others contradict.
+  std::vector<double> switches(switchable ? graph->edges().size() : 0, 1.0);
+  for (std::size_t k = 0; k < graph->edges().size(); ++k) {
+    const PoseGraphEdge& e = graph->edges()[k];
     const bool robust = options_.robust_loss_on_all_edges || e.kind == EdgeKind::kLoopClosure;
+    if (switchable && robust) {
+      double* w = &switches[k];
+      problem.AddResidualBlock(new SwitchedEdgeCost(e.measurement, e.information), nullptr,
+                               x[graph->IndexOf(e.from)].data(), x[graph->IndexOf(e.to)].data(), w);
+      problem.AddResidualBlock(new SwitchPriorCost(options_.robust_loss_scale), nullptr, w);
+      problem.SetParameterLowerBound(w, 0, 0.0);
+      problem.SetParameterUpperBound(w, 0, 1.0);
+      continue;
+    }
     ceres::CostFunction* cost = options_.autodiff_jacobians
                                     ? static_cast<ceres::CostFunction*>(
                                           new ceres::AutoDiffCostFunction<EdgeResidual, 3, 3, 3>(
@@ -203,6 +273,7 @@ PoseGraphSummary PoseGraphOptimizer::Optimize(PoseGraph* graph) const {
   summary.time_s = ceres_summary.total_time_in_seconds;
   summary.converged = ceres_summary.termination_type == ceres::CONVERGENCE;
   summary.message = ceres_summary.message;
+  summary.switches = std::move(switches);
   return summary;
 }
 

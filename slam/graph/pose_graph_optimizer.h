@@ -7,6 +7,7 @@
 // normal equations.
 
 #include <string>
+#include <vector>
 
 #include "slam/graph/pose_graph.h"
 #include "slam/graph/pose_graph_optimizer_options.h"
@@ -29,6 +30,9 @@ struct PoseGraphSummary {
   bool converged = false;
   /// Ceres's termination message.
   std::string message;
+  /// With RobustLoss::kSwitchable: the final switch of each edge, in PoseGraph::edges() order
+  /// (1 for an edge without a switch); empty with the other losses.
+  std::vector<double> switches;
 };
 
 /// Optimises a PoseGraph in place. Stateless between calls, so a front end that adds vertices

@@ -43,6 +43,8 @@ const char* RobustLossName(RobustLoss loss) {
       return "huber";
     case RobustLoss::kCauchy:
       return "cauchy";
+    case RobustLoss::kSwitchable:
+      return "switchable";
   }
   return "?";
 }

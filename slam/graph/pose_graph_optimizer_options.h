@@ -7,8 +7,12 @@ namespace slamrig::slam {
 
 /// A robust loss on an edge's whitened squared error s = e^T Omega e (Ceres's LossFunction):
 /// none keeps the plain chi2, huber is quadratic up to s = scale^2 and linear in sqrt(s) beyond,
-/// cauchy is scale^2 * log(1 + s / scale^2).
-enum class RobustLoss { kNone, kHuber, kCauchy };
+/// cauchy is scale^2 * log(1 + s / scale^2). switchable gives each robust edge a switch
+/// w in [0, 1] that the solve estimates with the poses (Sünderhauf and Protzel, "Switchable
+/// constraints for robust pose graph SLAM", IROS 2012, eq. 4, with the linear switch function):
+/// the edge costs w^2 s + scale^2 (1 - w)^2, so at the optimum w = scale^2 / (s + scale^2), half
+/// switched off where sqrt(s) = scale.
+enum class RobustLoss { kNone, kHuber, kCauchy, kSwitchable };
 
 /// The trust-region strategy of the Ceres solve.
 enum class TrustRegion { kLevenbergMarquardt, kDogleg };

@@ -143,6 +143,71 @@ TEST(PoseGraphOptimizerTest, RobustLossResistsAFalseLoopClosure) {
   EXPECT_NE(loops_only.pose(30), all.pose(30));
 }
 
+TEST(PoseGraphOptimizerTest, SwitchableConstraintsTurnOffOnlyTheFalseLoopClosure) {
+  testing::RandomPoseGraph r =
+      testing::MakeRandomPoseGraph({.num_poses = 60, .loop_closure_probability = 0.4, .seed = 6});
+  PoseGraph clean = r.graph;
+  PoseGraphOptimizer({}).Optimize(&clean);
+  std::vector<Pose2> clean_poses;
+  for (const PoseGraphVertex& v : clean.vertices()) clean_poses.push_back(v.pose);
+  const std::size_t false_edge = r.graph.edges().size();
+  r.graph.AddEdge({.from = 10,
+                   .to = 50,
+                   .measurement = Pose2(5.0, 0.0, 1.0),
+                   .information = r.graph.edges()[0].information,
+                   .kind = EdgeKind::kLoopClosure});
+  PoseGraphOptimizerOptions options;
+  options.robust_loss = RobustLoss::kSwitchable;
+  // Half off at a whitened error of 4 (chi2 16, the 3-dof 99.9 % gate): a true closure's chi2 is
+  // about 3, so its switch settles near 16 / 19.
+  options.robust_loss_scale = 4.0;
+  const PoseGraphSummary s = PoseGraphOptimizer(options).Optimize(&r.graph);
+  EXPECT_TRUE(s.converged) << s.message;
+  ASSERT_EQ(s.switches.size(), r.graph.edges().size());
+  // The false closure is off; every true one stays on (its switch at the closed form
+  // scale^2 / (s + scale^2) of its small residual), odometry edges have no switch.
+  EXPECT_LT(s.switches[false_edge], 0.01);
+  int loops = 0;
+  for (std::size_t k = 0; k < false_edge; ++k) {
+    if (r.graph.edges()[k].kind == EdgeKind::kLoopClosure) {
+      ++loops;
+      EXPECT_GT(s.switches[k], 0.5) << k;
+    } else {
+      EXPECT_EQ(s.switches[k], 1.0) << k;
+    }
+  }
+  EXPECT_GT(loops, 5);
+  EXPECT_LT(MaxPositionError(r.graph, clean_poses), 0.05);
+}
+
+TEST(PoseGraphOptimizerTest, ASwitchSettlesWhereTheClosedFormPutsIt) {
+  // Two vertices, a rigid odometry edge and a loop closure that disagrees by 1 m along x with
+  // information 4 (whitened error 2): the poses barely move, and the switch minimises
+  // w^2 * 4 + scale^2 (1 - w)^2, i.e. w = scale^2 / (4 + scale^2).
+  for (const double scale : {0.5, 1.0, 2.0, 4.0}) {
+    PoseGraph g;
+    g.AddVertex(0, Pose2(), /*fixed=*/true);
+    g.AddVertex(1, Pose2(1.0, 0.0, 0.0));
+    g.AddEdge({.from = 0,
+               .to = 1,
+               .measurement = Pose2(1.0, 0.0, 0.0),
+               .information = 1e8 * Eigen::Matrix3d::Identity(),
+               .kind = EdgeKind::kOdometry});
+    g.AddEdge({.from = 0,
+               .to = 1,
+               .measurement = Pose2(2.0, 0.0, 0.0),
+               .information = 4.0 * Eigen::Matrix3d::Identity(),
+               .kind = EdgeKind::kLoopClosure});
+    PoseGraphOptimizerOptions options;
+    options.robust_loss = RobustLoss::kSwitchable;
+    options.robust_loss_scale = scale;
+    const PoseGraphSummary s = PoseGraphOptimizer(options).Optimize(&g);
+    ASSERT_EQ(s.switches.size(), 2u);
+    EXPECT_EQ(s.switches[0], 1.0);
+    EXPECT_NEAR(s.switches[1], scale * scale / (4.0 + scale * scale), 1e-4) << scale;
+  }
+}
+
 TEST(PoseGraphOptimizerTest, ReportsAnIterationLimitAsNotConverged) {
   testing::RandomPoseGraph r = testing::MakeRandomPoseGraph({.num_poses = 60, .seed = 12});
   Perturb(&r.graph, 0.5, 13);

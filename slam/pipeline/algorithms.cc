@@ -52,7 +52,8 @@ const std::vector<Algorithm>& Algorithms() {
        "graph SLAM: ICP odometry keyframes, loop closures by correlative matching verified by "
        "ICP and a chi2 gate, Ceres with a robust loss",
        {"default"},
-       {"keyframes", "loop_closures", "loop_candidates", "rejected", "optimizations", "final_chi2"},
+       {"keyframes", "loop_closures", "loop_candidates", "rejected", "optimizations", "final_chi2",
+        "switched_off"},
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<
              AlgorithmOptionsFor<GraphSlamEstimatorOptions, GraphSlamEstimator>>(

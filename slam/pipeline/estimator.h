@@ -37,10 +37,18 @@ struct WeightedPose {
   double weight = 0.0;
 };
 
+/// An edge of a pose graph to draw: the positions of the two nodes it joins.
+struct ViewEdge {
+  Eigen::Vector2d from = Eigen::Vector2d::Zero();
+  Eigen::Vector2d to = Eigen::Vector2d::Zero();
+  bool loop_closure = false;  ///< a loop closure, else an odometry edge
+};
+
 /// What the live view (and `slamrig slam --clouds`) may show besides the pose and the map, in
 /// the estimator's frame.
 struct EstimatorView {
   std::vector<WeightedPose> particles;
+  std::vector<ViewEdge> edges;  ///< a graph estimator's edges at its current estimate
 };
 
 /// The one interface every SLAM algorithm implements (dead reckoning, the particle filter, and

@@ -15,18 +15,36 @@ GraphSlamEstimator::GraphSlamEstimator(const GraphSlamEstimatorOptions& options,
     : options_(options), slam_(options.graph), map_(options.map) {}
 
 ScanEstimate GraphSlamEstimator::AddScan(const SyncedScan& scan) {
+  const int keyframes = slam_.counts().keyframes;
   const Pose2 pose = slam_.Add(scan.scan, scan.increment);
-  map_.InsertScan(scan.scan, pose);
-  scans_.push_back(scan.scan);
+  // Only the graph's nodes enter the map: inserting every scan at the scan rate wears thin walls
+  // away (grazing beams clear them) and over-weights the places where the robot stood still.
+  if (slam_.counts().keyframes > keyframes) {
+    map_.InsertScan(scan.scan, pose);
+    node_scans_.push_back(scan.scan);
+  }
   return {pose, std::nullopt, {}, std::nullopt};
 }
 
 void GraphSlamEstimator::Finish() {
   slam_.Finish();
-  // The map from the optimised poses.
+  // The map from the nodes' optimised poses.
   map_ = OccupancyGrid(options_.map);
-  const std::vector<Pose2> poses = slam_.Poses();
-  for (std::size_t i = 0; i < scans_.size(); ++i) map_.InsertScan(scans_[i], poses[i]);
+  const PoseGraph& graph = slam_.graph();
+  for (std::size_t k = 0; k < node_scans_.size(); ++k) {
+    map_.InsertScan(node_scans_[k], graph.pose(static_cast<int>(k)));
+  }
+}
+
+EstimatorView GraphSlamEstimator::View() const {
+  EstimatorView view;
+  const PoseGraph& graph = slam_.graph();
+  view.edges.reserve(graph.edges().size());
+  for (const PoseGraphEdge& e : graph.edges()) {
+    view.edges.push_back({graph.pose(e.from).translation(), graph.pose(e.to).translation(),
+                          e.kind == EdgeKind::kLoopClosure});
+  }
+  return view;
 }
 
 std::map<std::string, double> GraphSlamEstimator::Statistics() const {
@@ -36,7 +54,9 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"loop_candidates", c.loop_candidates},
           {"rejected", c.rejected},
           {"optimizations", c.optimizations},
-          {"final_chi2", c.final_chi2}};
+          {"final_chi2", c.final_chi2},
+          {"switched_off", c.switched_off},
+          {"odometry_rematched", c.odometry_rematched}};
 }
 
 }  // namespace slamrig::slam

@@ -29,9 +29,9 @@ void VisitFields(V& v, GraphSlamEstimatorOptions& o) {
   v.Struct("map", o.map);
 }
 
-/// Graph SLAM with verified loop closures (GraphSlam) behind the Estimator interface. The online
-/// map is built along the online poses; Finish() optimises once more and rebuilds the map from
-/// the revised poses.
+/// Graph SLAM with verified loop closures (GraphSlam) behind the Estimator interface. The map
+/// holds the scans of the graph's nodes (keyframes), online at their online poses; Finish()
+/// optimises once more and rebuilds it from the nodes' revised poses.
 class GraphSlamEstimator final : public Estimator {
  public:
   GraphSlamEstimator(const GraphSlamEstimatorOptions& options, const EstimatorContext& context);
@@ -40,15 +40,18 @@ class GraphSlamEstimator final : public Estimator {
   void Finish() override;
   std::optional<std::vector<Pose2>> RevisedPoses() const override { return slam_.Poses(); }
   const OccupancyGrid& map() const override { return map_; }
-  /// keyframes, loop_closures, loop_candidates, rejected, optimizations, final_chi2.
+  /// keyframes, loop_closures, loop_candidates, rejected, optimizations, final_chi2,
+  /// switched_off.
   std::map<std::string, double> Statistics() const override;
   std::vector<LoopClosure> LoopClosures() const override { return slam_.loop_closures(); }
+  /// The graph's odometry and loop-closure edges at the current estimate.
+  EstimatorView View() const override;
 
  private:
   GraphSlamEstimatorOptions options_;
   GraphSlam slam_;
   OccupancyGrid map_;
-  std::vector<LaserScan> scans_;  // for the final map
+  std::vector<LaserScan> node_scans_;  // the scan of each graph node (vertex id), for the map
 };
 
 }  // namespace slamrig::slam
