@@ -29,6 +29,9 @@ struct BagTopicNames {
   std::string tf = "/tf";                           ///< tf2_msgs/msg/TFMessage, odom -> base
   std::string tf_static = "/tf_static";             ///< tf2_msgs/msg/TFMessage, base -> laser
   std::string clock = "/clock";                     ///< rosgraph_msgs/msg/Clock
+  std::string rgb = "/camera/color/image_raw";      ///< sensor_msgs/msg/Image, rgb8
+  std::string depth = "/camera/depth/image_raw";    ///< sensor_msgs/msg/Image, 32FC1 metres
+  std::string camera_info = "/camera/color/camera_info";  ///< sensor_msgs/msg/CameraInfo
 
   /// One RuleViolation() message per name that is not an absolute ROS name, or is repeated.
   std::vector<std::string> Validate() const;
@@ -47,6 +50,8 @@ struct BagFrames {
   std::string base = "base_link";
   std::string laser = "laser";
   std::string imu = "base_link";  ///< the IMU is aligned with base_link
+  std::string camera = "camera_color_optical_frame";  ///< RGB images and camera info
+  std::string depth = "camera_depth_optical_frame";   ///< depth images
 
   /// One RuleViolation() message per empty name.
   std::vector<std::string> Validate() const;
