@@ -228,6 +228,9 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
   slam::OccupancyGrid truth_map{slam::OccupancyGridOptions{}};
   std::unique_ptr<LiveView> view;
   if (options.view) view = std::make_unique<LiveView>("slamrig: " + spec.name);
+  // The live texture: each frame at the first configuration's latest pose (what it knows then).
+  std::optional<slam::TextureMap> live_texture;
+  if (view && texture) live_texture.emplace(texture->options());
 
   std::optional<Pose2> map_from_start;  // true pose at the first scan SLAM sees
   LaserScan truth_scan;
@@ -256,6 +259,9 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
       } else if (const auto* frame = std::get_if<RgbdFrame>(&record)) {
         ++result.frames;
         texture->Add(*frame, step.truth[i].map_from_base);
+        if (live_texture && map_from_start && runners.front()->scans() > 0) {
+          live_texture->Insert(*frame, *map_from_start * runners.front()->pose());
+        }
       }
       for (auto& r : runners) r->Add(record);
     }
@@ -284,6 +290,7 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
       if (view) {
         ShowLive(*view, now_s, runners, map_from_start.value_or(Pose2()),
                  map_from_start.has_value(), simulator.Truth().map_from_base);
+        if (live_texture) view->ShowTexture(live_texture->Colors());
       }
     }
   }
