@@ -46,8 +46,8 @@ struct RunSummary {
   int num_scans = 0;            ///< scans written (ROBOTLASER1 lines, /scan messages)
   int num_odometry = 0;         ///< odometry poses written (ODOM lines, /odom messages)
   int num_imu = 0;              ///< IMU samples fed to the odometry
-  int num_frames = 0;  ///< RGB-D frames rendered (a robot with a camera)
-  int frames_skipped = 0;  ///< of them, not written (a CARMEN log has no image line)
+  int num_frames = 0;           ///< RGB-D frames rendered (a robot with a camera)
+  int frames_skipped = 0;       ///< of them, not written (a CARMEN log has no image line)
   Pose2 final_truth;            ///< map_from_base at the end
   Pose2 final_odometry;  ///< odom_from_base at the end (the robot's own encoder + gyro estimate)
   double path_length_m = 0.0;      ///< true distance driven

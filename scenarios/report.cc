@@ -266,17 +266,18 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
   if (r.true_texture && r.truth_texture) {
     write_rgb("texture_truth.png", *r.true_texture);
     write_rgb("texture_true_poses.png", r.truth_texture->colors);
-    html_texture += "<figure><img src=\"texture_truth.png\"><figcaption>The true floor texture."
-                    "</figcaption></figure><figure><img src=\"texture_true_poses.png\">"
-                    "<figcaption>The texture map from the true poses (PSNR " +
-                    Number(r.truth_texture->score.psnr_db.value_or(NAN)) + " dB, coverage " +
-                    Number(r.truth_texture->score.coverage) + ").</figcaption></figure>";
+    html_texture +=
+        "<figure><img src=\"texture_truth.png\"><figcaption>The true floor texture."
+        "</figcaption></figure><figure><img src=\"texture_true_poses.png\">"
+        "<figcaption>The texture map from the true poses (PSNR " +
+        Number(r.truth_texture->score.psnr_db.value_or(NAN)) + " dB, coverage " +
+        Number(r.truth_texture->score.coverage) + ").</figcaption></figure>";
   }
   for (const ConfigResult& c : r.configs) {
     if (!c.texture) continue;
     write_rgb(c.name + "_texture.png", c.texture->colors);
-    html_texture += "<figure><img src=\"" + c.name + "_texture.png\"><figcaption>" +
-                    Html(c.name) + "'s texture map from its final poses (PSNR " +
+    html_texture += "<figure><img src=\"" + c.name + "_texture.png\"><figcaption>" + Html(c.name) +
+                    "'s texture map from its final poses (PSNR " +
                     Number(c.texture->score.psnr_db.value_or(NAN)) + " dB).</figcaption></figure>";
   }
 

@@ -315,9 +315,8 @@ std::string ResolvedYaml(const ScenarioSpec& spec, const std::vector<std::string
     // Bag topic names, every one (the defaults too), so that the resolved file is complete.
     slam::BagTopicNames topics = spec.log->read.topics;
     out << YAML::Key << "topics" << YAML::Value << YAML::BeginMap;
-    for (const char* key :
-         {"scan", "imu", "joint_states", "odom", "ground_truth", "tf", "tf_static", "clock", "rgb",
-          "depth", "camera_info"}) {
+    for (const char* key : {"scan", "imu", "joint_states", "odom", "ground_truth", "tf",
+                            "tf_static", "clock", "rgb", "depth", "camera_info"}) {
       out << YAML::Key << key << YAML::Value << *topics.Find(key);
     }
     out << YAML::EndMap << YAML::EndMap;

@@ -22,9 +22,9 @@ struct ZoneTexture {
 };
 
 /// An RGB-D camera on the robot (the robot file's `camera:` block), rendered by MuJoCo in
-/// sim/camera; the options live here so that a RobotSpec can carry them. Defaults: the ECE276A robot's Kinect at 640 x
-/// 480 and 10 Hz with the intrinsics and mounting of the reports (Zafari, ECE276A report,
-/// "Texture Mapping"; the course's robot configuration).
+/// sim/camera; the options live here so that a RobotSpec can carry them. Defaults: the ECE276A
+/// robot's Kinect at 640 x 480 and 10 Hz with the intrinsics and mounting of the reports (Zafari,
+/// ECE276A report, "Texture Mapping"; the course's robot configuration).
 struct CameraSpec {
   std::string name = "kinect";  ///< names the camera in errors
   int width_px = 640;           ///< image columns

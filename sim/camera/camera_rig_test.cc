@@ -21,7 +21,7 @@ SimulatorOptions Office() {
 }
 
 std::vector<Record> Drive(Simulator& sim, CameraRig* rig, double seconds,
-                        std::vector<TruthSample>* truth) {
+                          std::vector<TruthSample>* truth) {
   std::vector<Record> records;
   auto take = [&](StepResult step) {
     for (std::size_t i = 0; i < step.records.size(); ++i) {
@@ -73,7 +73,8 @@ TEST(CameraRigTest, FramesJoinTheStreamInTimeOrderAndChangeNoOtherRecord) {
       EXPECT_EQ(s->ranges_m, std::get<LaserScan>(without[i]).ranges_m) << i;
     }
     if (const auto* imu = std::get_if<ImuSample>(&others[i])) {
-      EXPECT_EQ(imu->angular_velocity_rad_s, std::get<ImuSample>(without[i]).angular_velocity_rad_s);
+      EXPECT_EQ(imu->angular_velocity_rad_s,
+                std::get<ImuSample>(without[i]).angular_velocity_rad_s);
     }
   }
 }

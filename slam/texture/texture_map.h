@@ -37,8 +37,8 @@ struct TextureMapOptions {
 /// a frame is reduced to these once and mapped with any estimator's pose later: a few hundred
 /// kilobytes instead of the frame's megabytes.
 struct FloorPixels {
-  Time time;                               ///< the frame's time
-  std::vector<Eigen::Vector2f> base_xy_m;  ///< floor points in base_link, metres
+  Time time;                                     ///< the frame's time
+  std::vector<Eigen::Vector2f> base_xy_m;        ///< floor points in base_link, metres
   std::vector<std::array<std::uint8_t, 3>> rgb;  ///< their colours (r, g, b), one per point
   int depth_readings = 0;  ///< depth pixels with a reading in range (floor or not)
 };

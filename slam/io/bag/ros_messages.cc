@@ -238,10 +238,10 @@ void EncodeCameraInfo(const RgbdFrame& frame, std::string_view frame_id, std::st
   w.Float64Array(kk);
   w.Float64Array(r);
   w.Float64Array(p);
-  w.Uint32(0);  // binning_x
-  w.Uint32(0);  // binning_y
+  w.Uint32(0);                              // binning_x
+  w.Uint32(0);                              // binning_y
   for (int i = 0; i < 4; ++i) w.Uint32(0);  // roi: the whole image
-  w.Uint8(0);                                // roi.do_rectify
+  w.Uint8(0);                               // roi.do_rectify
 }
 
 void EncodeLaserScan(const LaserScan& scan, std::string_view frame_id, std::string* out) {

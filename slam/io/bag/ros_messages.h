@@ -24,10 +24,9 @@ enum class RosType {
 };
 
 /// All types, in a fixed order.
-inline constexpr RosType kAllRosTypes[] = {RosType::kLaserScan,  RosType::kImu,
-                                           RosType::kJointState, RosType::kOdometry,
-                                           RosType::kTfMessage,  RosType::kClock,
-                                           RosType::kImage,      RosType::kCameraInfo};
+inline constexpr RosType kAllRosTypes[] = {
+    RosType::kLaserScan, RosType::kImu,   RosType::kJointState, RosType::kOdometry,
+    RosType::kTfMessage, RosType::kClock, RosType::kImage,      RosType::kCameraInfo};
 
 /// The type's ROS 2 name, e.g. "sensor_msgs/msg/LaserScan".
 std::string_view RosTypeName(RosType type);
