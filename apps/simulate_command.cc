@@ -110,6 +110,11 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
       summary.num_scans, summary.num_odometry, summary.num_imu, error.translation().norm(),
       std::abs(error.theta()) * 180.0 / std::numbers::pi, seconds,
       summary.duration_s / std::max(seconds, 1e-9), out_dir.c_str());
+  if (summary.num_frames > 0) {
+    std::printf("%d RGB-D frames rendered, %d written%s\n", summary.num_frames,
+                summary.num_frames - summary.frames_skipped,
+                summary.frames_skipped ? " (a CARMEN log has no image line)" : "");
+  }
   return 0;
 }
 

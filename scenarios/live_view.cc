@@ -29,7 +29,21 @@ LiveView::LiveView(const std::string& title, double max_fps)
   cv::namedWindow(title_, cv::WINDOW_AUTOSIZE);
 }
 
-LiveView::~LiveView() { cv::destroyWindow(title_); }
+LiveView::~LiveView() {
+  if (texture_shown_) cv::destroyWindow(title_ + ": texture");
+  cv::destroyWindow(title_);
+}
+
+void LiveView::ShowTexture(const cv::Mat3b& colors) {
+  // At most kSizePx on its longer side, whatever the world's extent.
+  const double scale = static_cast<double>(kSizePx) / std::max(colors.cols, colors.rows);
+  cv::Mat bgr, shown;
+  cv::cvtColor(colors, bgr, cv::COLOR_RGB2BGR);
+  cv::resize(bgr, shown, cv::Size(), scale, scale, cv::INTER_NEAREST);
+  cv::imshow(title_ + ": texture", shown);
+  texture_shown_ = true;
+  cv::waitKey(1);
+}
 
 Eigen::Vector2i LiveFrame::PixelOf(const Eigen::Vector2d& p) const {
   return {static_cast<int>((p.x() - min_world.x()) * px_per_m),

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
@@ -68,11 +69,14 @@ class LiveView {
   /// true pose and path in green, each estimate (world frame) in its colour.
   void Update(double sim_time_s, const slam::OccupancyGrid& map, const Pose2& world_from_map,
               const Pose2& truth, const std::vector<LiveEstimate>& estimates);
+  /// Shows a floor colour map (r, g, b, north up) in a second window, `title` + ": texture".
+  void ShowTexture(const cv::Mat3b& colors);
 
  private:
   std::string title_;
   double min_period_s_;
   double last_draw_s_ = -1e9;
+  bool texture_shown_ = false;
   std::vector<Pose2> truth_path_;
   std::vector<std::vector<Pose2>> estimate_paths_;
 };

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
+#include "sim/camera/camera_rig.h"
 #include "sim/robot_yaml.h"
 #include "sim/world_yaml.h"
 #include "slam/io/atomic_file.h"
@@ -70,6 +72,12 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
   RunSummary summary;
 
   sim::Simulator sim(options);
+  std::optional<sim::CameraRig> rig;
+  if (options.robot.camera) rig.emplace(&sim, *options.robot.camera, options.seed);
+  auto advance = [&](bool flush) {
+    if (!rig) return flush ? sim.Flush() : sim.Step();
+    return flush ? rig->Flush() : rig->Step();
+  };
   const sim::RobotSpec& robot = options.robot;
   slam::WheelOdometryOptions odometry;
   odometry.robot = sim::NominalOdometry(robot);
@@ -124,18 +132,20 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
   while (sim.time().seconds() < limit_s - 0.5 * sim.step_s()) {
     ThrowIfInterrupted();  // the sinks' destructors remove their temporary files
     if (run.duration_s == 0.0 && sim.drive_finished()) break;
-    consume(sim.Step());
+    consume(advance(false));
     const Pose2 now = sim.Truth().map_from_base;
     summary.path_length_m += (now.translation() - previous.translation()).norm();
     previous = now;
   }
-  consume(sim.Flush());
+  consume(advance(true));
   log.Commit();
 
   summary.num_scans = carmen_sink ? carmen_sink->scans() : bag_sink->scans();
   summary.num_odometry =
       carmen_sink ? carmen_sink->odometry_lines() : bag_sink->odometry_messages();
   summary.num_imu = carmen_sink ? carmen_sink->imu_samples() : bag_sink->imu_samples();
+  summary.num_frames = rig ? rig->frames() : 0;
+  summary.frames_skipped = carmen_sink ? carmen_sink->frames_skipped() : 0;
   summary.duration_s = sim.time().seconds();
   summary.drive_finished = sim.drive_finished();
   summary.final_truth = sim.Truth().map_from_base;

@@ -46,6 +46,8 @@ struct RunSummary {
   int num_scans = 0;            ///< scans written (ROBOTLASER1 lines, /scan messages)
   int num_odometry = 0;         ///< odometry poses written (ODOM lines, /odom messages)
   int num_imu = 0;              ///< IMU samples fed to the odometry
+  int num_frames = 0;           ///< RGB-D frames rendered (a robot with a camera)
+  int frames_skipped = 0;       ///< of them, not written (a CARMEN log has no image line)
   Pose2 final_truth;            ///< map_from_base at the end
   Pose2 final_odometry;  ///< odom_from_base at the end (the robot's own encoder + gyro estimate)
   double path_length_m = 0.0;      ///< true distance driven
@@ -61,6 +63,8 @@ struct RunSummary {
 ///  - with kMcap or kSqlite3, run/: a ROS 2 bag through slam::BagSink (the records, the same
 ///    robot odometry on /odom and /tf, the truth at every scan on /ground_truth/odom); a bag
 ///    folder left by an earlier run is replaced;
+///  - a robot with a camera (robot.camera) renders frames into the stream (sim::CameraRig); a
+///    bag carries them as sensor_msgs/Image and CameraInfo, a CARMEN log skips and counts them;
 ///  - in every format, truth.tum: ground truth at every scan time (TUM format); world.yaml,
 ///    robot.yaml: the resolved world and robot; sim.yaml: seed, rates, duration, written last
 ///    (an earlier one removed first), so that a folder with a sim.yaml is complete.

@@ -2,6 +2,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "scenarios/plot.h"
@@ -79,7 +81,13 @@ std::string MetricsJson(const ScenarioResult& r) {
       .Number("sim_time_s", r.sim_time_s)
       .Integer("scans", r.scans)
       .Integer("scans_blacked_out", r.scans_blacked_out)
-      .Integer("kidnaps", r.kidnaps_done);
+      .Integer("kidnaps", r.kidnaps_done)
+      .Integer("rgbd_frames", r.frames);
+  if (!r.truth_metrics.empty()) {
+    j.BeginObject("truth");
+    for (const auto& [name, value] : r.truth_metrics) j.Number(name, value);
+    j.EndObject();
+  }
   j.BeginObject("configs");
   for (const ConfigResult& c : r.configs) {
     j.BeginObject(c.name);
@@ -132,10 +140,16 @@ void CheckExpectations(ScenarioResult* result) {
     ExpectationOutcome o;
     o.expectation = e;
     o.value = NAN;
+    bool found = false;
     for (const ConfigResult& c : result->configs) {
       if (c.name != e.config) continue;
+      found = true;
       const auto it = c.metrics.find(e.metric);
       if (it != c.metrics.end()) o.value = it->second;
+    }
+    if (!found && e.config == "truth") {
+      const auto it = result->truth_metrics.find(e.metric);
+      if (it != result->truth_metrics.end()) o.value = it->second;
     }
     o.passed =
         std::isfinite(o.value) && (e.is_max ? o.value <= e.threshold : o.value >= e.threshold);
@@ -241,6 +255,33 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
       html_maps += "<figure><img src=\"" + c.name + "_map.png\"><figcaption>" + Html(c.name) +
                    "'s map with its trajectory (and the truth, in green).</figcaption></figure>";
     }
+  }
+
+  // The floor texture: the truth, the map from the true poses, each configuration's map.
+  std::string html_texture;
+  const auto write_rgb = [&](const std::string& name, const cv::Mat3b& rgb) {
+    cv::Mat bgr;
+    cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+    std::vector<std::uint8_t> png;
+    cv::imencode(".png", bgr, png);
+    slam::WriteFileAtomically(file(name), std::string(png.begin(), png.end()));
+  };
+  if (r.true_texture && r.truth_texture) {
+    write_rgb("texture_truth.png", *r.true_texture);
+    write_rgb("texture_true_poses.png", r.truth_texture->colors);
+    html_texture +=
+        "<figure><img src=\"texture_truth.png\"><figcaption>The true floor texture."
+        "</figcaption></figure><figure><img src=\"texture_true_poses.png\">"
+        "<figcaption>The texture map from the true poses (PSNR " +
+        Number(r.truth_texture->score.psnr_db.value_or(NAN)) + " dB, coverage " +
+        Number(r.truth_texture->score.coverage) + ").</figcaption></figure>";
+  }
+  for (const ConfigResult& c : r.configs) {
+    if (!c.texture) continue;
+    write_rgb(c.name + "_texture.png", c.texture->colors);
+    html_texture += "<figure><img src=\"" + c.name + "_texture.png\"><figcaption>" + Html(c.name) +
+                    "'s texture map from its final poses (PSNR " +
+                    Number(c.texture->score.psnr_db.value_or(NAN)) + " dB).</figcaption></figure>";
   }
 
   // Errors over time, per configuration.
@@ -379,7 +420,15 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
     for (const std::string& note : r.notes) h << "<li>" << Html(note) << "</li>";
     h << "</ul>";
   }
-  h << "<h2>Maps</h2>" << html_maps << "<h2>Errors</h2>" << html_plots << "</body></html>\n";
+  if (!r.truth_metrics.empty()) {
+    h << "<h2>Texture (true poses)</h2><table><tr><th>metric</th><th>truth</th></tr>";
+    for (const auto& [name, value] : r.truth_metrics)
+      h << "<tr><td>" << name << "</td><td>" << Number(value) << "</td></tr>";
+    h << "</table>";
+  }
+  h << "<h2>Maps</h2>" << html_maps;
+  if (!html_texture.empty()) h << "<h2>Floor texture</h2>" << html_texture;
+  h << "<h2>Errors</h2>" << html_plots << "</body></html>\n";
   slam::WriteFileAtomically(file("report.html"), h.str());
   slam::WriteFileAtomically(file("metrics.json"), MetricsJson(r));
 }

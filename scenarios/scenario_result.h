@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "scenarios/scenario_spec.h"
+#include "scenarios/texture_run.h"
 #include "slam/grid/occupancy_grid.h"
 #include "slam/pipeline/estimator_runner.h"
 #include "slam/types/trajectory.h"
@@ -29,6 +30,8 @@ struct ConfigResult {
   std::vector<double> nees;
   /// Per run.loop_closures entry: agrees with the reference (empty without one).
   std::vector<bool> loop_is_true;
+  /// The floor texture mapped with `estimate` (a run with a camera), else none.
+  std::optional<TextureResult> texture;
 };
 
 /// One checked expectation.
@@ -54,6 +57,12 @@ struct ScenarioResult {
   int scans = 0;              ///< scans the lidar produced (or the log holds)
   int scans_blacked_out = 0;  ///< of them, withheld by lidar_blackout faults
   int kidnaps_done = 0;
+  int frames = 0;  ///< RGB-D frames in the records (the camera's, or a log's)
+  /// A run with a camera: the true floor texture and the map from the true poses (the `truth`
+  /// pseudo-configuration's texture metrics, TruthMetrics()), else none.
+  std::optional<cv::Mat3b> true_texture;
+  std::optional<TextureResult> truth_texture;
+  std::map<std::string, double> truth_metrics;
   std::vector<std::string> notes;  ///< what the source said (a log's quirks), for the user
   std::vector<ExpectationOutcome> outcomes;
   bool passed = true;

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "scenarios/live_view.h"
+#include "sim/camera/camera_rig.h"
 #include "sim/simulator.h"
 #include "slam/eval/loop_closure_score.h"
 #include "slam/eval/map_score.h"
@@ -159,8 +160,36 @@ Trajectory InMapFrame(const Trajectory& t, const Pose2& map_from_estimator) {
   return out;
 }
 
+// The texture metrics of one texture map; `reference_psnr_db` (the truth's) gives the loss.
+void ScoreTextureMetrics(const TextureResult& t, double reference_psnr_db,
+                         std::map<std::string, double>* m) {
+  (*m)["texture_psnr_db"] = t.score.psnr_db.value_or(NAN);
+  (*m)["texture_mean_abs_error"] = t.score.mean_abs_error.value_or(NAN);
+  (*m)["texture_coverage"] = t.score.coverage;
+  (*m)["texture_frames"] = t.frames;
+  if (std::isfinite(reference_psnr_db))
+    (*m)["texture_psnr_loss_db"] = reference_psnr_db - t.score.psnr_db.value_or(NAN);
+}
+
+// The texture from the true poses (the `truth` pseudo-configuration), after checking that the
+// camera saw the floor at all: a camera that never does is a configuration mistake, not a
+// black map to score.
+void ScoreTruthTexture(const ScenarioSpec& spec, const TextureRun& texture,
+                       ScenarioResult* result) {
+  if (texture.floor_pixels() == 0) {
+    throw ConfigError(spec.path + ": robot.camera: " + std::to_string(texture.frames()) +
+                      " frames and not one floor pixel within texture.max_depth_m (" +
+                      std::to_string(texture.depth_readings()) +
+                      " depth readings in all); is robot.camera.mount pointing at the floor?");
+  }
+  result->true_texture = texture.truth();
+  result->truth_texture = texture.WithTruePoses();
+  ScoreTextureMetrics(*result->truth_texture, NAN, &result->truth_metrics);
+}
+
 void Finish(Runners& runners, const Pose2& map_from_start, double data_time_s,
-            ScenarioResult* result) {
+            const TextureRun* texture, ScenarioResult* result) {
+  if (texture) ScoreTruthTexture(*result->spec, *texture, result);
   for (auto& r : runners) {
     r->Finish();
     ConfigResult c;
@@ -172,6 +201,10 @@ void Finish(Runners& runners, const Pose2& map_from_start, double data_time_s,
     c.online = InMapFrame(c.run.online, map_from_start);
     c.mean_estimate = InMapFrame(c.run.mean, map_from_start);
     Score(*result, data_time_s, &c);
+    if (texture) {
+      c.texture = texture->WithPoses(c.estimate);
+      ScoreTextureMetrics(*c.texture, result->truth_metrics["texture_psnr_db"], &c.metrics);
+    }
     result->configs.push_back(std::move(c));
   }
   CheckExpectations(result);
@@ -182,10 +215,30 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
   ScenarioResult result;
   result.spec = &spec;
   sim::Simulator simulator(source.options);
+  // A robot with a camera: its frames join the stream, and the texture side keeps their floor.
+  std::optional<sim::CameraRig> rig;
+  std::optional<TextureRun> texture;
+  if (const auto& camera = source.options.robot.camera) {
+    try {
+      rig.emplace(&simulator, *camera, spec.seed);
+    } catch (const ConfigError& e) {
+      throw ConfigError(spec.path + ": robot.camera: " + e.what());
+    } catch (const ParseError& e) {
+      throw ParseError(spec.path + ": robot.camera: " + e.what());
+    }
+    const sim::FloorTexture& floor = rig->camera().floor();
+    slam::TextureMapOptions layout = spec.texture;
+    layout.min_m = floor.min_m();
+    layout.max_m = floor.max_m();
+    texture.emplace(layout, floor.TruthColors(layout), floor.FloorMask(layout));
+  }
   Runners runners = MakeRunners(spec, nullptr);
   slam::OccupancyGrid truth_map{slam::OccupancyGridOptions{}};
   std::unique_ptr<LiveView> view;
   if (options.view) view = std::make_unique<LiveView>("slamrig: " + spec.name);
+  // The live texture: each frame at the first configuration's latest pose (what it knows then).
+  std::optional<slam::TextureMap> live_texture;
+  if (view && texture) live_texture.emplace(texture->options());
 
   std::optional<Pose2> map_from_start;  // true pose at the first scan SLAM sees
   LaserScan truth_scan;
@@ -211,8 +264,23 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
           continue;
         }
         if (!map_from_start) map_from_start = truth;
+      } else if (const auto* frame = std::get_if<RgbdFrame>(&record)) {
+        ++result.frames;
+        texture->Add(*frame, step.truth[i].map_from_base);
+        if (live_texture && map_from_start && runners.front()->scans() > 0) {
+          live_texture->Insert(*frame, *map_from_start * runners.front()->pose());
+        }
       }
       for (auto& r : runners) r->Add(record);
+    }
+  };
+  // A camera that sees nothing at some pose is one error naming the camera's key.
+  auto step = [&](bool flush) {
+    if (!rig) return flush ? simulator.Flush() : simulator.Step();
+    try {
+      return flush ? rig->Flush() : rig->Step();
+    } catch (const ConfigError& e) {
+      throw ConfigError(spec.path + ": robot.camera: " + e.what());
     }
   };
 
@@ -223,7 +291,7 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
       simulator.Teleport(source.kidnaps[next_kidnap++].to);
       ++result.kidnaps_done;
     }
-    consume(simulator.Step());
+    consume(step(false));
     const double now_s = simulator.time().seconds();
     if (now_s >= next_progress_s) {
       next_progress_s = now_s + 1.0;
@@ -231,13 +299,15 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
       if (view) {
         ShowLive(*view, now_s, runners, map_from_start.value_or(Pose2()),
                  map_from_start.has_value(), simulator.Truth().map_from_base);
+        if (live_texture) view->ShowTexture(live_texture->Colors());
       }
     }
   }
-  consume(simulator.Flush());
+  consume(step(true));
   result.sim_time_s = simulator.time().seconds();
   result.truth_map.emplace(std::move(truth_map));
-  Finish(runners, map_from_start.value_or(Pose2()), result.sim_time_s, &result);
+  Finish(runners, map_from_start.value_or(Pose2()), result.sim_time_s,
+         texture ? &*texture : nullptr, &result);
   return result;
 }
 
@@ -271,6 +341,8 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
       }
       ++scans;
       ++result.scans;
+    } else if (std::holds_alternative<RgbdFrame>(record)) {
+      ++result.frames;  // a log's frames have no true floor to be scored against
     }
     last_time = last_time ? std::max(*last_time, t) : t;
     for (auto& r : runners) r->Add(record);
@@ -291,7 +363,7 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
   result.sim_time_s = first_time ? SecondsBetween(*last_time, *first_time) : 0.0;
   if (!data.reference.empty()) result.truth_map.emplace(std::move(truth_map));
   // A log without a reference is scored on nothing but its own statistics.
-  Finish(runners, map_from_start.value_or(Pose2()), result.sim_time_s, &result);
+  Finish(runners, map_from_start.value_or(Pose2()), result.sim_time_s, nullptr, &result);
   return result;
 }
 

@@ -114,6 +114,23 @@ std::vector<sim::ObstacleSpec> MakeCrowd(const YamlNode& node, const sim::DriveO
 
 }  // namespace
 
+}  // namespace slamrig::scenario
+
+namespace slamrig::slam {
+
+// The scenario's `texture:` block; the extents come from the world's floor texture.
+template <typename V>
+void VisitFields(V& v, TextureMapOptions& t) {
+  v("resolution_m", t.resolution_m);
+  v("floor_height_threshold_m", t.floor_height_threshold_m);
+  v("max_depth_m", t.max_depth_m);
+  v("pixel_stride", t.pixel_stride);
+}
+
+}  // namespace slamrig::slam
+
+namespace slamrig::scenario {
+
 const std::vector<std::string>& KnownMetrics() {
   static const std::vector<std::string> metrics = {"ate_rmse_m",
                                                    "ate_mean_m",
@@ -138,7 +155,18 @@ const std::vector<std::string>& KnownMetrics() {
                                                    "nees_upper_95",
                                                    "loop_precision",
                                                    "loop_recall",
-                                                   "false_loop_closures"};
+                                                   "false_loop_closures",
+                                                   "texture_psnr_db",
+                                                   "texture_mean_abs_error",
+                                                   "texture_coverage",
+                                                   "texture_frames",
+                                                   "texture_psnr_loss_db"};
+  return metrics;
+}
+
+const std::vector<std::string>& TruthMetrics() {
+  static const std::vector<std::string> metrics = {"texture_psnr_db", "texture_mean_abs_error",
+                                                   "texture_coverage", "texture_frames"};
   return metrics;
 }
 
@@ -214,9 +242,10 @@ void ReadExpectations(const YamlNode& expect, ScenarioSpec* spec) {
     const YamlNode block = expect.Required(config);
     const auto it = std::find_if(spec->configs.begin(), spec->configs.end(),
                                  [&](const slam::EstimatorConfig& c) { return c.name == config; });
-    if (it == spec->configs.end())
-      block.Fail("no SLAM configuration named '" + config + "' in slam:");
-    const std::vector<std::string> known = MetricsOf(*it);
+    const bool truth = it == spec->configs.end() && config == "truth";
+    if (it == spec->configs.end() && !truth)
+      block.Fail("no SLAM configuration named '" + config + "' in slam: (nor 'truth')");
+    const std::vector<std::string> known = truth ? TruthMetrics() : MetricsOf(*it);
     for (const std::string& key : block.Keys()) {
       const YamlNode value = block.Required(key);
       Expectation e;
@@ -286,11 +315,14 @@ std::string ResolvedYaml(const ScenarioSpec& spec, const std::vector<std::string
     // Bag topic names, every one (the defaults too), so that the resolved file is complete.
     slam::BagTopicNames topics = spec.log->read.topics;
     out << YAML::Key << "topics" << YAML::Value << YAML::BeginMap;
-    for (const char* key :
-         {"scan", "imu", "joint_states", "odom", "ground_truth", "tf", "tf_static", "clock"}) {
+    for (const char* key : {"scan", "imu", "joint_states", "odom", "ground_truth", "tf",
+                            "tf_static", "clock", "rgb", "depth", "camera_info"}) {
       out << YAML::Key << key << YAML::Value << *topics.Find(key);
     }
     out << YAML::EndMap << YAML::EndMap;
+  }
+  if (spec.simulated && spec.simulated->options.robot.camera) {
+    out << YAML::Key << "texture" << YAML::Value << YAML::Load(ToYaml(spec.texture, ""));
   }
   out << YAML::Key << "slam" << YAML::Value << YAML::BeginMap;
   for (const slam::EstimatorConfig& c : spec.configs) {
@@ -427,6 +459,14 @@ ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string
   }
   if (spec.configs.empty()) slam.Fail("needs at least one SLAM configuration");
 
+  if (auto texture = root.Optional("texture")) {
+    if (!spec.simulated || !spec.simulated->options.robot.camera)
+      texture->Fail("texture: needs a simulated robot with a camera (robot: {camera: ...})");
+    if (!texture->IsMap()) texture->Fail("expected a map (resolution_m, pixel_stride, ...)");
+    FieldReader reader(*texture);
+    VisitFields(reader, spec.texture);
+    texture->ThrowIfInvalid(spec.texture.Validate());
+  }
   if (auto expect = root.Optional("expect")) ReadExpectations(*expect, &spec);
   root.CheckAllKeysUsed();
   spec.resolved_yaml = ResolvedYaml(spec, overrides);

@@ -8,6 +8,7 @@
 #include "sim/simulator.h"
 #include "slam/io/log_reader.h"
 #include "slam/pipeline/estimator_config.h"
+#include "slam/texture/texture_map.h"
 
 namespace slamrig::scenario {
 
@@ -45,6 +46,14 @@ struct LogSource {
   slam::LogReadOptions read;
   slam::DiffDriveParams robot;  ///< wheel geometry for logs with encoder ticks (ECE276A default)
 };
+
+/// The texture map options a scenario uses unless its `texture:` block says otherwise: every
+/// fourth pixel along rows and columns (a 640 x 480 frame keeps ~50 k floor pixels, ~0.2 MB).
+inline slam::TextureMapOptions DefaultScenarioTexture() {
+  slam::TextureMapOptions o;
+  o.pixel_stride = 4;
+  return o;
+}
 
 /// A scenario: where the records come from (a simulated world or a log), which SLAM
 /// configurations run on them, and what they must achieve. Read from scenarios/*.yaml:
@@ -84,6 +93,9 @@ struct ScenarioSpec {
   std::optional<SimulatedSource> simulated;  ///< exactly one of simulated and log
   std::optional<LogSource> log;
   std::vector<slam::EstimatorConfig> configs;
+  /// The texture map's raster (`texture:`; extents come from the world's floor) for a robot with a
+  /// camera.
+  slam::TextureMapOptions texture = DefaultScenarioTexture();
   std::vector<Expectation> expectations;
   /// The whole resolved scenario, in the input schema (world and robot inline, every field):
   /// `slamrig run config.yaml` repeats the run bit for bit.
@@ -92,6 +104,10 @@ struct ScenarioSpec {
 
 /// Metric names every configuration has (metrics.json per configuration).
 const std::vector<std::string>& KnownMetrics();
+
+/// Metrics of the `truth` pseudo-configuration of a run with a camera: the texture map from the
+/// true poses (`expect: {truth: {texture_psnr_db_min: 20}}`).
+const std::vector<std::string>& TruthMetrics();
 
 /// The metrics of `config`: KnownMetrics() and its algorithm's statistics.
 std::vector<std::string> MetricsOf(const slam::EstimatorConfig& config);

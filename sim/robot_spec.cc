@@ -92,6 +92,7 @@ std::vector<std::string> RobotSpec::Validate() const {
   AppendErrors(&errors, PrefixErrors("encoders", encoders.Validate()));
   AppendErrors(&errors, PrefixErrors("imu", imu.Validate()));
   AppendErrors(&errors, PrefixErrors("lidar", lidar.Validate()));
+  if (camera) AppendErrors(&errors, PrefixErrors("camera", camera->Validate()));
   return errors;
 }
 

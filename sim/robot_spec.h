@@ -1,8 +1,10 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "sim/camera_spec.h"
 #include "sim/encoder_model.h"
 #include "sim/imu_model.h"
 #include "sim/lidar_model.h"
@@ -88,6 +90,8 @@ struct RobotSpec {
   EncoderOptions encoders;        ///< wheel encoders
   ImuOptions imu;                 ///< inertial sensor
   LidarOptions lidar;             ///< 2D range finder
+  /// An RGB-D camera (sim/camera renders it; the Simulator itself ignores it); none if absent.
+  std::optional<CameraSpec> camera;
 
   /// One message per broken rule, field names as in the robot file ("motor.kp_n_m_s_rad = ...").
   std::vector<std::string> Validate() const;

@@ -3,6 +3,30 @@
 #include "sim/mount_pose.h"
 #include "slam/config/fields.h"
 
+// The camera's intrinsics and mounting are data-contract types (namespace slamrig): their field
+// tables live there so that argument-dependent lookup finds them.
+namespace slamrig {
+
+template <typename V>
+void VisitFields(V& v, CameraIntrinsics& k) {
+  v("fx_px", k.fx_px);
+  v("fy_px", k.fy_px);
+  v("cx_px", k.cx_px);
+  v("cy_px", k.cy_px);
+}
+
+template <typename V>
+void VisitFields(V& v, CameraMount& m) {
+  v("x_m", m.x_m);
+  v("y_m", m.y_m);
+  v("z_m", m.z_m);
+  v("roll_rad", m.roll_rad);
+  v("pitch_rad", m.pitch_rad);
+  v("yaw_rad", m.yaw_rad);
+}
+
+}  // namespace slamrig
+
 namespace slamrig::sim {
 
 // The robot file's schema: one field list per struct, shared by reader and writer.
@@ -98,6 +122,42 @@ void VisitFields(V& v, LidarOptions& l) {
 }
 
 template <typename V>
+void VisitFields(V& v, ZoneTexture& z) {
+  v("zone", z.zone);
+  v("image", z.image);
+  v("tile_m", z.tile_m);
+}
+
+template <typename V>
+void VisitFields(V& v, CameraSpec& c) {
+  v("name", c.name);
+  v("width_px", c.width_px);
+  v("height_px", c.height_px);
+  v("rate_hz", c.rate_hz);
+  v.Struct("intrinsics", c.intrinsics);
+  v.Struct("mount", c.mount);
+  v("depth_offset_x_m", c.depth_offset_x_m);
+  v.Enum("depth_model", c.depth_model,
+         {{DepthModel::kIdeal, "ideal"}, {DepthModel::kKinectDisparity, "kinect_disparity"}});
+  v("disparity_noise_stddev", c.disparity_noise_stddev);
+  v("quantize_disparity", c.quantize_disparity);
+  v("min_depth_m", c.min_depth_m);
+  v("max_depth_m", c.max_depth_m);
+  v("rgb_noise_stddev", c.rgb_noise_stddev);
+  v("texture_dir", c.texture_dir);
+  v("floor_image", c.floor_image);
+  v("floor_tile_m", c.floor_tile_m);
+  v.List("zones", c.zones);
+  v("floor_texel_m", c.floor_texel_m);
+  v("wall_height_m", c.wall_height_m);
+  v("wall_rgb", c.wall_rgb);
+  v("wall_image", c.wall_image);
+  v("wall_tile_m", c.wall_tile_m);
+  v("znear_m", c.znear_m);
+  v("zfar_m", c.zfar_m);
+}
+
+template <typename V>
 void VisitFields(V& v, RobotSpec& r) {
   v("name", r.name);
   v.Struct("chassis", r.chassis);
@@ -108,6 +168,7 @@ void VisitFields(V& v, RobotSpec& r) {
   v.Struct("encoders", r.encoders);
   v.Struct("imu", r.imu);
   v.Struct("lidar", r.lidar);
+  v.OptionalStruct("camera", r.camera);
 }
 
 RobotSpec ParseRobotSpec(const YamlNode& node) {

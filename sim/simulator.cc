@@ -287,6 +287,12 @@ void Simulator::MeasureLidar() {
   }
 }
 
+Time Simulator::released_before() const {
+  // Records up to now are measured; a scan in progress holds back those from its start on.
+  const Time after_now{time_.ns + 1};
+  return lidar_ ? std::min(ScanStart(next_scan_), after_now) : after_now;
+}
+
 StepResult Simulator::Release(bool all) {
   StepResult result;
   result.time = time_;

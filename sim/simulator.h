@@ -74,6 +74,9 @@ class Simulator {
 
   /// Current simulation time (0 at the start).
   Time time() const { return time_; }
+  /// Every record stamped before this time has been released by Step() (a scan in progress holds
+  /// the later ones back); a source that merges its own records into the stream waits for it.
+  Time released_before() const;
   /// The physics step length, seconds.
   double step_s() const { return step_s_; }
   /// Ground truth now.

@@ -6,7 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
-#include "sim/camera/camera_spec.h"
+#include "sim/camera_spec.h"
 #include "sim/world_spec.h"
 
 namespace slamrig::sim::testing {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/camera/camera_spec.h"
+#include "sim/camera_spec.h"
 #include "sim/shape_spec.h"
 #include "sim/world_spec.h"
 #include "slam/texture/texture_map.h"

@@ -219,7 +219,7 @@ struct RgbdCamera::Impl {
 
 RgbdCamera::RgbdCamera(const WorldSpec& world, const CameraSpec& spec, std::uint64_t seed) {
   const std::vector<std::string> errors = spec.Validate();
-  if (!errors.empty()) throw ConfigError("camera '" + spec.name + "': " + errors.front());
+  if (!errors.empty()) throw ConfigError("camera '" + spec.name + "': camera." + errors.front());
   impl_ = std::make_unique<Impl>(world, spec, seed);
   Impl& m = *impl_;
 

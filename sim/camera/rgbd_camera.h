@@ -3,8 +3,8 @@
 #include <cstdint>
 #include <memory>
 
-#include "sim/camera/camera_spec.h"
 #include "sim/camera/floor_texture.h"
+#include "sim/camera_spec.h"
 #include "sim/world_spec.h"
 #include "slam/types/pose2.h"
 #include "slam/types/rgbd_frame.h"

@@ -7,7 +7,8 @@
 //
 // The visitor interface every VisitFields may use:
 //   v(key, scalar)                  double, float, int, bool, std::string, std::uint64_t,
-//                                   Eigen::Vector2d ([x, y]), std::vector<Eigen::Vector2d>
+//                                   Eigen::Vector2d ([x, y]), Eigen::Vector3d ([x, y, z]),
+//                                   std::vector<Eigen::Vector2d>
 //   v.Enum(key, e, {{E::kA, "a"}})  an enum by name; absent keeps the default
 //   v.RequiredEnum(key, e, names)   the same, but the key must be there
 //   v.Struct(key, s)                a nested map (its own VisitFields and Validate())
@@ -44,6 +45,15 @@ class FieldReader {
   /// `[x, y]`.
   void operator()(const char* key, Eigen::Vector2d& value) {
     if (auto child = node_.Optional(key)) value = ReadPoint(*child);
+  }
+  /// `[x, y, z]`.
+  void operator()(const char* key, Eigen::Vector3d& value) {
+    auto child = node_.Optional(key);
+    if (!child) return;
+    const auto elements = child->Elements();
+    if (elements.size() != 3)
+      child->Fail("expected [x, y, z], got " + std::to_string(elements.size()) + " numbers");
+    value = {elements[0].As<double>(), elements[1].As<double>(), elements[2].As<double>()};
   }
   /// `[[x, y], ...]`.
   void operator()(const char* key, std::vector<Eigen::Vector2d>& values) {
@@ -151,6 +161,11 @@ class FieldWriter {
   void operator()(const char* key, const Eigen::Vector2d& value) {
     out_ << YAML::Key << key << YAML::Value;
     WritePoint(value);
+  }
+  void operator()(const char* key, const Eigen::Vector3d& value) {
+    out_ << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq
+         << FormatNumber(value.x()) << FormatNumber(value.y()) << FormatNumber(value.z())
+         << YAML::EndSeq;
   }
   void operator()(const char* key, const std::vector<Eigen::Vector2d>& values) {
     out_ << YAML::Key << key << YAML::Value << YAML::BeginSeq;

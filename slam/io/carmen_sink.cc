@@ -17,6 +17,8 @@ void CarmenSink::Add(const Record& record, const GroundTruthPose* truth) {
   } else if (const auto* scan = std::get_if<LaserScan>(&record)) {
     held_.emplace_back(*scan, truth ? std::optional<GroundTruthPose>(*truth) : std::nullopt);
     ++scans_;
+  } else if (std::holds_alternative<RgbdFrame>(record)) {
+    ++frames_skipped_;
   }
 }
 

@@ -25,7 +25,8 @@ struct CarmenSinkOptions {
 /// encoder + gyro odometry), ROBOTLASER1 for each scan (with the odometry pose interpolated to
 /// its time, so it waits for the next ODOM) and, when the scan came with the truth, a TRUEPOS
 /// line after it. ImuSamples feed the odometry; OdometryPose records (a log replayed) are
-/// written as ODOM lines instead when there are no ticks.
+/// written as ODOM lines instead when there are no ticks. CARMEN has no image line: RgbdFrame
+/// records are skipped and counted (frames_skipped()).
 class CarmenSink final : public RecordSink {
  public:
   CarmenSink(const std::string& path, const CarmenSinkOptions& options);
@@ -35,6 +36,8 @@ class CarmenSink final : public RecordSink {
 
   int scans() const { return scans_; }
   int odometry_lines() const { return odometry_lines_; }
+  /// RgbdFrame records left out (CARMEN cannot carry them).
+  int frames_skipped() const { return frames_skipped_; }
   int imu_samples() const { return odometry_.imu_samples(); }
   /// The robot's odometry pose after the last WheelTicks record.
   const Pose2& odometry_pose() const { return odometry_.pose(); }
@@ -49,6 +52,7 @@ class CarmenSink final : public RecordSink {
   std::vector<std::pair<LaserScan, std::optional<GroundTruthPose>>> held_;
   int scans_ = 0;
   int odometry_lines_ = 0;
+  int frames_skipped_ = 0;
 };
 
 }  // namespace slamrig::slam

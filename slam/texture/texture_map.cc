@@ -67,7 +67,7 @@ Eigen::Vector2d TextureMap::CellCenter(int col, int row) const {
           options_.max_m.y() - (row + 0.5) * options_.resolution_m};
 }
 
-int TextureMap::Insert(const RgbdFrame& frame, const Pose2& map_from_base) {
+FloorPixels ExtractFloorPixels(const RgbdFrame& frame, const TextureMapOptions& options) {
   const std::size_t pixels = static_cast<std::size_t>(frame.width) * frame.height;
   if (frame.width <= 0 || frame.height <= 0 || frame.rgb.size() != 3 * pixels ||
       frame.depth_m.size() != pixels) {
@@ -75,29 +75,25 @@ int TextureMap::Insert(const RgbdFrame& frame, const Pose2& map_from_base) {
                       std::to_string(frame.height) + " has " + std::to_string(frame.rgb.size()) +
                       " RGB bytes and " + std::to_string(frame.depth_m.size()) + " depths");
   }
-  // map_from_base in 3D: the robot on the floor plane.
-  Eigen::Isometry3d map_from_base3 = Eigen::Isometry3d::Identity();
-  map_from_base3.translation() = Eigen::Vector3d(map_from_base.x(), map_from_base.y(), 0.0);
-  map_from_base3.linear() =
-      Eigen::AngleAxisd(map_from_base.theta(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const Eigen::Isometry3d map_from_depth = map_from_base3 * frame.BaseFromDepthOptical();
-  const Eigen::Matrix3d rot = map_from_depth.linear();
-  const Eigen::Vector3d trans = map_from_depth.translation();
+  // The floor is z = 0 of base_link: a planar pose moves it in x, y only.
+  const Eigen::Isometry3d base_from_depth = frame.BaseFromDepthOptical();
+  const Eigen::Matrix3d rot = base_from_depth.linear();
+  const Eigen::Vector3d trans = base_from_depth.translation();
   const CameraIntrinsics& k = frame.intrinsics;
   const double offset = frame.depth_offset_x_m;
-  const int stride = options_.pixel_stride;
+  const int stride = options.pixel_stride;
 
-  int added = 0;
+  FloorPixels out;
+  out.time = frame.time;
   for (int v = 0; v < frame.height; v += stride) {
     for (int u = 0; u < frame.width; u += stride) {
       const double z = frame.depth_m[static_cast<std::size_t>(v) * frame.width + u];
-      if (!(z > 0.0) || z > options_.max_depth_m) continue;
-      // Back-project in the depth camera's optical frame, then to the map.
+      if (!(z > 0.0) || z > options.max_depth_m) continue;
+      ++out.depth_readings;
+      // Back-project in the depth camera's optical frame, then to base_link.
       const Eigen::Vector3d p_depth((u - k.cx_px) / k.fx_px * z, (v - k.cy_px) / k.fy_px * z, z);
-      const Eigen::Vector3d p_map = rot * p_depth + trans;
-      if (std::abs(p_map.z()) > options_.floor_height_threshold_m) continue;
-      int col = 0, row = 0;
-      if (!CellOf(p_map.x(), p_map.y(), &col, &row)) continue;
+      const Eigen::Vector3d p_base = rot * p_depth + trans;
+      if (std::abs(p_base.z()) > options.floor_height_threshold_m) continue;
       // The same point in the RGB optical frame (same orientation, origin -offset along x).
       const double xr = p_depth.x() + offset;
       const double ur = std::round(k.fx_px * xr / z + k.cx_px);
@@ -105,13 +101,31 @@ int TextureMap::Insert(const RgbdFrame& frame, const Pose2& map_from_base) {
       if (!(ur >= 0.0 && ur < frame.width && vr >= 0.0 && vr < frame.height)) continue;
       const std::size_t src =
           3 * (static_cast<std::size_t>(vr) * frame.width + static_cast<std::size_t>(ur));
-      const std::size_t cell = static_cast<std::size_t>(row) * width_ + col;
-      sums_[3 * cell] += frame.rgb[src];
-      sums_[3 * cell + 1] += frame.rgb[src + 1];
-      sums_[3 * cell + 2] += frame.rgb[src + 2];
-      ++counts_[cell];
-      ++added;
+      out.base_xy_m.emplace_back(static_cast<float>(p_base.x()), static_cast<float>(p_base.y()));
+      out.rgb.push_back({frame.rgb[src], frame.rgb[src + 1], frame.rgb[src + 2]});
     }
+  }
+  return out;
+}
+
+int TextureMap::Insert(const RgbdFrame& frame, const Pose2& map_from_base) {
+  return Insert(ExtractFloorPixels(frame, options_), map_from_base);
+}
+
+int TextureMap::Insert(const FloorPixels& pixels, const Pose2& map_from_base) {
+  const double c = std::cos(map_from_base.theta()), s = std::sin(map_from_base.theta());
+  int added = 0;
+  for (std::size_t i = 0; i < pixels.base_xy_m.size(); ++i) {
+    const double bx = pixels.base_xy_m[i].x(), by = pixels.base_xy_m[i].y();
+    int col = 0, row = 0;
+    if (!CellOf(map_from_base.x() + c * bx - s * by, map_from_base.y() + s * bx + c * by, &col,
+                &row)) {
+      continue;
+    }
+    const std::size_t cell = static_cast<std::size_t>(row) * width_ + col;
+    for (int k = 0; k < 3; ++k) sums_[3 * cell + k] += pixels.rgb[i][k];
+    ++counts_[cell];
+    ++added;
   }
   return added;
 }

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <string>
@@ -8,6 +9,7 @@
 
 #include "slam/types/pose2.h"
 #include "slam/types/rgbd_frame.h"
+#include "slam/types/time.h"
 
 namespace slamrig::slam {
 
@@ -30,6 +32,24 @@ struct TextureMapOptions {
   std::vector<std::string> Validate() const;
 };
 
+/// The floor pixels of one RGB-D frame in base_link's floor plane, with their colours. Which
+/// pixels are floor does not depend on the robot's planar pose (only on the camera's mounting), so
+/// a frame is reduced to these once and mapped with any estimator's pose later: a few hundred
+/// kilobytes instead of the frame's megabytes.
+struct FloorPixels {
+  Time time;                                     ///< the frame's time
+  std::vector<Eigen::Vector2f> base_xy_m;        ///< floor points in base_link, metres
+  std::vector<std::array<std::uint8_t, 3>> rgb;  ///< their colours (r, g, b), one per point
+  int depth_readings = 0;  ///< depth pixels with a reading in range (floor or not)
+};
+
+/// The floor pixels of `frame` (every `options.pixel_stride`-th depth pixel along rows and
+/// columns): back-projected from the depth camera, kept when their height is within
+/// `floor_height_threshold_m` of the floor and the RGB camera sees them, coloured by projecting
+/// them into the RGB image (the two cameras are offset). Throws ConfigError for a frame whose
+/// image sizes disagree.
+FloorPixels ExtractFloorPixels(const RgbdFrame& frame, const TextureMapOptions& options);
+
 /// A floor colour map: RGB-D floor pixels projected through the robot's pose into a raster that
 /// keeps the mean colour per cell (Zafari, ECE276A report, "Texture Mapping", Eq. 8: a pixel with
 /// depth goes optical frame -> body -> world; Wang, ECE276A report, Fig. 4: floor pixels are those
@@ -46,6 +66,9 @@ class TextureMap {
   /// from the depth camera, kept when it is floor and inside the raster, and coloured by projecting
   /// it into the RGB camera (the depth and RGB cameras are offset). Returns the pixels added.
   int Insert(const RgbdFrame& frame, const Pose2& map_from_base);
+  /// Adds floor pixels taken at `map_from_base` (those inside the raster); returns their number.
+  /// Insert(frame, pose) is Insert(ExtractFloorPixels(frame, options()), pose).
+  int Insert(const FloorPixels& pixels, const Pose2& map_from_base);
 
   /// The cell holding map point (x, y), or false when it is outside.
   bool CellOf(double x_m, double y_m, int* col, int* row) const;

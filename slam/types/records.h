@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "slam/types/pose2.h"
+#include "slam/types/rgbd_frame.h"
 #include "slam/types/time.h"
 
 namespace slamrig {
@@ -57,8 +58,10 @@ struct ImuSample {
   Eigen::Vector3d linear_acceleration_m_s2 = Eigen::Vector3d::Zero();
 };
 
-/// A sensor record as the SLAM stack receives it, from a simulator or a real log alike.
-using Record = std::variant<LaserScan, OdometryPose, WheelTicks, ImuSample>;
+/// A sensor record as the SLAM stack receives it, from a simulator or a real log alike. An
+/// RgbdFrame is megabytes: records are moved along, never copied per consumer, and a consumer that
+/// has no use for frames (the scan estimators, a CARMEN log) skips them and counts them.
+using Record = std::variant<LaserScan, OdometryPose, WheelTicks, ImuSample, RgbdFrame>;
 
 /// Time stamp of any record.
 inline Time RecordTime(const Record& record) {

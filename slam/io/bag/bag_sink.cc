@@ -29,6 +29,7 @@ void BagSink::Add(const Record& record, const GroundTruthPose* truth) {
   // A logged OdometryPose went out with the record itself; ticks add the robot's own estimate.
   if (pose && std::holds_alternative<WheelTicks>(record)) writer_.Write(Record{*pose});
   if (std::holds_alternative<LaserScan>(record)) ++scans_;
+  if (std::holds_alternative<RgbdFrame>(record)) ++frames_;
   if (truth != nullptr) writer_.Write(*truth);
 }
 

@@ -22,7 +22,8 @@ struct BagSinkOptions {
 };
 
 /// A RecordSink that writes a ROS 2 bag folder through BagWriter: every record on its topic
-/// (/scan with /tf_static, /imu, /joint_states), after each WheelTicks record the robot's own
+/// (/scan with /tf_static, /imu, /joint_states, an RgbdFrame as two sensor_msgs/Image and a
+/// CameraInfo), after each WheelTicks record the robot's own
 /// odometry pose at its time on /odom and /tf, OdometryPose records (a log replayed) as they
 /// are, and the truth given with a record on /ground_truth/odom right after it. Nothing appears
 /// at the folder until Commit().
@@ -36,6 +37,8 @@ class BagSink final : public RecordSink {
   void Commit() override;
 
   int scans() const { return scans_; }
+  /// RGB-D frames written (each an rgb and a depth image and a camera info).
+  int frames() const { return frames_; }
   int odometry_messages() const { return odometry_.poses(); }
   int imu_samples() const { return odometry_.imu_samples(); }
   /// The robot's odometry pose after the last WheelTicks record.
@@ -45,6 +48,7 @@ class BagSink final : public RecordSink {
   BagWriter writer_;
   RobotOdometry odometry_;
   int scans_ = 0;
+  int frames_ = 0;
 };
 
 }  // namespace slamrig::slam

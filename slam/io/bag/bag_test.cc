@@ -2,6 +2,7 @@
 #include <sqlite3.h>
 
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -9,6 +10,7 @@
 
 #include "slam/io/bag/bag_reader.h"
 #include "slam/io/bag/bag_writer.h"
+#include "slam/io/bag/cdr.h"
 #include "slam/io/bag/mcap_writer.h"
 #include "slam/io/bag/raw_bag.h"
 #include "slam/io/bag/ros_messages.h"
@@ -206,6 +208,77 @@ TEST(BagTest, MetadataListsTopicsAndCounts) {
         "  relative_file_paths:\n    - m_0.mcap\n"}) {
     EXPECT_NE(yaml.find(key), std::string::npos) << key;
   }
+}
+
+TEST(BagTest, AnRgbdFrameIsTwoImagesAndACameraInfo) {
+  TempDir dir;
+  RgbdFrame frame;
+  frame.time = Time{1'500'000'000};
+  frame.width = 2;
+  frame.height = 2;
+  frame.rgb = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+  frame.depth_m = {0.5f, 1.25f, 0.0f, 4.0f};
+  frame.intrinsics = {100.0, 100.0, 0.5, 0.5};
+  {
+    BagWriterOptions options;
+    options.compression = McapCompression::kNone;
+    BagWriter writer(dir.File("f"), options);
+    writer.Write(Record{frame});
+    writer.Commit();
+  }
+  const RawBag bag = ReadMcapFile(dir.File("f/f_0.mcap"));
+  std::map<std::string, std::string> type_of, data_of;
+  for (const RawBagTopic& t : bag.topics) type_of[t.name] = t.type;
+  for (const RawBagMessage& m : bag.messages) {
+    EXPECT_EQ(m.log_time_ns, frame.time.ns);
+    data_of[bag.topics[m.topic].name] = m.data;
+  }
+  const BagTopicNames names;
+  EXPECT_EQ(type_of[names.rgb], "sensor_msgs/msg/Image");
+  EXPECT_EQ(type_of[names.depth], "sensor_msgs/msg/Image");
+  EXPECT_EQ(type_of[names.camera_info], "sensor_msgs/msg/CameraInfo");
+
+  // sensor_msgs/Image: header, height, width, encoding, is_bigendian, step, data.
+  const auto image = [](const std::string& bytes, const char* encoding) {
+    CdrReader r(bytes);
+    EXPECT_EQ(r.Int32(), 1);
+    EXPECT_EQ(r.Uint32(), 500'000'000u);
+    r.String();  // frame_id
+    EXPECT_EQ(r.Uint32(), 2u);
+    EXPECT_EQ(r.Uint32(), 2u);
+    EXPECT_EQ(r.String(), encoding);
+    // Then is_bigendian (one byte, 0), step aligned to 4 and the data sequence: checked below.
+  };
+  image(data_of[names.rgb], "rgb8");
+  image(data_of[names.depth], "32FC1");
+  const std::string& rgb = data_of[names.rgb];
+  EXPECT_EQ(rgb.substr(rgb.size() - 12),
+            std::string(reinterpret_cast<const char*>(frame.rgb.data()), 12));
+  const std::string& depth = data_of[names.depth];
+  EXPECT_EQ(depth.substr(depth.size() - 16),
+            std::string(reinterpret_cast<const char*>(frame.depth_m.data()), 16));
+  // The step and the data's length right before the data.
+  std::uint32_t step = 0, count = 0;
+  std::memcpy(&step, rgb.data() + rgb.size() - 12 - 8, 4);
+  std::memcpy(&count, rgb.data() + rgb.size() - 12 - 4, 4);
+  EXPECT_EQ(step, 6u);
+  EXPECT_EQ(count, 12u);
+
+  // sensor_msgs/CameraInfo: K from the intrinsics, no distortion.
+  CdrReader info(data_of[names.camera_info]);
+  info.Int32();
+  info.Uint32();
+  info.String();
+  EXPECT_EQ(info.Uint32(), 2u);
+  EXPECT_EQ(info.Uint32(), 2u);
+  EXPECT_EQ(info.String(), "plumb_bob");
+  EXPECT_EQ(info.Float64Sequence(), std::vector<double>(5, 0.0));
+  EXPECT_EQ(info.Float64Array(9),
+            (std::vector<double>{100.0, 0.0, 0.5, 0.0, 100.0, 0.5, 0.0, 0.0, 1.0}));
+
+  // slamrig's reader has no use for the images: it reads the bag and says what it skipped.
+  const Dataset back = ReadBag(dir.File("f"));
+  EXPECT_TRUE(back.records.empty());
 }
 
 // --- hostile input --------------------------------------------------------------------------

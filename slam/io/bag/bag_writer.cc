@@ -80,7 +80,10 @@ std::vector<std::string> BagTopicNames::Validate() const {
       {"topics.ground_truth", &ground_truth},
       {"topics.tf", &tf},
       {"topics.tf_static", &tf_static},
-      {"topics.clock", &clock}};
+      {"topics.clock", &clock},
+      {"topics.rgb", &rgb},
+      {"topics.depth", &depth},
+      {"topics.camera_info", &camera_info}};
   for (std::size_t i = 0; i < names.size(); ++i) {
     CheckTopicName(names[i].first, *names[i].second, &errors);
     for (std::size_t j = 0; j < i; ++j) {
@@ -101,7 +104,10 @@ std::string* BagTopicNames::Find(std::string_view key) {
                                                               {"ground_truth", &ground_truth},
                                                               {"tf", &tf},
                                                               {"tf_static", &tf_static},
-                                                              {"clock", &clock}};
+                                                              {"clock", &clock},
+                                                              {"rgb", &rgb},
+                                                              {"depth", &depth},
+                                                              {"camera_info", &camera_info}};
   for (const auto& [name, field] : fields) {
     if (name == key) return field;
   }
@@ -109,7 +115,8 @@ std::string* BagTopicNames::Find(std::string_view key) {
 }
 
 const char* BagTopicNames::Keys() {
-  return "scan, imu, joint_states, odom, ground_truth, tf, tf_static, clock";
+  return "scan, imu, joint_states, odom, ground_truth, tf, tf_static, clock, rgb, depth, "
+         "camera_info";
 }
 
 std::vector<std::string> BagFrames::Validate() const {
@@ -117,7 +124,8 @@ std::vector<std::string> BagFrames::Validate() const {
   for (const auto& [field, value] :
        {std::pair{"frames.map", &map}, std::pair{"frames.odom", &odom},
         std::pair{"frames.base", &base}, std::pair{"frames.laser", &laser},
-        std::pair{"frames.imu", &imu}}) {
+        std::pair{"frames.imu", &imu}, std::pair{"frames.camera", &camera},
+        std::pair{"frames.depth", &depth}}) {
     if (value->empty()) errors.push_back(RuleViolation(field, "''", "must not be empty"));
   }
   return errors;
@@ -285,6 +293,14 @@ void BagWriter::Write(const Record& record) {
     }
     EncodeJointState(time, joint_names_, positions_, &buffer_);
     Emit(GetTopic(options_.topics.joint_states, static_cast<int>(RosType::kJointState), false),
+         time);
+  } else if (const auto* frame = std::get_if<RgbdFrame>(&record)) {
+    EncodeRgbImage(*frame, f.camera, &buffer_);
+    Emit(GetTopic(options_.topics.rgb, static_cast<int>(RosType::kImage), false), time);
+    EncodeDepthImage(*frame, f.depth, &buffer_);
+    Emit(GetTopic(options_.topics.depth, static_cast<int>(RosType::kImage), false), time);
+    EncodeCameraInfo(*frame, f.camera, &buffer_);
+    Emit(GetTopic(options_.topics.camera_info, static_cast<int>(RosType::kCameraInfo), false),
          time);
   } else if (const auto* odom = std::get_if<OdometryPose>(&record)) {
     EncodeOdometry({time, f.odom, f.base, odom->odom_from_base}, &buffer_);

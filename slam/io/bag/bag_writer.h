@@ -21,14 +21,17 @@ std::string_view BagStorageName(BagStorage storage);
 
 /// Topic names of a bag, with the usual ROS defaults.
 struct BagTopicNames {
-  std::string scan = "/scan";                       ///< sensor_msgs/msg/LaserScan
-  std::string imu = "/imu";                         ///< sensor_msgs/msg/Imu
-  std::string joint_states = "/joint_states";       ///< sensor_msgs/msg/JointState (wheels)
-  std::string odom = "/odom";                       ///< nav_msgs/msg/Odometry
-  std::string ground_truth = "/ground_truth/odom";  ///< nav_msgs/msg/Odometry, map frame
-  std::string tf = "/tf";                           ///< tf2_msgs/msg/TFMessage, odom -> base
-  std::string tf_static = "/tf_static";             ///< tf2_msgs/msg/TFMessage, base -> laser
-  std::string clock = "/clock";                     ///< rosgraph_msgs/msg/Clock
+  std::string scan = "/scan";                             ///< sensor_msgs/msg/LaserScan
+  std::string imu = "/imu";                               ///< sensor_msgs/msg/Imu
+  std::string joint_states = "/joint_states";             ///< sensor_msgs/msg/JointState (wheels)
+  std::string odom = "/odom";                             ///< nav_msgs/msg/Odometry
+  std::string ground_truth = "/ground_truth/odom";        ///< nav_msgs/msg/Odometry, map frame
+  std::string tf = "/tf";                                 ///< tf2_msgs/msg/TFMessage, odom -> base
+  std::string tf_static = "/tf_static";                   ///< tf2_msgs/msg/TFMessage, base -> laser
+  std::string clock = "/clock";                           ///< rosgraph_msgs/msg/Clock
+  std::string rgb = "/camera/color/image_raw";            ///< sensor_msgs/msg/Image, rgb8
+  std::string depth = "/camera/depth/image_raw";          ///< sensor_msgs/msg/Image, 32FC1 metres
+  std::string camera_info = "/camera/color/camera_info";  ///< sensor_msgs/msg/CameraInfo
 
   /// One RuleViolation() message per name that is not an absolute ROS name, or is repeated.
   std::vector<std::string> Validate() const;
@@ -46,7 +49,9 @@ struct BagFrames {
   std::string odom = "odom";
   std::string base = "base_link";
   std::string laser = "laser";
-  std::string imu = "base_link";  ///< the IMU is aligned with base_link
+  std::string imu = "base_link";                      ///< the IMU is aligned with base_link
+  std::string camera = "camera_color_optical_frame";  ///< RGB images and camera info
+  std::string depth = "camera_depth_optical_frame";   ///< depth images
 
   /// One RuleViolation() message per empty name.
   std::vector<std::string> Validate() const;

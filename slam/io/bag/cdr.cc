@@ -30,6 +30,11 @@ void CdrWriter::Float32Sequence(std::span<const float> values) {
   out_->append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(float));
 }
 
+void CdrWriter::ByteSequence(std::span<const std::uint8_t> bytes) {
+  Uint32(static_cast<std::uint32_t>(bytes.size()));
+  out_->append(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+}
+
 void CdrWriter::Float64Sequence(std::span<const double> values) {
   Uint32(static_cast<std::uint32_t>(values.size()));
   Float64Array(values);

@@ -32,6 +32,9 @@ class CdrWriter {
   void Uint32(std::uint32_t v) { Pod(v); }
   void Float32(float v) { Pod(v); }
   void Float64(double v) { Pod(v); }
+  void Uint8(std::uint8_t v) { Pod(v); }
+  /// `sequence<uint8>`: count, then the bytes.
+  void ByteSequence(std::span<const std::uint8_t> bytes);
   /// A CDR string: uint32 length including the NUL, the bytes, the NUL.
   void String(std::string_view s);
   /// `sequence<float>`: count, then the elements.

@@ -1,6 +1,7 @@
 #include "slam/io/bag/ros_messages.h"
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <map>
 #include <set>
@@ -74,6 +75,8 @@ const std::map<std::string, std::string>& NestedDefinitions() {
       {"geometry_msgs/TwistWithCovariance", "geometry_msgs/Twist twist\nfloat64[36] covariance\n"},
       {"geometry_msgs/Transform",
        "geometry_msgs/Vector3 translation\ngeometry_msgs/Quaternion rotation\n"},
+      {"sensor_msgs/RegionOfInterest",
+       "uint32 x_offset\nuint32 y_offset\nuint32 height\nuint32 width\nbool do_rectify\n"},
       {"geometry_msgs/TransformStamped",
        "std_msgs/Header header\nstring child_frame_id\ngeometry_msgs/Transform transform\n"},
   };
@@ -81,7 +84,7 @@ const std::map<std::string, std::string>& NestedDefinitions() {
 }
 
 const TypeInfo& Info(RosType type) {
-  static const std::array<TypeInfo, 6> infos = {{
+  static const std::array<TypeInfo, 8> infos = {{
       {"sensor_msgs/msg/LaserScan",
        "std_msgs/Header header\nfloat32 angle_min\nfloat32 angle_max\nfloat32 angle_increment\n"
        "float32 time_increment\nfloat32 scan_time\nfloat32 range_min\nfloat32 range_max\n"
@@ -99,6 +102,13 @@ const TypeInfo& Info(RosType type) {
        "geometry_msgs/TwistWithCovariance twist\n"},
       {"tf2_msgs/msg/TFMessage", "geometry_msgs/TransformStamped[] transforms\n"},
       {"rosgraph_msgs/msg/Clock", "builtin_interfaces/Time clock\n"},
+      {"sensor_msgs/msg/Image",
+       "std_msgs/Header header\nuint32 height\nuint32 width\nstring encoding\n"
+       "uint8 is_bigendian\nuint32 step\nuint8[] data\n"},
+      {"sensor_msgs/msg/CameraInfo",
+       "std_msgs/Header header\nuint32 height\nuint32 width\nstring distortion_model\n"
+       "float64[] d\nfloat64[9] k\nfloat64[9] r\nfloat64[12] p\nuint32 binning_x\n"
+       "uint32 binning_y\nsensor_msgs/RegionOfInterest roi\n"},
   }};
   return infos[static_cast<std::size_t>(type)];
 }
@@ -154,8 +164,8 @@ void AppendDependencies(std::string_view fields, std::set<std::string>* seen, st
 }  // namespace
 
 const std::string& RosMessageDefinition(RosType type) {
-  static const std::array<std::string, 6> texts = [] {
-    std::array<std::string, 6> t;
+  static const std::array<std::string, 8> texts = [] {
+    std::array<std::string, 8> t;
     for (RosType ty : kAllRosTypes) {
       std::string text = Info(ty).fields;
       std::set<std::string> seen;
@@ -181,6 +191,57 @@ double YawFromQuaternion(double x, double y, double z, double w) {
     down = std::nextafter(down, -INFINITY);
   }
   return guess;
+}
+
+namespace {
+
+void WriteImage(const RgbdFrame& frame, std::string_view frame_id, const char* encoding,
+                std::size_t bytes_per_pixel, std::span<const std::uint8_t> data, CdrWriter* w) {
+  WriteHeader(frame.time, frame_id, w);
+  w->Uint32(static_cast<std::uint32_t>(frame.height));
+  w->Uint32(static_cast<std::uint32_t>(frame.width));
+  w->String(encoding);
+  w->Uint8(0);  // little-endian
+  w->Uint32(static_cast<std::uint32_t>(bytes_per_pixel * static_cast<std::size_t>(frame.width)));
+  w->ByteSequence(data);
+}
+
+}  // namespace
+
+void EncodeRgbImage(const RgbdFrame& frame, std::string_view frame_id, std::string* out) {
+  CdrWriter w(out);
+  WriteImage(frame, frame_id, "rgb8", 3, frame.rgb, &w);
+}
+
+void EncodeDepthImage(const RgbdFrame& frame, std::string_view frame_id, std::string* out) {
+  static_assert(std::endian::native == std::endian::little, "32FC1 data is written as stored");
+  CdrWriter w(out);
+  WriteImage(frame, frame_id, "32FC1", 4,
+             {reinterpret_cast<const std::uint8_t*>(frame.depth_m.data()),
+              frame.depth_m.size() * sizeof(float)},
+             &w);
+}
+
+void EncodeCameraInfo(const RgbdFrame& frame, std::string_view frame_id, std::string* out) {
+  CdrWriter w(out);
+  WriteHeader(frame.time, frame_id, &w);
+  w.Uint32(static_cast<std::uint32_t>(frame.height));
+  w.Uint32(static_cast<std::uint32_t>(frame.width));
+  w.String("plumb_bob");
+  const std::array<double, 5> d = {0.0, 0.0, 0.0, 0.0, 0.0};
+  w.Float64Sequence(d);
+  const CameraIntrinsics& k = frame.intrinsics;
+  const std::array<double, 9> kk = {k.fx_px, 0.0, k.cx_px, 0.0, k.fy_px, k.cy_px, 0.0, 0.0, 1.0};
+  const std::array<double, 9> r = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+  const std::array<double, 12> p = {k.fx_px, 0.0, k.cx_px, 0.0, 0.0, k.fy_px,
+                                    k.cy_px, 0.0, 0.0,     0.0, 1.0, 0.0};
+  w.Float64Array(kk);
+  w.Float64Array(r);
+  w.Float64Array(p);
+  w.Uint32(0);                              // binning_x
+  w.Uint32(0);                              // binning_y
+  for (int i = 0; i < 4; ++i) w.Uint32(0);  // roi: the whole image
+  w.Uint8(0);                               // roi.do_rectify
 }
 
 void EncodeLaserScan(const LaserScan& scan, std::string_view frame_id, std::string* out) {

@@ -12,12 +12,21 @@
 namespace slamrig::slam {
 
 /// The ROS 2 message types slamrig writes to and reads from bags.
-enum class RosType { kLaserScan, kImu, kJointState, kOdometry, kTfMessage, kClock };
+enum class RosType {
+  kLaserScan,
+  kImu,
+  kJointState,
+  kOdometry,
+  kTfMessage,
+  kClock,
+  kImage,
+  kCameraInfo
+};
 
 /// All types, in a fixed order.
-inline constexpr RosType kAllRosTypes[] = {RosType::kLaserScan,  RosType::kImu,
-                                           RosType::kJointState, RosType::kOdometry,
-                                           RosType::kTfMessage,  RosType::kClock};
+inline constexpr RosType kAllRosTypes[] = {
+    RosType::kLaserScan, RosType::kImu,   RosType::kJointState, RosType::kOdometry,
+    RosType::kTfMessage, RosType::kClock, RosType::kImage,      RosType::kCameraInfo};
 
 /// The type's ROS 2 name, e.g. "sensor_msgs/msg/LaserScan".
 std::string_view RosTypeName(RosType type);
@@ -75,6 +84,14 @@ void EncodeOdometry(const RosOdometry& odometry, std::string* out);
 void EncodeTfMessage(const std::vector<RosTransform>& transforms, std::string* out);
 /// rosgraph_msgs/msg/Clock.
 void EncodeClock(Time time, std::string* out);
+/// sensor_msgs/Image of `frame`'s colour image ("rgb8", top row first).
+void EncodeRgbImage(const RgbdFrame& frame, std::string_view frame_id, std::string* out);
+/// sensor_msgs/Image of `frame`'s depth image ("32FC1", metres, 0 = no reading; REP-118 would
+/// have NaN there, but 0 is what the depth_image_proc drivers of a Kinect publish).
+void EncodeDepthImage(const RgbdFrame& frame, std::string_view frame_id, std::string* out);
+/// sensor_msgs/CameraInfo of `frame`'s intrinsics: no distortion ("plumb_bob", five zeros),
+/// R identity, P = [K | 0].
+void EncodeCameraInfo(const RgbdFrame& frame, std::string_view frame_id, std::string* out);
 
 // Decoders: throw CdrError (slam/io/bag/cdr.h) when the payload is too short or a length is bad.
 

@@ -1,4 +1,4 @@
-#include "sim/camera/camera_spec.h"
+#include "sim/camera_spec.h"
 
 #include <cmath>
 
@@ -8,7 +8,7 @@ namespace slamrig::sim {
 
 std::vector<std::string> CameraSpec::Validate() const {
   std::vector<std::string> e;
-  const std::string p = "camera.";
+  const std::string p;  // the robot file prefixes "camera."
   const auto positive = [&](const std::string& field, double v) {
     if (!(v > 0.0) || !std::isfinite(v)) e.push_back(RuleViolation(p + field, v, "must be > 0"));
   };

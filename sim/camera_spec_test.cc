@@ -1,4 +1,4 @@
-#include "sim/camera/camera_spec.h"
+#include "sim/camera_spec.h"
 
 #include <gtest/gtest.h>
 
@@ -23,11 +23,11 @@ TEST(CameraSpecTest, NamesTheFieldTheValueAndTheRule) {
   c.zfar_m = 0.01;
   const std::vector<std::string> e = c.Validate();
   ASSERT_GE(e.size(), 3u);
-  EXPECT_EQ(e[0], "camera.width_px = 0; must be in [1, 4096]");
+  EXPECT_EQ(e[0], "width_px = 0; must be in [1, 4096]");
   EXPECT_EQ(e[1],
-            "camera.intrinsics.fx_px = 500; must equal intrinsics.fy_px (MuJoCo 2.2 renders "
+            "intrinsics.fx_px = 500; must equal intrinsics.fy_px (MuJoCo 2.2 renders "
             "square pixels)");
-  EXPECT_NE(std::find(e.begin(), e.end(), "camera.zfar_m = 0.01; must be > znear_m"), e.end());
+  EXPECT_NE(std::find(e.begin(), e.end(), "zfar_m = 0.01; must be > znear_m"), e.end());
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -20,9 +21,10 @@ struct ZoneTexture {
   double tile_m = 1.0;  ///< side of the floor square one copy of the image covers
 };
 
-/// An RGB-D camera on the robot, rendered by MuJoCo. Defaults: the ECE276A robot's Kinect at 640 x
-/// 480 and 10 Hz with the intrinsics and mounting of the reports (Zafari, ECE276A report,
-/// "Texture Mapping"; the course's robot configuration).
+/// An RGB-D camera on the robot (the robot file's `camera:` block), rendered by MuJoCo in
+/// sim/camera; the options live here so that a RobotSpec can carry them. Defaults: the ECE276A
+/// robot's Kinect at 640 x 480 and 10 Hz with the intrinsics and mounting of the reports (Zafari,
+/// ECE276A report, "Texture Mapping"; the course's robot configuration).
 struct CameraSpec {
   std::string name = "kinect";  ///< names the camera in errors
   int width_px = 640;           ///< image columns
@@ -54,7 +56,7 @@ struct CameraSpec {
   std::vector<ZoneTexture> zones = {{"carpet", "carpet.png", 1.0}, {"ice", "concrete.png", 2.0}};
   double floor_texel_m = 0.01;  ///< texel of the floor texture the zones are composed into
   double wall_height_m = 2.0;   ///< walls are extruded to this height
-  double wall_rgb[3] = {0.85, 0.85, 0.8};   ///< wall colour, 0..1 (multiplies the wall image)
+  Eigen::Vector3d wall_rgb = Eigen::Vector3d(0.85, 0.85, 0.8);  ///< wall colour, 0..1 (x image)
   std::string wall_image = "concrete.png";  ///< wall texture; empty: plain wall_rgb
   double wall_tile_m = 1.0;                 ///< side of the square one wall image covers
   double znear_m = 0.05;                    ///< near clipping plane
