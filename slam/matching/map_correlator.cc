@@ -46,13 +46,13 @@ struct IndicatorOp {
 };
 
 // Adds, for every patch row r and column c < 4*K, the contribution of cell
-// values[offset + r*width + c] over all `offsets` into sums[r*4K + c].
+// values[offset + r*stride + c] over all `offsets` into sums[r*4K + c].
 template <int K, typename Op>
-void AccumulateRows(const float* values, int width, int side,
+void AccumulateRows(const float* values, int stride, int side,
                     const std::vector<std::int64_t>& offsets, const Op& op, float* sums) {
   for (int r = 0; r < side; ++r) {
     V4 acc[K] = {};
-    const float* row_base = values + static_cast<std::ptrdiff_t>(r) * width;
+    const float* row_base = values + static_cast<std::ptrdiff_t>(r) * stride;
     for (const std::int64_t offset : offsets) {
       const float* p = row_base + offset;
       for (int k = 0; k < K; ++k) acc[k] += op(Load4(p + 4 * k));
@@ -62,25 +62,25 @@ void AccumulateRows(const float* values, int width, int side,
 }
 
 template <typename Op>
-void AccumulateDispatch(int chunks, const float* values, int width, int side,
+void AccumulateDispatch(int chunks, const float* values, int stride, int side,
                         const std::vector<std::int64_t>& offsets, const Op& op, float* sums) {
   switch (chunks) {
     case 1:
-      return AccumulateRows<1>(values, width, side, offsets, op, sums);
+      return AccumulateRows<1>(values, stride, side, offsets, op, sums);
     case 2:
-      return AccumulateRows<2>(values, width, side, offsets, op, sums);
+      return AccumulateRows<2>(values, stride, side, offsets, op, sums);
     case 3:
-      return AccumulateRows<3>(values, width, side, offsets, op, sums);
+      return AccumulateRows<3>(values, stride, side, offsets, op, sums);
     case 4:
-      return AccumulateRows<4>(values, width, side, offsets, op, sums);
+      return AccumulateRows<4>(values, stride, side, offsets, op, sums);
     case 5:
-      return AccumulateRows<5>(values, width, side, offsets, op, sums);
+      return AccumulateRows<5>(values, stride, side, offsets, op, sums);
     case 6:
-      return AccumulateRows<6>(values, width, side, offsets, op, sums);
+      return AccumulateRows<6>(values, stride, side, offsets, op, sums);
     case 7:
-      return AccumulateRows<7>(values, width, side, offsets, op, sums);
+      return AccumulateRows<7>(values, stride, side, offsets, op, sums);
     case 8:
-      return AccumulateRows<8>(values, width, side, offsets, op, sums);
+      return AccumulateRows<8>(values, stride, side, offsets, op, sums);
     default:
       SLAMRIG_CHECK(false, "shift grid too wide");
   }
@@ -135,6 +135,7 @@ CorrelationResult MapCorrelator::Correlate(const GridView& grid,
   const int chunks = (side + 3) / 4;
   const int padded = 4 * chunks;  // columns actually read per patch row
   const double inv_res = 1.0 / grid.resolution;
+  const int stride = grid.row_stride();
   const IndicatorOp indicator{options_.occupied_threshold};
   const RawOp raw;
   if (table != nullptr)
@@ -177,7 +178,7 @@ CorrelationResult MapCorrelator::Correlate(const GridView& grid,
       ++distinct;
       const int x0 = ix - n, y0 = iy - n;
       if (x0 >= 0 && y0 >= 0 && x0 + padded <= grid.width && y0 + side <= grid.height) {
-        scratch.offsets.push_back(static_cast<std::int64_t>(y0) * grid.width + x0);
+        scratch.offsets.push_back(static_cast<std::int64_t>(y0) * stride + x0);
       } else {
         scratch.border.push_back({x0, y0});
       }
@@ -186,10 +187,10 @@ CorrelationResult MapCorrelator::Correlate(const GridView& grid,
     scratch.sums.assign(static_cast<std::size_t>(side * padded), 0.0f);
     if (!scratch.offsets.empty()) {
       if (options_.value == CorrelationValue::kOccupiedIndicator) {
-        AccumulateDispatch(chunks, grid.values, grid.width, side, scratch.offsets, indicator,
+        AccumulateDispatch(chunks, grid.values, stride, side, scratch.offsets, indicator,
                            scratch.sums.data());
       } else {
-        AccumulateDispatch(chunks, grid.values, grid.width, side, scratch.offsets, raw,
+        AccumulateDispatch(chunks, grid.values, stride, side, scratch.offsets, raw,
                            scratch.sums.data());
       }
     }

@@ -31,11 +31,12 @@ Sample Interpolate(const GridView& g, const Eigen::Vector2d& world) {
   double v00, v10, v01, v11;
   if (ix >= 0 && iy >= 0 && ix + 1 < g.width && iy + 1 < g.height) {
     // Inside: the four samples without At()'s bounds checks (the same values).
-    const float* row = g.values + static_cast<std::ptrdiff_t>(iy) * g.width + ix;
+    const int stride = g.row_stride();
+    const float* row = g.values + static_cast<std::ptrdiff_t>(iy) * stride + ix;
     v00 = row[0];
     v10 = row[1];
-    v01 = row[g.width];
-    v11 = row[g.width + 1];
+    v01 = row[stride];
+    v11 = row[stride + 1];
   } else {
     v00 = g.At(ix, iy);
     v10 = g.At(ix + 1, iy);

@@ -74,9 +74,10 @@ std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& po
         reach + (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
         options_.likelihood_field.cutoff_sigmas * options_.likelihood_field.sigma_m;
     const Eigen::Vector2d m = Eigen::Vector2d::Constant(margin);
-    likelihood_field_.Update(map_,
-                             Eigen::AlignedBox2d(particles_box.min() - m, particles_box.max() + m));
-    field_view = likelihood_field_.view();
+    // Kept up to date where the map changed; the window keeps reads outside it at 0.
+    likelihood_field_.Follow(map_);
+    field_view = likelihood_field_.view(
+        Eigen::AlignedBox2d(particles_box.min() - m, particles_box.max() + m));
   }
   const GridView view = use_field ? field_view : GridView::Of(map_);
   const float field_max = static_cast<float>(likelihood_field_.Score(0.0));
