@@ -110,6 +110,11 @@ void OccupancyGrid::RecordWallFlips(float threshold) {
   wall_threshold_ = threshold;
 }
 
+void OccupancyGrid::RecordFlip(std::size_t index) {
+  flips_.push_back({static_cast<int>(index % static_cast<std::size_t>(width_)),
+                    static_cast<int>(index / static_cast<std::size_t>(width_))});
+}
+
 std::vector<Eigen::Array2i> OccupancyGrid::TakeWallFlips() {
   std::vector<Eigen::Array2i> taken;
   taken.swap(flips_);

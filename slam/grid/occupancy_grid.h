@@ -131,13 +131,13 @@ class OccupancyGrid {
   // Stores `value` into cell `index`, recording a wall flip.
   void Assign(std::size_t index, float value) {
     float& l = log_odds_[index];
-    if (records_flips_ && (l > wall_threshold_) != (value > wall_threshold_)) RecordFlip(index);
+    if (records_flips_ && (l > wall_threshold_) != (value > wall_threshold_)) [[unlikely]] {
+      RecordFlip(index);
+    }
     l = value;
   }
-  void RecordFlip(std::size_t index) {
-    flips_.push_back({static_cast<int>(index % static_cast<std::size_t>(width_)),
-                      static_cast<int>(index / static_cast<std::size_t>(width_))});
-  }
+  // Out of line: flips are rare, the update loops stay small.
+  void RecordFlip(std::size_t index);
 
   std::size_t Index(int ix, int iy) const {
     return static_cast<std::size_t>(iy) * static_cast<std::size_t>(width_) +
