@@ -97,9 +97,28 @@ void OccupancyGrid::EnsureContains(const Eigen::AlignedBox2d& box) {
   }
   log_odds_ = std::move(grown);
   last_update_ = std::move(grown_updates);
+  for (Eigen::Array2i& cell : flips_) cell += Eigen::Array2i(shift_x, shift_y);
   origin_ = new_origin;
   width_ = new_width;
   height_ = new_height;
+}
+
+void OccupancyGrid::RecordWallFlips(float threshold) {
+  SLAMRIG_CHECK(!records_flips_ || threshold == wall_threshold_,
+                "a grid records wall flips for one threshold");
+  records_flips_ = true;
+  wall_threshold_ = threshold;
+}
+
+void OccupancyGrid::RecordFlip(std::size_t index) {
+  flips_.push_back({static_cast<int>(index % static_cast<std::size_t>(width_)),
+                    static_cast<int>(index / static_cast<std::size_t>(width_))});
+}
+
+std::vector<Eigen::Array2i> OccupancyGrid::TakeWallFlips() {
+  std::vector<Eigen::Array2i> taken;
+  taken.swap(flips_);
+  return taken;
 }
 
 int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_base) {
@@ -139,7 +158,9 @@ int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_bas
     std::uint32_t& stamp = last_update_[Index(cell.x(), cell.y())];
     if (once && stamp == scan_count_) continue;
     stamp = scan_count_;
-    Update(cell, options_.hit_log_odds);
+    const std::size_t index = Index(cell.x(), cell.y());
+    Assign(index, std::clamp(log_odds_[index] + options_.hit_log_odds, options_.min_log_odds,
+                             options_.max_log_odds));
   }
   for (const auto& [end, hit] : ends) {
     const Eigen::Array2i cell = WorldToCell(end);
@@ -149,16 +170,14 @@ int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_bas
         if (last_update_[index] == scan_count_) return;
         last_update_[index] = scan_count_;
       }
-      float& l = log_odds_[index];
-      l = std::max(l + options_.miss_log_odds, options_.min_log_odds);
+      Assign(index, std::max(log_odds_[index] + options_.miss_log_odds, options_.min_log_odds));
     });
     // A no-return beam's last cell is free too.
     if (!hit) {
       const std::size_t index = Index(cell.x(), cell.y());
       if (!once || last_update_[index] != scan_count_) {
         last_update_[index] = scan_count_;
-        log_odds_[index] =
-            std::max(log_odds_[index] + options_.miss_log_odds, options_.min_log_odds);
+        Assign(index, std::max(log_odds_[index] + options_.miss_log_odds, options_.min_log_odds));
       }
     }
   }

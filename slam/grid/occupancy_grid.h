@@ -110,15 +110,35 @@ class OccupancyGrid {
 
   /// Adds `delta` to `cell` with clamping; the grid must contain the cell.
   void Update(const Eigen::Array2i& cell, float delta) {
-    float& l = log_odds_[Index(cell.x(), cell.y())];
-    l = std::clamp(l + delta, options_.min_log_odds, options_.max_log_odds);
+    const std::size_t index = Index(cell.x(), cell.y());
+    Assign(index,
+           std::clamp(log_odds_[index] + delta, options_.min_log_odds, options_.max_log_odds));
   }
   /// Sets `cell` to `value` unclamped (map loading); the grid must contain the cell.
-  void Set(const Eigen::Array2i& cell, float value) {
-    log_odds_[Index(cell.x(), cell.y())] = value;
-  }
+  void Set(const Eigen::Array2i& cell, float value) { Assign(Index(cell.x(), cell.y()), value); }
+
+  /// From now on, records every cell whose wall state (log-odds > `threshold`) flips, so that a
+  /// raster derived from the walls (LikelihoodField::Follow) can be redone only where they
+  /// changed. Recording stays on; a second call must give the same threshold.
+  void RecordWallFlips(float threshold);
+  bool records_wall_flips() const { return records_flips_; }
+  float wall_threshold() const { return wall_threshold_; }
+  /// The cells whose wall state flipped since the last call, on the current lattice (re-based when
+  /// the grid grew); a cell may appear more than once. Clears the record: one reader per grid.
+  std::vector<Eigen::Array2i> TakeWallFlips();
 
  private:
+  // Stores `value` into cell `index`, recording a wall flip.
+  void Assign(std::size_t index, float value) {
+    float& l = log_odds_[index];
+    if (records_flips_ && (l > wall_threshold_) != (value > wall_threshold_)) [[unlikely]] {
+      RecordFlip(index);
+    }
+    l = value;
+  }
+  // Out of line: flips are rare, the update loops stay small.
+  void RecordFlip(std::size_t index);
+
   std::size_t Index(int ix, int iy) const {
     return static_cast<std::size_t>(iy) * static_cast<std::size_t>(width_) +
            static_cast<std::size_t>(ix);
@@ -132,6 +152,10 @@ class OccupancyGrid {
   // Scan number that last touched each cell, for update_once_per_scan.
   std::vector<std::uint32_t> last_update_;
   std::uint32_t scan_count_ = 0;
+  // Wall flips since the last TakeWallFlips, when recording.
+  bool records_flips_ = false;
+  float wall_threshold_ = 0.0f;
+  std::vector<Eigen::Array2i> flips_;
   // Scratch buffer reused across scans: beam end points and whether each is a hit.
   std::vector<std::pair<Eigen::Vector2d, bool>> beam_ends_;
 };

@@ -33,33 +33,32 @@ double LikelihoodField::Score(double distance_m) const {
   return std::log(options_.z_hit * g + options_.z_rand) - std::log(options_.z_rand);
 }
 
-void LikelihoodField::Update(const OccupancyGrid& grid, const Eigen::AlignedBox2d& region) {
-  resolution_ = grid.resolution();
+void LikelihoodField::EnsureKernel(double resolution) {
+  resolution_ = resolution;
   // Kernel of scores by cell offset, rebuilt only when the resolution changes.
-  if (kernel_resolution_ != resolution_) {
-    kernel_resolution_ = resolution_;
-    radius_cells_ =
-        static_cast<int>(std::ceil(options_.cutoff_sigmas * options_.sigma_m / resolution_));
-    const int side = 2 * radius_cells_ + 1;
-    kernel_.assign(static_cast<std::size_t>(side * side), 0.0f);
-    for (int dy = -radius_cells_; dy <= radius_cells_; ++dy) {
-      for (int dx = -radius_cells_; dx <= radius_cells_; ++dx) {
-        kernel_[static_cast<std::size_t>((dy + radius_cells_) * side + dx + radius_cells_)] =
-            static_cast<float>(Score(std::hypot(dx, dy) * resolution_));
-      }
+  if (kernel_resolution_ == resolution_) return;
+  kernel_resolution_ = resolution_;
+  radius_cells_ =
+      static_cast<int>(std::ceil(options_.cutoff_sigmas * options_.sigma_m / resolution_));
+  const int side = 2 * radius_cells_ + 1;
+  kernel_.assign(static_cast<std::size_t>(side * side), 0.0f);
+  for (int dy = -radius_cells_; dy <= radius_cells_; ++dy) {
+    for (int dx = -radius_cells_; dx <= radius_cells_; ++dx) {
+      kernel_[static_cast<std::size_t>((dy + radius_cells_) * side + dx + radius_cells_)] =
+          static_cast<float>(Score(std::hypot(dx, dy) * resolution_));
     }
   }
-  // Window on the grid lattice, clipped to the grid.
-  const Eigen::Array2i lo = grid.WorldToCell(region.min()).max(Eigen::Array2i(0, 0));
-  const Eigen::Array2i hi =
-      grid.WorldToCell(region.max()).min(Eigen::Array2i(grid.width() - 1, grid.height() - 1));
-  width_ = std::max(0, hi.x() - lo.x() + 1);
-  height_ = std::max(0, hi.y() - lo.y() + 1);
-  origin_ = grid.origin() + lo.cast<double>().matrix() * resolution_;
-  values_.assign(static_cast<std::size_t>(width_) * height_, 0.0f);
-  if (width_ == 0 || height_ == 0) return;
+}
 
-  // Stamp the kernel (max) around every wall cell within reach of the window.
+void LikelihoodField::Fill(const OccupancyGrid& grid, const Eigen::Array2i& lo,
+                           const Eigen::Array2i& hi, float* out, int stride) const {
+  const int width = hi.x() - lo.x() + 1, height = hi.y() - lo.y() + 1;
+  if (width <= 0 || height <= 0) return;
+  for (int y = 0; y < height; ++y) {
+    std::fill_n(out + static_cast<std::ptrdiff_t>(y) * stride, width, 0.0f);
+  }
+  // Stamp the kernel (max) around every wall cell within reach of the box. A max is exact and
+  // order-free, so any box gives its cells the values of a whole-grid pass.
   const int r = radius_cells_;
   const int side = 2 * r + 1;
   const std::vector<float>& log_odds = grid.log_odds();
@@ -70,19 +69,128 @@ void LikelihoodField::Update(const OccupancyGrid& grid, const Eigen::AlignedBox2
     for (int gx = x_begin; gx < x_end; ++gx) {
       if (!(row[gx] > options_.occupied_threshold)) continue;
       const int wx = gx - lo.x(), wy = gy - lo.y();
-      const int dy0 = std::max(-r, -wy), dy1 = std::min(r, height_ - 1 - wy);
-      const int dx0 = std::max(-r, -wx), dx1 = std::min(r, width_ - 1 - wx);
+      const int dy0 = std::max(-r, -wy), dy1 = std::min(r, height - 1 - wy);
+      const int dx0 = std::max(-r, -wx), dx1 = std::min(r, width - 1 - wx);
       for (int dy = dy0; dy <= dy1; ++dy) {
-        float* out = values_.data() + static_cast<std::ptrdiff_t>(wy + dy) * width_ + wx;
+        float* o = out + static_cast<std::ptrdiff_t>(wy + dy) * stride + wx;
         const float* k = kernel_.data() + static_cast<std::ptrdiff_t>(dy + r) * side + r;
-        for (int dx = dx0; dx <= dx1; ++dx) out[dx] = std::max(out[dx], k[dx]);
+        for (int dx = dx0; dx <= dx1; ++dx) o[dx] = std::max(o[dx], k[dx]);
       }
+    }
+  }
+}
+
+Eigen::Array2i LikelihoodField::WorldToCell(const Eigen::Vector2d& p) const {
+  return {static_cast<int>(std::floor((p.x() - origin_.x()) / resolution_)),
+          static_cast<int>(std::floor((p.y() - origin_.y()) / resolution_))};
+}
+
+void LikelihoodField::Update(const OccupancyGrid& grid, const Eigen::AlignedBox2d& region) {
+  followed_ = nullptr;
+  EnsureKernel(grid.resolution());
+  // Window on the grid lattice, clipped to the grid.
+  const Eigen::Array2i lo = grid.WorldToCell(region.min()).max(Eigen::Array2i(0, 0));
+  const Eigen::Array2i hi =
+      grid.WorldToCell(region.max()).min(Eigen::Array2i(grid.width() - 1, grid.height() - 1));
+  width_ = std::max(0, hi.x() - lo.x() + 1);
+  height_ = std::max(0, hi.y() - lo.y() + 1);
+  origin_ = grid.origin() + lo.cast<double>().matrix() * resolution_;
+  values_.assign(static_cast<std::size_t>(width_) * height_, 0.0f);
+  Fill(grid, lo, hi, values_.data(), width_);
+}
+
+void LikelihoodField::Refill(const OccupancyGrid& grid, Eigen::Array2i lo, Eigen::Array2i hi) {
+  lo = lo.max(Eigen::Array2i(0, 0));
+  hi = hi.min(Eigen::Array2i(width_ - 1, height_ - 1));
+  if ((lo > hi).any()) return;
+  Fill(grid, lo, hi, values_.data() + static_cast<std::ptrdiff_t>(lo.y()) * width_ + lo.x(),
+       width_);
+}
+
+void LikelihoodField::Regrow(const OccupancyGrid& grid) {
+  // The grid grows on its own lattice: the old cell (0, 0) is now cell `shift`.
+  const Eigen::Vector2d shift_cells = (origin_ - grid.origin()) / resolution_;
+  const Eigen::Array2i shift(static_cast<int>(std::lround(shift_cells.x())),
+                             static_cast<int>(std::lround(shift_cells.y())));
+  const int old_width = width_, old_height = height_;
+  std::vector<float> grown(static_cast<std::size_t>(grid.width()) * grid.height(), 0.0f);
+  for (int y = 0; y < old_height; ++y) {
+    std::copy_n(
+        values_.begin() + static_cast<std::ptrdiff_t>(y) * old_width, old_width,
+        grown.begin() + static_cast<std::ptrdiff_t>(y + shift.y()) * grid.width() + shift.x());
+  }
+  values_ = std::move(grown);
+  width_ = grid.width();
+  height_ = grid.height();
+  origin_ = grid.origin();
+  // The new cells, and the old ones within reach of them (unknown cells are walls when the
+  // threshold is below 0): four strips around the old area.
+  const int r = radius_cells_;
+  const Eigen::Array2i old_lo = shift, old_hi = shift + Eigen::Array2i(old_width, old_height) - 1;
+  Refill(grid, {0, 0}, {width_ - 1, old_lo.y() + r - 1});
+  Refill(grid, {0, old_hi.y() - r + 1}, {width_ - 1, height_ - 1});
+  Refill(grid, {0, old_lo.y()}, {old_lo.x() + r - 1, old_hi.y()});
+  Refill(grid, {old_hi.x() - r + 1, old_lo.y()}, {width_ - 1, old_hi.y()});
+}
+
+void LikelihoodField::Follow(OccupancyGrid& grid) {
+  EnsureKernel(grid.resolution());
+  const bool following = followed_ == &grid && grid.records_wall_flips() &&
+                         grid.wall_threshold() == options_.occupied_threshold;
+  if (!following) {
+    grid.RecordWallFlips(options_.occupied_threshold);
+    grid.TakeWallFlips();
+    followed_ = &grid;
+    width_ = grid.width();
+    height_ = grid.height();
+    origin_ = grid.origin();
+    values_.assign(static_cast<std::size_t>(width_) * height_, 0.0f);
+    Refill(grid, {0, 0}, {width_ - 1, height_ - 1});
+    return;
+  }
+  if (grid.width() != width_ || grid.height() != height_ || grid.origin() != origin_) {
+    Regrow(grid);
+  }
+  // A new wall only raises the cells around it; a wall that went can lower them, so they are
+  // recomputed from the walls now in reach.
+  const int r = radius_cells_;
+  const int side = 2 * r + 1;
+  const std::vector<float>& log_odds = grid.log_odds();
+  for (const Eigen::Array2i& cell : grid.TakeWallFlips()) {
+    const float l = log_odds[static_cast<std::size_t>(cell.y()) * width_ + cell.x()];
+    if (!(l > options_.occupied_threshold)) {
+      Refill(grid, cell - r, cell + r);
+      continue;
+    }
+    const int dy0 = std::max(-r, -cell.y()), dy1 = std::min(r, height_ - 1 - cell.y());
+    const int dx0 = std::max(-r, -cell.x()), dx1 = std::min(r, width_ - 1 - cell.x());
+    for (int dy = dy0; dy <= dy1; ++dy) {
+      float* o = values_.data() + static_cast<std::ptrdiff_t>(cell.y() + dy) * width_ + cell.x();
+      const float* k = kernel_.data() + static_cast<std::ptrdiff_t>(dy + r) * side + r;
+      for (int dx = dx0; dx <= dx1; ++dx) o[dx] = std::max(o[dx], k[dx]);
     }
   }
 }
 
 GridView LikelihoodField::view() const {
   return GridView{values_.data(), width_, height_, origin_, resolution_};
+}
+
+GridView LikelihoodField::view(const Eigen::AlignedBox2d& region) const {
+  SLAMRIG_CHECK(followed_ != nullptr, "LikelihoodField::view(region) needs Follow()");
+  // The window Update(grid, region) would compute, as a view into the whole field.
+  const Eigen::Array2i lo = WorldToCell(region.min()).max(Eigen::Array2i(0, 0));
+  const Eigen::Array2i hi = WorldToCell(region.max()).min(Eigen::Array2i(width_ - 1, height_ - 1));
+  GridView view;
+  view.width = std::max(0, hi.x() - lo.x() + 1);
+  view.height = std::max(0, hi.y() - lo.y() + 1);
+  view.origin = origin_ + lo.cast<double>().matrix() * resolution_;
+  view.resolution = resolution_;
+  view.stride = width_;
+  view.values = view.width > 0 && view.height > 0
+                    ? values_.data() + static_cast<std::ptrdiff_t>(lo.y()) * width_ + lo.x()
+                    : values_.data();
+  return view;
 }
 
 }  // namespace slamrig::slam

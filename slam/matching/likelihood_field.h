@@ -45,12 +45,35 @@ class LikelihoodField {
   /// on the grid's own cell lattice.
   void Update(const OccupancyGrid& grid, const Eigen::AlignedBox2d& region);
 
-  /// The field as a raster (valid until the next Update).
+  /// Keeps the field over the whole of `grid` up to date, at a cost that follows what changed, not
+  /// the map's size: the first call (or the first after Update, or with another grid) computes it
+  /// everywhere and starts the grid's wall-flip record; later calls redo only the cells within
+  /// reach of a wall that appeared or went, and when the grid grew only its new border. Every
+  /// value is exactly what Update would compute. One follower per grid (it takes the flips).
+  void Follow(OccupancyGrid& grid);
+
+  /// The field as a raster (valid until the next Update or Follow): Update's window, or the whole
+  /// followed grid.
   GridView view() const;
+  /// After Follow: the field over the part of the grid that overlaps `region`, 0 outside it, cell
+  /// for cell the raster that Update(grid, region) would give (a window, no copy).
+  GridView view(const Eigen::AlignedBox2d& region) const;
   /// Value of a cell at distance `distance_m` from the nearest wall.
   double Score(double distance_m) const;
 
  private:
+  void EnsureKernel(double resolution);
+  // Writes the field of the cells in [lo, hi] (inclusive, inside the grid) to `out`, the cell lo
+  // at out[0] and rows `stride` floats apart.
+  void Fill(const OccupancyGrid& grid, const Eigen::Array2i& lo, const Eigen::Array2i& hi,
+            float* out, int stride) const;
+  // Fill() on the followed lattice, for the cells of [lo, hi] inside it.
+  void Refill(const OccupancyGrid& grid, Eigen::Array2i lo, Eigen::Array2i hi);
+  // Moves the followed field onto the grid's grown lattice and fills the new border.
+  void Regrow(const OccupancyGrid& grid);
+  // The grid cell of world point `p` on the lattice in use (as OccupancyGrid::WorldToCell).
+  Eigen::Array2i WorldToCell(const Eigen::Vector2d& p) const;
+
   LikelihoodFieldOptions options_;
   int radius_cells_ = 0;
   double kernel_resolution_ = 0.0;
@@ -60,6 +83,8 @@ class LikelihoodField {
   int height_ = 0;
   Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
   double resolution_ = 1.0;
+  // The grid Follow keeps up with (nullptr after Update); width_, height_, origin_ are its lattice.
+  const OccupancyGrid* followed_ = nullptr;
 };
 
 }  // namespace slamrig::slam

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <random>
 
 namespace slamrig::slam {
 namespace {
@@ -36,6 +38,102 @@ TEST(LikelihoodFieldTest, ValueFollowsDistanceToTheNearestWall) {
   }
   EXPECT_NEAR(field.Score(0.0), std::log(1.0 / 0.1), 1e-12);
   EXPECT_EQ(field.Score(1.0), 0.0);
+}
+
+// The whole grid as an Update region: the centres of its corner cells.
+Eigen::AlignedBox2d WholeGrid(const OccupancyGrid& grid) {
+  return Eigen::AlignedBox2d(grid.CellCenter({0, 0}),
+                             grid.CellCenter({grid.width() - 1, grid.height() - 1}));
+}
+
+// Bit-for-bit equality of two rasters over the same cells (NaN-safe, -0 != +0).
+bool SameBits(const GridView& a, const GridView& b) {
+  if (a.width != b.width || a.height != b.height || a.origin != b.origin) return false;
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < a.width; ++x) {
+      const float va = a.At(x, y), vb = b.At(x, y);
+      if (std::memcmp(&va, &vb, sizeof(float)) != 0) return false;
+    }
+  }
+  return true;
+}
+
+// A scan of `beams` random ranges over 360 degrees (some no-returns, some short).
+LaserScan RandomScan(std::mt19937& rng, int beams) {
+  LaserScan scan;
+  scan.angle_min_rad = -3.14159;
+  scan.angle_increment_rad = 2 * 3.14159 / beams;
+  scan.range_min_m = 0.1;
+  scan.range_max_m = 4.0;
+  std::uniform_real_distribution<float> range(0.05f, 4.5f);
+  for (int i = 0; i < beams; ++i) scan.ranges_m.push_back(range(rng));
+  return scan;
+}
+
+// Property: after random scans (the grid grows), random walls set and erased, the followed
+// field equals a whole recompute bit for bit, everywhere and in every window; for thresholds
+// above and below 0 (below 0 the unknown cells the grid grows into are walls).
+TEST(LikelihoodFieldTest, FollowEqualsAWholeRecomputeBitForBit) {
+  for (const float threshold : {0.0f, 0.5f, -0.2f}) {
+    std::mt19937 rng(7);
+    OccupancyGridOptions grid_options;
+    grid_options.resolution_m = 0.05;
+    grid_options.grow_margin_m = 0.3;
+    OccupancyGrid grid(grid_options);
+    LikelihoodFieldOptions options;
+    options.sigma_m = 0.06;
+    options.occupied_threshold = threshold;
+    LikelihoodField followed(options);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Pose2 pose;
+    for (int round = 0; round < 40; ++round) {
+      // A random walk, so the grid grows now and then, to every side.
+      pose = Pose2(pose.x() + 0.6 * u(rng), pose.y() + 0.6 * u(rng), 3.0 * u(rng));
+      grid.InsertScan(RandomScan(rng, 90), pose);
+      // Walls appear and go by hand too, some at the grid's edge.
+      std::uniform_int_distribution<int> cx(0, grid.width() - 1), cy(0, grid.height() - 1);
+      for (int k = 0; k < 30; ++k) {
+        const Eigen::Array2i cell =
+            k % 10 == 0 ? Eigen::Array2i(0, cy(rng)) : Eigen::Array2i(cx(rng), cy(rng));
+        grid.Set(cell, static_cast<float>(2.0 * u(rng)));
+      }
+      if (round % 3 == 0) continue;  // several changes between two Follow calls
+      followed.Follow(grid);
+      LikelihoodField whole(options);
+      whole.Update(grid, WholeGrid(grid));
+      ASSERT_TRUE(SameBits(followed.view(), whole.view())) << threshold << " round " << round;
+      for (int w = 0; w < 5; ++w) {
+        const Eigen::Vector2d a = grid.CellCenter({cx(rng), cy(rng)});
+        const Eigen::Vector2d b = a + Eigen::Vector2d(3.0 * u(rng), 3.0 * u(rng));
+        Eigen::AlignedBox2d region(a.cwiseMin(b), a.cwiseMax(b));
+        LikelihoodField window(options);
+        window.Update(grid, region);
+        ASSERT_TRUE(SameBits(followed.view(region), window.view())) << threshold << " " << round;
+      }
+    }
+  }
+}
+
+// The flips the field follows: each recorded once per change, re-based when the grid grows.
+TEST(LikelihoodFieldTest, GridRecordsWallFlipsOnItsCurrentLattice) {
+  OccupancyGridOptions grid_options;
+  grid_options.resolution_m = 0.1;
+  grid_options.grow_margin_m = 0.0;
+  OccupancyGrid grid(grid_options, Eigen::Vector2d(0, 0), 10, 10);
+  grid.Set({3, 4}, 1.0f);  // before recording: not recorded
+  grid.RecordWallFlips(0.0f);
+  grid.Set({3, 4}, 2.0f);   // still a wall: no flip
+  grid.Set({5, 5}, 1.0f);   // a wall appears
+  grid.Set({3, 4}, -1.0f);  // a wall goes
+  grid.EnsureContains(
+      Eigen::AlignedBox2d(Eigen::Vector2d(-0.55, -0.25), Eigen::Vector2d(0.5, 0.5)));
+  const Eigen::Array2i shift = grid.WorldToCell({0.05, 0.05});
+  ASSERT_TRUE((shift > 0).all());
+  const std::vector<Eigen::Array2i> flips = grid.TakeWallFlips();
+  ASSERT_EQ(flips.size(), 2u);
+  EXPECT_TRUE((flips[0] == Eigen::Array2i(5, 5) + shift).all());
+  EXPECT_TRUE((flips[1] == Eigen::Array2i(3, 4) + shift).all());
+  EXPECT_TRUE(grid.TakeWallFlips().empty());
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include "slam/matching/map_correlator.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -46,13 +47,13 @@ struct IndicatorOp {
 };
 
 // Adds, for every patch row r and column c < 4*K, the contribution of cell
-// values[offset + r*width + c] over all `offsets` into sums[r*4K + c].
+// values[offset + r*stride + c] over all `offsets` into sums[r*4K + c].
 template <int K, typename Op>
-void AccumulateRows(const float* values, int width, int side,
+void AccumulateRows(const float* values, int stride, int side,
                     const std::vector<std::int64_t>& offsets, const Op& op, float* sums) {
   for (int r = 0; r < side; ++r) {
     V4 acc[K] = {};
-    const float* row_base = values + static_cast<std::ptrdiff_t>(r) * width;
+    const float* row_base = values + static_cast<std::ptrdiff_t>(r) * stride;
     for (const std::int64_t offset : offsets) {
       const float* p = row_base + offset;
       for (int k = 0; k < K; ++k) acc[k] += op(Load4(p + 4 * k));
@@ -62,27 +63,62 @@ void AccumulateRows(const float* values, int width, int side,
 }
 
 template <typename Op>
-void AccumulateDispatch(int chunks, const float* values, int width, int side,
+void AccumulateDispatch(int chunks, const float* values, int stride, int side,
                         const std::vector<std::int64_t>& offsets, const Op& op, float* sums) {
   switch (chunks) {
     case 1:
-      return AccumulateRows<1>(values, width, side, offsets, op, sums);
+      return AccumulateRows<1>(values, stride, side, offsets, op, sums);
     case 2:
-      return AccumulateRows<2>(values, width, side, offsets, op, sums);
+      return AccumulateRows<2>(values, stride, side, offsets, op, sums);
     case 3:
-      return AccumulateRows<3>(values, width, side, offsets, op, sums);
+      return AccumulateRows<3>(values, stride, side, offsets, op, sums);
     case 4:
-      return AccumulateRows<4>(values, width, side, offsets, op, sums);
+      return AccumulateRows<4>(values, stride, side, offsets, op, sums);
     case 5:
-      return AccumulateRows<5>(values, width, side, offsets, op, sums);
+      return AccumulateRows<5>(values, stride, side, offsets, op, sums);
     case 6:
-      return AccumulateRows<6>(values, width, side, offsets, op, sums);
+      return AccumulateRows<6>(values, stride, side, offsets, op, sums);
     case 7:
-      return AccumulateRows<7>(values, width, side, offsets, op, sums);
+      return AccumulateRows<7>(values, stride, side, offsets, op, sums);
     case 8:
-      return AccumulateRows<8>(values, width, side, offsets, op, sums);
+      return AccumulateRows<8>(values, stride, side, offsets, op, sums);
     default:
       SLAMRIG_CHECK(false, "shift grid too wide");
+  }
+}
+
+// Sixteen byte counters in one SIMD register.
+typedef std::uint8_t V16u8 __attribute__((vector_size(16)));
+
+// Counts, for every patch row r and column c < side, the walls at mask cell offset + r*stride + c
+// over all `offsets` into sums[r*padded + c]. Counts below 2^24 are exact floats, so the sums are
+// those of adding 1.0f per wall in any order.
+template <int K>
+void CountWalls(const std::uint8_t* mask, int stride, int side, int padded,
+                const std::vector<std::int64_t>& offsets, float* sums) {
+  std::array<std::uint32_t, 16 * K> counts;
+  for (int r = 0; r < side; ++r) {
+    counts.fill(0);
+    const std::uint8_t* row_base = mask + static_cast<std::ptrdiff_t>(r) * stride;
+    // Blocks of 255 points: a byte counter holds 255.
+    for (std::size_t begin = 0; begin < offsets.size(); begin += 255) {
+      const std::size_t end = std::min(offsets.size(), begin + 255);
+      V16u8 acc[K] = {};
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::uint8_t* p = row_base + offsets[i];
+        for (int k = 0; k < K; ++k) {
+          V16u8 v;
+          std::memcpy(&v, p + 16 * k, sizeof(v));
+          acc[k] += v;
+        }
+      }
+      for (int k = 0; k < K; ++k) {
+        for (int j = 0; j < 16; ++j) counts[static_cast<std::size_t>(16 * k + j)] += acc[k][j];
+      }
+    }
+    for (int c = 0; c < side; ++c) {
+      sums[r * padded + c] = static_cast<float>(counts[static_cast<std::size_t>(c)]);
+    }
   }
 }
 
@@ -94,8 +130,9 @@ inline int FastFloor(double v) {
 
 // Scratch reused across calls on the same thread.
 struct Scratch {
-  std::vector<std::int64_t> offsets;   // patch corner offsets of points fully inside
-  std::vector<Eigen::Array2i> border;  // patch corner cells of points near or over the edge
+  std::vector<std::int64_t> offsets;       // patch corner offsets of points fully inside
+  std::vector<std::int64_t> mask_offsets;  // the same corners in an OccupiedMask
+  std::vector<Eigen::Array2i> border;      // patch corner cells of points near or over the edge
   std::vector<float> sums;
 };
 
@@ -129,12 +166,32 @@ CorrelationResult MapCorrelator::Correlate(const GridView& grid,
                                            std::span<const Eigen::Vector2d> points_base,
                                            const Pose2& world_from_base,
                                            std::vector<float>* table) const {
+  return CorrelateImpl(grid, nullptr, points_base, world_from_base, table);
+}
+
+CorrelationResult MapCorrelator::Correlate(const GridView& grid, const OccupiedMask& mask,
+                                           std::span<const Eigen::Vector2d> points_base,
+                                           const Pose2& world_from_base,
+                                           std::vector<float>* table) const {
+  SLAMRIG_CHECK(options_.value == CorrelationValue::kOccupiedIndicator &&
+                    mask.threshold() == options_.occupied_threshold,
+                "OccupiedMask need the occupied-indicator model at their threshold");
+  SLAMRIG_CHECK(mask.width() == grid.width && mask.height() == grid.height,
+                "OccupiedMask must follow the viewed grid");
+  return CorrelateImpl(grid, &mask, points_base, world_from_base, table);
+}
+
+CorrelationResult MapCorrelator::CorrelateImpl(const GridView& grid, const OccupiedMask* mask,
+                                               std::span<const Eigen::Vector2d> points_base,
+                                               const Pose2& world_from_base,
+                                               std::vector<float>* table) const {
   thread_local Scratch scratch;
   const int n = options_.xy_half_width_cells;
   const int side = options_.side();
   const int chunks = (side + 3) / 4;
   const int padded = 4 * chunks;  // columns actually read per patch row
   const double inv_res = 1.0 / grid.resolution;
+  const int stride = grid.row_stride();
   const IndicatorOp indicator{options_.occupied_threshold};
   const RawOp raw;
   if (table != nullptr)
@@ -165,6 +222,7 @@ CorrelationResult MapCorrelator::Correlate(const GridView& grid,
 
     // Points to patch-corner cells, consecutive duplicates dropped.
     scratch.offsets.clear();
+    scratch.mask_offsets.clear();
     scratch.border.clear();
     int last_x = std::numeric_limits<int>::min(), last_y = 0;
     int distinct = 0;
@@ -177,19 +235,31 @@ CorrelationResult MapCorrelator::Correlate(const GridView& grid,
       ++distinct;
       const int x0 = ix - n, y0 = iy - n;
       if (x0 >= 0 && y0 >= 0 && x0 + padded <= grid.width && y0 + side <= grid.height) {
-        scratch.offsets.push_back(static_cast<std::int64_t>(y0) * grid.width + x0);
+        if (mask != nullptr) {
+          scratch.mask_offsets.push_back(static_cast<std::int64_t>(y0) * mask->stride() + x0);
+        } else {
+          scratch.offsets.push_back(static_cast<std::int64_t>(y0) * stride + x0);
+        }
       } else {
         scratch.border.push_back({x0, y0});
       }
     }
 
     scratch.sums.assign(static_cast<std::size_t>(side * padded), 0.0f);
-    if (!scratch.offsets.empty()) {
+    if (mask != nullptr) {
+      if (side <= 16) {
+        CountWalls<1>(mask->data(), mask->stride(), side, padded, scratch.mask_offsets,
+                      scratch.sums.data());
+      } else {
+        CountWalls<2>(mask->data(), mask->stride(), side, padded, scratch.mask_offsets,
+                      scratch.sums.data());
+      }
+    } else if (!scratch.offsets.empty()) {
       if (options_.value == CorrelationValue::kOccupiedIndicator) {
-        AccumulateDispatch(chunks, grid.values, grid.width, side, scratch.offsets, indicator,
+        AccumulateDispatch(chunks, grid.values, stride, side, scratch.offsets, indicator,
                            scratch.sums.data());
       } else {
-        AccumulateDispatch(chunks, grid.values, grid.width, side, scratch.offsets, raw,
+        AccumulateDispatch(chunks, grid.values, stride, side, scratch.offsets, raw,
                            scratch.sums.data());
       }
     }

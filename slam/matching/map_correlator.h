@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "slam/matching/grid_view.h"
+#include "slam/matching/occupied_mask.h"
 #include "slam/types/pose2.h"
 
 namespace slamrig::slam {
@@ -96,7 +97,18 @@ class MapCorrelator {
                               const Pose2& world_from_base,
                               std::vector<float>* table = nullptr) const;
 
+  /// The same for the occupied-indicator model, reading the walls from `mask` (which must follow
+  /// the grid `grid` views, at occupied_threshold): the same result bit for bit, faster.
+  CorrelationResult Correlate(const GridView& grid, const OccupiedMask& mask,
+                              std::span<const Eigen::Vector2d> points_base,
+                              const Pose2& world_from_base,
+                              std::vector<float>* table = nullptr) const;
+
  private:
+  CorrelationResult CorrelateImpl(const GridView& grid, const OccupiedMask* mask,
+                                  std::span<const Eigen::Vector2d> points_base,
+                                  const Pose2& world_from_base, std::vector<float>* table) const;
+
   MapCorrelatorOptions options_;
 };
 

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <random>
 
 #include "slam/matching/likelihood_field.h"
 #include "slam/matching/scan_points.h"
@@ -230,6 +232,63 @@ TEST(MapCorrelatorTest, ValidateNamesFieldValueAndRule) {
   options.min_shift_gain = -1.0f;
   EXPECT_THAT(options.Validate(), ::testing::ElementsAre("prior_sigma_xy_m = -0.1; must be >= 0",
                                                          "min_shift_gain = -1; must be >= 0"));
+}
+
+// Property: the occupied-indicator correlation read from an OccupiedMask that follows a changing
+// grid gives the float path's result and score table bit for bit; windows of 1 to 31 cells,
+// yaw shifts, points inside, near and beyond the edges, more than 255 points.
+TEST(MapCorrelatorTest, OccupiedMaskGivesTheFloatPathsResultBitForBit) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  OccupancyGridOptions grid_options;
+  grid_options.resolution_m = 0.05;
+  grid_options.grow_margin_m = 0.2;
+  OccupancyGrid grid(grid_options);
+  OccupiedMask mask(0.0f);
+  LaserScan scan;
+  scan.angle_min_rad = -3.1;
+  scan.angle_increment_rad = 6.2 / 400;
+  scan.range_min_m = 0.1;
+  scan.range_max_m = 3.0;
+  for (int round = 0; round < 30; ++round) {
+    scan.ranges_m.clear();
+    for (int i = 0; i < 400; ++i) scan.ranges_m.push_back(static_cast<float>(1.5 + 1.4 * u(rng)));
+    const Pose2 pose(0.8 * round * u(rng) / 10.0, 0.8 * u(rng), 3.0 * u(rng));
+    grid.InsertScan(scan, pose);
+    mask.Follow(grid);
+    std::vector<Eigen::Vector2d> points;
+    for (int i = 0; i < 300 + 20 * round; ++i) points.emplace_back(2.5 * u(rng), 2.5 * u(rng));
+    MapCorrelatorOptions options;
+    options.xy_half_width_cells = round % 16;
+    options.yaw_half_steps = round % 3;
+    options.yaw_step_rad = 0.01;
+    options.prior_sigma_xy_m = round % 2 == 0 ? 0.0 : 0.1;
+    const MapCorrelator correlator(options);
+    std::vector<float> float_table, mask_table;
+    const CorrelationResult a =
+        correlator.Correlate(GridView::Of(grid), points, pose, &float_table);
+    const CorrelationResult b =
+        correlator.Correlate(GridView::Of(grid), mask, points, pose, &mask_table);
+    ASSERT_EQ(float_table.size(), mask_table.size());
+    ASSERT_EQ(std::memcmp(float_table.data(), mask_table.data(), float_table.size() * 4), 0)
+        << round;
+    EXPECT_EQ(a.score, b.score);
+    EXPECT_EQ(a.pose, b.pose);
+    EXPECT_EQ(a.points_used, b.points_used);
+    EXPECT_GT(*std::max_element(mask_table.begin(), mask_table.end()), 0.0f) << round;
+  }
+  // More than 255 points on walls for one shift: the byte counters must not wrap.
+  for (int x = 0; x < grid.width(); ++x) {
+    for (int y = 0; y < grid.height(); ++y) grid.Set({x, y}, 1.0f);
+  }
+  mask.Follow(grid);
+  std::vector<Eigen::Vector2d> points;
+  for (int i = 0; i < 700; ++i) points.emplace_back(i % 2 == 0 ? 0.3 : 0.5, 0.2);
+  const MapCorrelator correlator(MapCorrelatorOptions{});
+  const CorrelationResult a = correlator.Correlate(GridView::Of(grid), points, Pose2());
+  const CorrelationResult b = correlator.Correlate(GridView::Of(grid), mask, points, Pose2());
+  EXPECT_EQ(a.score, 700.0f);
+  EXPECT_EQ(b.score, 700.0f);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 #include "slam/types/check.h"
 #include "slam/types/validation.h"
@@ -27,13 +28,42 @@ Sample Interpolate(const GridView& g, const Eigen::Vector2d& world) {
   const double x0 = std::floor(fx), y0 = std::floor(fy);
   const int ix = static_cast<int>(x0), iy = static_cast<int>(y0);
   const double tx = fx - x0, ty = fy - y0;
-  const double v00 = g.At(ix, iy), v10 = g.At(ix + 1, iy);
-  const double v01 = g.At(ix, iy + 1), v11 = g.At(ix + 1, iy + 1);
+  double v00, v10, v01, v11;
+  if (ix >= 0 && iy >= 0 && ix + 1 < g.width && iy + 1 < g.height) {
+    // Inside: the four samples without At()'s bounds checks (the same values).
+    const int stride = g.row_stride();
+    const float* row = g.values + static_cast<std::ptrdiff_t>(iy) * stride + ix;
+    v00 = row[0];
+    v10 = row[1];
+    v01 = row[stride];
+    v11 = row[stride + 1];
+  } else {
+    v00 = g.At(ix, iy);
+    v10 = g.At(ix + 1, iy);
+    v01 = g.At(ix, iy + 1);
+    v11 = g.At(ix + 1, iy + 1);
+  }
   Sample s;
   s.value = (1 - ty) * ((1 - tx) * v00 + tx * v10) + ty * ((1 - tx) * v01 + tx * v11);
   s.gradient.x() = ((1 - ty) * (v10 - v00) + ty * (v11 - v01)) / g.resolution;
   s.gradient.y() = ((1 - tx) * (v01 - v00) + tx * (v11 - v10)) / g.resolution;
   return s;
+}
+
+// Samples the raster at every point seen from `pose` into `samples` and returns their sum (the
+// score), in point order. The points are transformed exactly as Pose2::operator* does.
+double SampleAll(const GridView& raster, std::span<const Eigen::Vector2d> points_base,
+                 const Pose2& pose, std::vector<Sample>& samples) {
+  const double c = std::cos(pose.theta()), s = std::sin(pose.theta());
+  samples.resize(points_base.size());
+  double sum = 0.0;
+  for (std::size_t i = 0; i < points_base.size(); ++i) {
+    const Eigen::Vector2d& p = points_base[i];
+    const Eigen::Vector2d world(pose.x() + c * p.x() - s * p.y(), pose.y() + s * p.x() + c * p.y());
+    samples[i] = Interpolate(raster, world);
+    sum += samples[i].value;
+  }
+  return sum;
 }
 
 double Square(double v) { return v * v; }
@@ -89,7 +119,11 @@ RefineResult ScanRefiner::Refine(const GridView& raster, float max_value,
     const Eigen::Vector3d d = offset(pose);
     return 0.5 * d.dot(info.cwiseProduct(d));
   };
-  RefineResult result{initial, Score(raster, points_base, initial), prior_cost(initial), 0};
+  // Each pose is sampled once: the samples that give a candidate's score also give the next
+  // iteration's normal equations if the candidate is taken.
+  thread_local std::vector<Sample> samples;
+  RefineResult result{initial, SampleAll(raster, points_base, initial, samples),
+                      prior_cost(initial), 0};
   if (!(max_value > 0.0f) || points_base.empty()) return result;
   const double scale = 1.0 / max_value;
   for (int it = 0; it < options_.max_iterations; ++it) {
@@ -98,8 +132,9 @@ RefineResult ScanRefiner::Refine(const GridView& raster, float max_value,
     Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
     Eigen::Vector3d b = Eigen::Vector3d::Zero();
     double residual_sum = 0.0;
-    for (const Eigen::Vector2d& p : points_base) {
-      const Sample m = Interpolate(raster, pose * p);
+    for (std::size_t i = 0; i < points_base.size(); ++i) {
+      const Eigen::Vector2d& p = points_base[i];
+      const Sample& m = samples[i];
       const double residual = 1.0 - scale * m.value;
       // d(world point)/d(theta) = R' p.
       const Eigen::Vector2d dtheta(-s * p.x() - c * p.y(), c * p.x() - s * p.y());
@@ -125,10 +160,13 @@ RefineResult ScanRefiner::Refine(const GridView& raster, float max_value,
     if (std::abs(step.z()) > options_.max_step_rad)
       step *= options_.max_step_rad / std::abs(step.z());
     const Pose2 candidate(pose.x() + step.x(), pose.y() + step.y(), pose.theta() + step.z());
-    const double score = Score(raster, points_base, candidate);
+    // The samples stay those of result.pose when the candidate is refused (the loop ends then).
+    thread_local std::vector<Sample> candidate_samples;
+    const double score = SampleAll(raster, points_base, candidate, candidate_samples);
     const double cost = prior_cost(candidate);
     ++result.iterations;
     if (!(score - cost > result.score - result.prior_cost)) break;
+    samples.swap(candidate_samples);
     result.pose = candidate;
     result.score = score;
     result.prior_cost = cost;

@@ -35,6 +35,7 @@ ParticleFilter::ParticleFilter(const ParticleFilterOptions& options)
       map_(options.map),
       correlator_(options.correlation),
       likelihood_field_(options.likelihood_field),
+      occupied_mask_(options.correlation.occupied_threshold),
       refiner_(options.refiner),
       rng_(options.seed) {
   SLAMRIG_CHECK(options_.Validate().empty(), "invalid ParticleFilterOptions");
@@ -74,18 +75,28 @@ std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& po
         reach + (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
         options_.likelihood_field.cutoff_sigmas * options_.likelihood_field.sigma_m;
     const Eigen::Vector2d m = Eigen::Vector2d::Constant(margin);
-    likelihood_field_.Update(map_,
-                             Eigen::AlignedBox2d(particles_box.min() - m, particles_box.max() + m));
-    field_view = likelihood_field_.view();
+    // Kept up to date where the map changed; the window keeps reads outside it at 0.
+    likelihood_field_.Follow(map_);
+    field_view = likelihood_field_.view(
+        Eigen::AlignedBox2d(particles_box.min() - m, particles_box.max() + m));
   }
   const GridView view = use_field ? field_view : GridView::Of(map_);
+  // The occupied indicator on the map itself reads a bit raster kept up to date where the map
+  // changed (only when the field does not follow the map: one follower per grid).
+  const OccupiedMask* walls = nullptr;
+  if (!use_field && !options_.refine &&
+      options_.correlation.value == CorrelationValue::kOccupiedIndicator) {
+    occupied_mask_.Follow(map_);
+    walls = &occupied_mask_;
+  }
   const float field_max = static_cast<float>(likelihood_field_.Score(0.0));
   std::vector<CorrelationResult> results(static_cast<std::size_t>(n));
   auto score_block = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
       CorrelationResult& r = results[static_cast<std::size_t>(i)];
       const Pose2& predicted = particles_[static_cast<std::size_t>(i)].pose;
-      r = correlator_.Correlate(view, points, predicted);
+      r = walls ? correlator_.Correlate(view, *walls, points, predicted)
+                : correlator_.Correlate(view, points, predicted);
       if (options_.refine) {
         // The refiner's prior stays on the predicted pose, not on the shift the search chose.
         const RefineResult refined =

@@ -59,6 +59,7 @@ class ParticleFilter {
   OccupancyGrid map_;
   MapCorrelator correlator_;
   LikelihoodField likelihood_field_;
+  OccupiedMask occupied_mask_;  // the map's walls for the occupied-indicator correlation
   ScanRefiner refiner_;
   RandomEngine rng_;
   std::unique_ptr<ThreadPool> pool_;
