@@ -53,6 +53,15 @@ class TiledGrid {
   }
   float LogOdds(const Eigen::Array2i& cell) const { return LogOdds(cell.x(), cell.y()); }
 
+  /// The tile of tile coordinates (tx, ty) = (ix >> kTileBits, iy >> kTileBits), null where
+  /// nothing was written; cell (ix, iy) is its value [(iy & 63) * 64 + (ix & 63)]. For readers
+  /// that visit neighbouring cells (scan matchers): one lookup, then plain indexing.
+  const Tile* FindTile(int tx, int ty) const {
+    const int col = tx - tile_x0_;
+    const int row = ty - tile_y0_;
+    if (col < 0 || row < 0 || col >= tiles_w_ || row >= tiles_h_) return nullptr;
+    return tiles_[static_cast<std::size_t>(row) * tiles_w_ + col].get();
+  }
   /// Adds `delta` to `cell` with OccupancyGrid::Update's clamping (copying its tile if shared).
   void Update(const Eigen::Array2i& cell, float delta);
 
@@ -73,12 +82,6 @@ class TiledGrid {
   static std::size_t Offset(int ix, int iy) {
     return static_cast<std::size_t>(iy & (kTileSize - 1)) * kTileSize +
            static_cast<std::size_t>(ix & (kTileSize - 1));
-  }
-  const Tile* FindTile(int tx, int ty) const {
-    const int col = tx - tile_x0_;
-    const int row = ty - tile_y0_;
-    if (col < 0 || row < 0 || col >= tiles_w_ || row >= tiles_h_) return nullptr;
-    return tiles_[static_cast<std::size_t>(row) * tiles_w_ + col].get();
   }
   /// Grows the tile table to cover the cells in [lo, hi] (inclusive).
   void EnsureCells(const Eigen::Array2i& lo, const Eigen::Array2i& hi);
