@@ -50,7 +50,8 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
   const Pose2 start =
       predicted * Pose2(sigma_xy * StandardNormal(rng), sigma_xy * StandardNormal(rng),
                         sigma_yaw * StandardNormal(rng));
-  const ClimbResult match = matcher_.Climb(particle.map, points, start);
+  const ClimbResult match =
+      matcher_.Climb(particle.map, points, start, PosePrior{predicted, sigma_xy, sigma_yaw});
   double log_eta = 0.0;
   Pose2 drawn;
   if (points.empty() || match.fit.matched < options_.matcher.min_matched_fraction *

@@ -38,7 +38,14 @@ std::vector<std::string> RbpfMatcherOptions::Validate() const {
   if (!(angular_step_rad > 0.0)) {
     errors.push_back(Rule("angular_step_rad", angular_step_rad, "must be > 0"));
   }
+  if (!(yaw_search_rad >= 0.0)) {
+    errors.push_back(Rule("yaw_search_rad", yaw_search_rad, "must be >= 0"));
+  }
+  if (!(yaw_search_step_rad > 0.0)) {
+    errors.push_back(Rule("yaw_search_step_rad", yaw_search_step_rad, "must be > 0"));
+  }
   if (refinements < 0) errors.push_back(Rule("refinements", refinements, "must be >= 0"));
+  if (!(prior_weight >= 0.0)) errors.push_back(Rule("prior_weight", prior_weight, "must be >= 0"));
   if (max_iterations < 1) errors.push_back(Rule("max_iterations", max_iterations, "must be >= 1"));
   if (!(min_matched_fraction >= 0.0 && min_matched_fraction <= 1.0)) {
     errors.push_back(Rule("min_matched_fraction", min_matched_fraction, "must be in [0, 1]"));
@@ -87,6 +94,7 @@ MatchFit RbpfMatcher::Fit(const TiledGrid& map, std::span<const MatchPoint> poin
                           const Pose2& world_from_base) const {
   constexpr int kSize = TiledGrid::kTileSize;
   const int k = options_.kernel_cells;
+  const bool free_test = options_.free_cell_test;
   const double c = std::cos(world_from_base.theta());
   const double s = std::sin(world_from_base.theta());
   const Eigen::Vector2d t = world_from_base.translation();
@@ -106,7 +114,7 @@ MatchFit RbpfMatcher::Fit(const TiledGrid& map, std::span<const MatchPoint> poin
                                 ih;
     double best = std::numeric_limits<double>::infinity();
     auto consider = [&](int x, int y, float cell, float behind) {
-      if (!(cell > 0.0f) || behind > 0.0f) return;
+      if (!(cell > 0.0f) || (free_test && behind > 0.0f)) return;
       const double ex = hit.x() - (origin.x() + (x + 0.5) * res);
       const double ey = hit.y() - (origin.y() + (y + 0.5) * res);
       best = std::min(best, ex * ex + ey * ey);
@@ -156,9 +164,33 @@ MatchFit RbpfMatcher::Evaluate(const TiledGrid& map, std::span<const MatchPoint>
 }
 
 ClimbResult RbpfMatcher::Climb(const TiledGrid& map, std::span<const MatchPoint> points,
-                               const Pose2& initial) const {
+                               const Pose2& initial, const PosePrior& prior) const {
+  const double wx = options_.prior_weight * 0.5 / (prior.sigma_xy_m * prior.sigma_xy_m);
+  const double wt = options_.prior_weight * 0.5 / (prior.sigma_yaw_rad * prior.sigma_yaw_rad);
+  auto objective = [&](const Pose2& pose, const MatchFit& fit) {
+    const double dx = pose.x() - prior.mean.x();
+    const double dy = pose.y() - prior.mean.y();
+    const double dt = NormalizeAngle(pose.theta() - prior.mean.theta());
+    return fit.score - wx * (dx * dx + dy * dy) - wt * dt * dt;
+  };
   ClimbResult best{initial, Fit<false>(map, points, initial), 1};
+  double best_value = objective(best.pose, best.fit);
   int evaluations = 1;
+  if (options_.yaw_search_rad > 0.0) {
+    const int steps = static_cast<int>(options_.yaw_search_rad / options_.yaw_search_step_rad);
+    for (int i = -steps; i <= steps; ++i) {
+      if (i == 0) continue;
+      const Pose2 pose(initial.x(), initial.y(),
+                       initial.theta() + i * options_.yaw_search_step_rad);
+      const MatchFit fit = Fit<false>(map, points, pose);
+      ++evaluations;
+      const double value = objective(pose, fit);
+      if (value > best_value) {
+        best = {pose, fit, 0};
+        best_value = value;
+      }
+    }
+  }
   double linear = options_.linear_step_m;
   double angular = options_.angular_step_rad;
   int refinements = 0;
@@ -172,13 +204,19 @@ ClimbResult RbpfMatcher::Climb(const TiledGrid& map, std::span<const MatchPoint>
         Pose2(best.pose.x(), best.pose.y(), best.pose.theta() + angular),
         Pose2(best.pose.x(), best.pose.y(), best.pose.theta() - angular)};
     ClimbResult next = best;
+    double next_value = best_value;
     for (const Pose2& move : moves) {
       const MatchFit fit = Fit<false>(map, points, move);
       ++evaluations;
-      if (fit.score > next.fit.score) next = {move, fit};
+      const double value = objective(move, fit);
+      if (value > next_value) {
+        next = {move, fit, 0};
+        next_value = value;
+      }
     }
-    if (next.fit.score > best.fit.score) {
-      best = {next.pose, next.fit, evaluations};
+    if (next_value > best_value) {
+      best = next;
+      best_value = next_value;
       continue;
     }
     if (++refinements > options_.refinements) break;

@@ -53,7 +53,7 @@ TEST(RbpfMatcherTest, ClimbRecoversRandomOffsetsWithinReach) {
   for (int trial = 0; trial < 20; ++trial) {
     const Pose2 start(truth.x() + 0.06 * u(rng), truth.y() + 0.06 * u(rng),
                       truth.theta() + 0.03 * u(rng));
-    const ClimbResult r = matcher.Climb(map, points, start);
+    const ClimbResult r = matcher.Climb(map, points, start, PosePrior{start, 1.0, 1.0});
     EXPECT_NEAR(r.pose.x(), truth.x(), 0.025) << trial;
     EXPECT_NEAR(r.pose.y(), truth.y(), 0.025) << trial;
     EXPECT_NEAR(r.pose.theta(), truth.theta(), 0.015) << trial;
