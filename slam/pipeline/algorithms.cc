@@ -7,6 +7,7 @@
 #include "slam/pipeline/graph_slam_estimator.h"
 #include "slam/pipeline/icp_odometry_estimator.h"
 #include "slam/pipeline/particle_filter_estimator.h"
+#include "slam/pipeline/rbpf_estimator.h"
 
 namespace slamrig::slam {
 
@@ -58,6 +59,15 @@ const std::vector<Algorithm>& Algorithms() {
          return std::make_unique<
              AlgorithmOptionsFor<GraphSlamEstimatorOptions, GraphSlamEstimator>>(
              GraphSlamEstimatorOptions{});
+       }},
+      {"rbpf",
+       "Rao-Blackwellised particle filter with per-particle copy-on-write maps (GMapping's "
+       "scan-matched proposal, selective resampling); revises its past",
+       {"default"},
+       {"mean_neff", "resamples", "updates", "failed_matches", "map_tiles",
+        "map_tiles_per_particle"},
+       [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
+         return std::make_unique<AlgorithmOptionsFor<RbpfOptions, RbpfEstimator>>(RbpfOptions{});
        }},
   };
   return algorithms;

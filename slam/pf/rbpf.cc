@@ -1,0 +1,228 @@
+// Rao-Blackwellised particle filter SLAM after Grisetti, Stachniss, Burgard, "Improved Techniques
+// for Grid Mapping with Rao-Blackwellized Particle Filters", IEEE T-RO 23(1), 2007:
+//  - proposal: scan-match each particle against its own map from the odometry prediction
+//    (Table I, step "scan-matching"); sample K poses around the match, x_j, and weigh each by
+//    p(z | m, x_j) p(x_j | x_{t-1}, u) (Eqs. 15-16); their weighted mean and covariance define the
+//    Gaussian the new pose is drawn from (Eq. 17);
+//  - weight: multiplied by the normaliser eta, the sum of those weights (Eq. 18); a failed match
+//    samples the odometry model and weighs by the likelihood alone;
+//  - selective resampling when Neff < N/2 (Sec. V); the maps are copy-on-write TiledGrids.
+#include "slam/pf/rbpf.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "slam/pf/particle_filter.h"
+#include "slam/types/check.h"
+
+namespace slamrig::slam {
+
+RbpfPoseNode::~RbpfPoseNode() {
+  std::shared_ptr<RbpfPoseNode> next = std::move(parent);
+  while (next && next.use_count() == 1) next = std::move(next->parent);
+}
+
+Rbpf::Rbpf(const RbpfOptions& options)
+    : options_(options), matcher_(options.matcher), rng_(options.seed) {
+  SLAMRIG_CHECK(options_.Validate().empty(), "invalid RbpfOptions");
+  if (options_.num_threads > 1) pool_ = std::make_unique<ThreadPool>(options_.num_threads);
+}
+
+void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
+                          const std::vector<MatchPoint>& points, const LaserScan& scan,
+                          std::uint64_t seed, bool* failed) const {
+  RandomEngine rng(seed);
+  const Pose2 predicted = particle.pose * motion;
+  const RbpfMotionNoise& noise = options_.motion;
+  const double trans = motion.translation().norm();
+  const double rot = std::abs(motion.theta());
+  const double sigma_xy = noise.xy_per_m * trans + noise.xy_per_rad * rot + noise.min_xy_m;
+  const double sigma_yaw = noise.yaw_per_m * trans + noise.yaw_per_rad * rot + noise.min_yaw_rad;
+  const double scale = options_.observation_scale;
+
+  // The climb starts from a draw of the motion model, not from the prediction itself (as the
+  // gmapping code does): the matcher sees only a few cells around each point, so the spread of
+  // starting points is what lets some particles reach the right match after a large odometry
+  // error. The motion prior below stays centred on the prediction.
+  const Pose2 start =
+      predicted * Pose2(sigma_xy * StandardNormal(rng), sigma_xy * StandardNormal(rng),
+                        sigma_yaw * StandardNormal(rng));
+  const ClimbResult match =
+      matcher_.Climb(particle.map, points, start, PosePrior{predicted, sigma_xy, sigma_yaw});
+  double log_eta = 0.0;
+  Pose2 drawn;
+  if (points.empty() || match.fit.matched < options_.matcher.min_matched_fraction *
+                                                static_cast<double>(points.size())) {
+    // No usable match: the odometry model is the proposal, the likelihood the weight.
+    *failed = true;
+    drawn = start;
+    log_eta = scale * matcher_.Evaluate(particle.map, points, drawn).log_likelihood;
+  } else {
+    // K = 27 poses on a grid around the match, weighted by likelihood times motion prior.
+    constexpr int kSamples = 27;
+    std::array<Eigen::Vector3d, kSamples> offsets;
+    std::array<double, kSamples> log_q;
+    int j = 0;
+    for (int iy = -1; iy <= 1; ++iy) {
+      for (int ix = -1; ix <= 1; ++ix) {
+        for (int it = -1; it <= 1; ++it, ++j) {
+          offsets[j] =
+              Eigen::Vector3d(ix * options_.proposal_xy_step_m, iy * options_.proposal_xy_step_m,
+                              it * options_.proposal_yaw_step_rad);
+          const Pose2 x(match.pose.x() + offsets[j].x(), match.pose.y() + offsets[j].y(),
+                        match.pose.theta() + offsets[j].z());
+          const Pose2 e = predicted.Between(x);
+          const double log_prior = -0.5 * ((e.x() * e.x() + e.y() * e.y()) / (sigma_xy * sigma_xy) +
+                                           e.theta() * e.theta() / (sigma_yaw * sigma_yaw));
+          log_q[j] = scale * matcher_.Evaluate(particle.map, points, x).log_likelihood + log_prior;
+        }
+      }
+    }
+    const double max_log_q = *std::max_element(log_q.begin(), log_q.end());
+    double sum = 0.0;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    std::array<double, kSamples> w;
+    for (int k = 0; k < kSamples; ++k) {
+      w[k] = std::exp(log_q[k] - max_log_q);
+      sum += w[k];
+      mean += w[k] * offsets[k];
+    }
+    mean /= sum;
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (int k = 0; k < kSamples; ++k) {
+      const Eigen::Vector3d d = offsets[k] - mean;
+      covariance += (w[k] / sum) * d * d.transpose();
+    }
+    // The mean of the sample weights (not their sum) keeps eta on the scale of a failed match's
+    // single likelihood.
+    log_eta = max_log_q + std::log(sum / kSamples);
+    covariance.diagonal().array() += 1e-12;
+    const Eigen::Matrix3d l = covariance.llt().matrixL();
+    const Eigen::Vector3d z(StandardNormal(rng), StandardNormal(rng), StandardNormal(rng));
+    const Eigen::Vector3d d = mean + l * z;
+    drawn = Pose2(match.pose.x() + d.x(), match.pose.y() + d.y(), match.pose.theta() + d.z());
+  }
+  particle.pose = drawn;
+  particle.log_weight += log_eta;
+  particle.path_log_likelihood += log_eta;
+  particle.map.InsertScan(scan, drawn);
+  particle.history = std::make_shared<RbpfPoseNode>(drawn, std::move(particle.history));
+}
+
+void Rbpf::Resample(const std::vector<double>& weights) {
+  const std::vector<int> keep = slam::Resample(weights, options_.resampling, rng_);
+  std::vector<RbpfParticle> resampled;
+  resampled.reserve(particles_.size());
+  // A copy shares the map's tiles and the trajectory's nodes with its source.
+  for (const int k : keep) resampled.push_back(particles_[static_cast<std::size_t>(k)]);
+  for (RbpfParticle& p : resampled) p.log_weight = 0.0;
+  particles_ = std::move(resampled);
+  ++resample_count_;
+}
+
+RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
+  RbpfStep step;
+  if (!started_) {
+    // Every particle starts at the identity with the first scan's map, all tiles shared.
+    started_ = true;
+    RbpfParticle first{Pose2(), 0.0, 0.0, TiledGrid(options_.map),
+                       std::make_shared<RbpfPoseNode>(Pose2(), nullptr)};
+    first.map.InsertScan(scan, Pose2());
+    particles_.assign(static_cast<std::size_t>(options_.num_particles), first);
+    update_count_ = 1;
+    step.neff = options_.num_particles;
+    step.updated = true;
+    last_step_ = step;
+    return step;
+  }
+  pending_motion_ = pending_motion_ * odometry_increment;
+  if (pending_motion_.translation().norm() < options_.min_update_distance_m &&
+      std::abs(pending_motion_.theta()) < options_.min_update_angle_rad) {
+    step = last_step_;
+    step.best_pose = last_step_.best_pose * pending_motion_;
+    step.mean_pose = last_step_.mean_pose * pending_motion_;
+    step.resampled = false;
+    step.updated = false;
+    step.failed_matches = 0;
+    return step;
+  }
+  const Pose2 motion = pending_motion_;
+  pending_motion_ = Pose2();
+  step.updated = true;
+  ++update_count_;
+
+  // One seed per particle, drawn in order: the noise does not depend on the thread count.
+  const int n = options_.num_particles;
+  std::vector<std::uint64_t> seeds(static_cast<std::size_t>(n));
+  for (std::uint64_t& s : seeds) s = rng_();
+  const std::vector<MatchPoint> points =
+      MakeMatchPoints(scan, options_.points, options_.map.resolution_m);
+  std::vector<char> failed(static_cast<std::size_t>(n), 0);
+  auto update_block = [&](int begin, int end) {
+    for (int i = begin; i < end; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      bool f = false;
+      UpdateParticle(particles_[k], motion, points, scan, seeds[k], &f);
+      failed[k] = f;
+    }
+  };
+  if (pool_) {
+    pool_->ParallelFor(n, update_block);
+  } else {
+    update_block(0, n);
+  }
+  step.failed_matches = static_cast<int>(std::count(failed.begin(), failed.end(), 1));
+
+  std::vector<double> log_weights(particles_.size());
+  for (std::size_t i = 0; i < particles_.size(); ++i) log_weights[i] = particles_[i].log_weight;
+  const std::vector<double> weights = SoftmaxWeights(log_weights);
+  std::vector<Particle> cloud(particles_.size());
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    // Normalised logs keep the weights bounded; the ratios are unchanged.
+    particles_[i].log_weight =
+        weights[i] > 0.0 ? std::log(weights[i]) : -std::numeric_limits<double>::infinity();
+    cloud[i] = Particle{particles_[i].pose, weights[i]};
+  }
+  step.mean_pose = WeightedMeanPose(cloud);
+  step.neff = EffectiveSampleSize(weights);
+  if (step.neff < options_.resample_neff_ratio * n) {
+    Resample(weights);
+    step.resampled = true;
+  }
+  best_ = 0;
+  for (std::size_t i = 1; i < particles_.size(); ++i) {
+    if (particles_[i].path_log_likelihood > particles_[best_].path_log_likelihood) best_ = i;
+  }
+  step.best_pose = particles_[best_].pose;
+  step.matched_fraction =
+      points.empty()
+          ? 0.0
+          : static_cast<double>(
+                matcher_.Evaluate(particles_[best_].map, points, step.best_pose).matched) /
+                static_cast<double>(points.size());
+  last_step_ = step;
+  return step;
+}
+
+std::vector<Pose2> Rbpf::BestUpdatePoses() const {
+  std::vector<Pose2> poses;
+  if (particles_.empty()) return poses;
+  poses.reserve(static_cast<std::size_t>(update_count_));
+  for (const RbpfPoseNode* node = best().history.get(); node; node = node->parent.get()) {
+    poses.push_back(node->pose);
+  }
+  std::reverse(poses.begin(), poses.end());
+  return poses;
+}
+
+int Rbpf::DistinctTiles() const {
+  std::vector<const TiledGrid::Tile*> tiles;
+  for (const RbpfParticle& p : particles_) p.map.CollectTiles(&tiles);
+  std::sort(tiles.begin(), tiles.end());
+  return static_cast<int>(std::unique(tiles.begin(), tiles.end()) - tiles.begin());
+}
+
+}  // namespace slamrig::slam

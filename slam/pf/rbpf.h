@@ -1,0 +1,99 @@
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "slam/grid/tiled_grid.h"
+#include "slam/odometry/gaussian.h"
+#include "slam/pf/rbpf_matcher.h"
+#include "slam/pf/rbpf_options.h"
+#include "slam/pf/thread_pool.h"
+#include "slam/types/pose2.h"
+#include "slam/types/records.h"
+
+namespace slamrig::slam {
+
+/// One pose of a particle's trajectory. Particles that share a past share its nodes: resampling
+/// copies a pointer, not a trajectory.
+struct RbpfPoseNode {
+  RbpfPoseNode(const Pose2& p, std::shared_ptr<RbpfPoseNode> before)
+      : pose(p), parent(std::move(before)) {}
+  /// Releases the chain only this node keeps alive iteratively (a recursive release of a long
+  /// chain would exhaust the stack).
+  ~RbpfPoseNode();
+  RbpfPoseNode(const RbpfPoseNode&) = delete;
+  RbpfPoseNode& operator=(const RbpfPoseNode&) = delete;
+
+  Pose2 pose;
+  std::shared_ptr<RbpfPoseNode> parent;  ///< the pose at the previous update; null at the first
+};
+
+/// One hypothesis of the robot's path with its own map.
+struct RbpfParticle {
+  Pose2 pose;
+  double log_weight = 0.0;  ///< since the last resampling (normalised: max 0 after each step)
+  /// Sum of the log proposal normalisers along the particle's whole ancestry: ranks paths.
+  double path_log_likelihood = 0.0;
+  TiledGrid map;
+  std::shared_ptr<RbpfPoseNode> history;  ///< the pose at every update, newest first
+};
+
+/// What one AddScan did.
+struct RbpfStep {
+  Pose2 best_pose;  ///< the pose of the particle with the most likely path
+  Pose2 mean_pose;  ///< weighted mean (circular in yaw)
+  double neff = 0.0;
+  bool resampled = false;
+  bool updated = false;           ///< false: the robot moved too little, poses follow the odometry
+  int failed_matches = 0;         ///< particles whose scan match failed (odometry proposal)
+  double matched_fraction = 0.0;  ///< of the best particle's scan points, at its new pose
+};
+
+/// A Rao-Blackwellised particle filter with per-particle maps, GMapping's method (Grisetti,
+/// Stachniss, Burgard, "Improved Techniques for Grid Mapping with Rao-Blackwellized Particle
+/// Filters", IEEE T-RO 23(1), 2007, Table I): each particle's scan is matched against its own map
+/// from the odometry prediction; K poses around the match, weighted by observation likelihood
+/// times motion prior, give a Gaussian (Eqs. 15-17) from which the new pose is drawn, and their
+/// sum, the normaliser eta (Eq. 18), multiplies the weight; a failed match falls back on the
+/// odometry model. Resampling only when Neff < N/2 (Sec. V). The maps are TiledGrids, so that a
+/// resampled particle copies a tile table. Deterministic for a seed, whatever `num_threads` is.
+class Rbpf {
+ public:
+  explicit Rbpf(const RbpfOptions& options);
+
+  /// Processes one scan; `odometry_increment` is the robot-frame motion since the previous scan
+  /// (ignored for the first, which starts every map at the identity pose).
+  RbpfStep AddScan(const LaserScan& scan, const Pose2& odometry_increment);
+
+  const std::vector<RbpfParticle>& particles() const { return particles_; }
+  /// The particle with the most likely path.
+  const RbpfParticle& best() const { return particles_[best_]; }
+  /// The best particle's pose at every update, oldest first.
+  std::vector<Pose2> BestUpdatePoses() const;
+  /// Distinct map tiles over all particles (the memory the maps hold, in tiles).
+  int DistinctTiles() const;
+  int resample_count() const { return resample_count_; }
+  int update_count() const { return update_count_; }
+  const RbpfOptions& options() const { return options_; }
+
+ private:
+  /// Moves particle `i` by `motion`, draws its pose from the proposal, updates its map.
+  void UpdateParticle(RbpfParticle& particle, const Pose2& motion,
+                      const std::vector<MatchPoint>& points, const LaserScan& scan,
+                      std::uint64_t seed, bool* failed) const;
+  void Resample(const std::vector<double>& weights);
+
+  RbpfOptions options_;
+  RbpfMatcher matcher_;
+  RandomEngine rng_;
+  std::unique_ptr<ThreadPool> pool_;
+  std::vector<RbpfParticle> particles_;
+  std::size_t best_ = 0;
+  bool started_ = false;
+  Pose2 pending_motion_;
+  RbpfStep last_step_;
+  int resample_count_ = 0;
+  int update_count_ = 0;
+};
+
+}  // namespace slamrig::slam

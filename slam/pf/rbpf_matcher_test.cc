@@ -1,0 +1,99 @@
+#include "slam/pf/rbpf_matcher.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace slamrig::slam {
+namespace {
+
+// A room 6 m x 4 m seen from inside: a scan of its walls and a TiledGrid built from it.
+LaserScan RoomScan(const Pose2& world_from_base) {
+  LaserScan scan;
+  scan.angle_min_rad = -3.1;
+  scan.angle_increment_rad = 6.2 / 360;
+  scan.range_min_m = 0.1;
+  scan.range_max_m = 20.0;
+  for (int i = 0; i < 360; ++i) {
+    const double a = world_from_base.theta() + scan.angle_min_rad + i * scan.angle_increment_rad;
+    const Eigen::Vector2d d(std::cos(a), std::sin(a));
+    const Eigen::Vector2d o = world_from_base.translation();
+    // Walls x = -3, x = 3, y = -2, y = 2.
+    double r = 1e9;
+    if (d.x() > 1e-9) r = std::min(r, (3.0 - o.x()) / d.x());
+    if (d.x() < -1e-9) r = std::min(r, (-3.0 - o.x()) / d.x());
+    if (d.y() > 1e-9) r = std::min(r, (2.0 - o.y()) / d.y());
+    if (d.y() < -1e-9) r = std::min(r, (-2.0 - o.y()) / d.y());
+    scan.ranges_m.push_back(static_cast<float>(r));
+  }
+  return scan;
+}
+
+TEST(RbpfMatcherTest, ClimbRecoversRandomOffsetsWithinReach) {
+  OccupancyGridOptions map_options;
+  TiledGrid map(map_options);
+  const Pose2 truth(0.3, -0.2, 0.1);
+  // The map from a few nearby poses, as a filter would build it.
+  for (const Pose2& p : {Pose2(0, 0, 0), Pose2(0.5, 0.3, 0.4), Pose2(-0.6, -0.4, -0.3)}) {
+    map.InsertScan(RoomScan(p), p);
+  }
+  const LaserScan scan = RoomScan(truth);
+  const std::vector<MatchPoint> points =
+      MakeMatchPoints(scan, ScanPointsOptions{0.1, 30.0, 1, 0.0}, map_options.resolution_m);
+  ASSERT_GT(points.size(), 300u);
+  const RbpfMatcher matcher(RbpfMatcherOptions{});
+  // Grazing beams find their wall's cells behind them along the beam (the free-cell test rejects
+  // those), so not every point matches even at the truth; far off, few do.
+  const int matched = matcher.Evaluate(map, points, truth).matched;
+  EXPECT_GT(matched, static_cast<int>(points.size()) / 2);
+  EXPECT_LT(matcher.Evaluate(map, points, Pose2(0.5, 0.0, 0.1)).matched, matched / 4);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Pose2 start(truth.x() + 0.06 * u(rng), truth.y() + 0.06 * u(rng),
+                      truth.theta() + 0.03 * u(rng));
+    const ClimbResult r = matcher.Climb(map, points, start, PosePrior{start, 1.0, 1.0});
+    EXPECT_NEAR(r.pose.x(), truth.x(), 0.025) << trial;
+    EXPECT_NEAR(r.pose.y(), truth.y(), 0.025) << trial;
+    EXPECT_NEAR(r.pose.theta(), truth.theta(), 0.015) << trial;
+    EXPECT_GE(r.fit.score, matcher.Evaluate(map, points, start).score);
+  }
+}
+
+// A wall cell counts only when its counterpart one cell back along the beam is not occupied: a
+// point reaching a two-cell-thick wall from behind matches the back cell, not the front one.
+TEST(RbpfMatcherTest, MatchesWallsOnlyFromTheSideTheBeamCameFrom) {
+  OccupancyGridOptions map_options;  // 0.05 m cells
+  TiledGrid map(map_options);
+  for (int iy = -10; iy <= 10; ++iy) {
+    map.Update({40, iy}, 2.0f);  // x in [2.00, 2.05)
+    map.Update({41, iy}, 2.0f);  // x in [2.05, 2.10)
+    map.Update({39, iy}, -2.0f);
+  }
+  const RbpfMatcherOptions options;
+  const RbpfMatcher matcher(options);
+  const Eigen::Vector2d hit(2.02, 0.026);
+  // From the front (free point in cell 39): the nearest cell, 40, at 5 mm.
+  const std::vector<MatchPoint> front = {{hit, {1.97, 0.026}}};
+  const MatchFit f = matcher.Evaluate(map, front, Pose2());
+  EXPECT_EQ(f.matched, 1);
+  EXPECT_NEAR(f.score, std::exp(-0.5 * (0.005 * 0.005 + 0.001 * 0.001) / (0.05 * 0.05)), 0.01);
+  // From behind (free point in cell 41, occupied): cell 40 is rejected, cell 41 is 55 mm away.
+  const std::vector<MatchPoint> back = {{hit, {2.07, 0.026}}};
+  const MatchFit b = matcher.Evaluate(map, back, Pose2());
+  EXPECT_EQ(b.matched, 1);
+  EXPECT_NEAR(b.score, std::exp(-0.5 * (0.055 * 0.055 + 0.001 * 0.001) / (0.05 * 0.05)), 0.01);
+  EXPECT_NEAR(b.log_likelihood,
+              std::max(-0.5 * (0.055 * 0.055 + 0.001 * 0.001) / (0.05 * 0.05),
+                       options.no_match_log_likelihood),
+              1e-9);
+  // No wall within the kernel: no match, no_match_log_likelihood.
+  const std::vector<MatchPoint> far = {{{5.0, 0.0}, {4.95, 0.0}}};
+  const MatchFit none = matcher.Evaluate(map, far, Pose2());
+  EXPECT_EQ(none.matched, 0);
+  EXPECT_DOUBLE_EQ(none.log_likelihood, options.no_match_log_likelihood);
+}
+
+}  // namespace
+}  // namespace slamrig::slam

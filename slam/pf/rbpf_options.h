@@ -1,0 +1,94 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "slam/grid/occupancy_grid.h"
+#include "slam/matching/scan_points.h"
+#include "slam/pf/rbpf_matcher.h"
+#include "slam/pf/resampling.h"
+
+namespace slamrig::slam {
+
+/// Standard deviations of the odometry motion model, per unit of the increment (GMapping's
+/// srr, srt, str, stt): in the robot frame, sigma_xy = xy_per_m |trans| + xy_per_rad |rot| +
+/// min_xy_m, sigma_yaw = yaw_per_m |trans| + yaw_per_rad |rot| + min_yaw_rad.
+struct RbpfMotionNoise {
+  double xy_per_m = 0.1;       ///< m of position spread per m travelled
+  double xy_per_rad = 0.2;     ///< m of position spread per rad turned
+  double yaw_per_m = 0.1;      ///< rad of heading spread per m travelled
+  double yaw_per_rad = 0.2;    ///< rad of heading spread per rad turned
+  double min_xy_m = 0.01;      ///< floor on sigma_xy
+  double min_yaw_rad = 0.005;  ///< floor on sigma_yaw
+
+  /// One message per broken rule (prefixed "motion.").
+  std::vector<std::string> Validate() const;
+};
+
+/// The field table of RbpfMotionNoise (slam/config/fields.h).
+template <typename V>
+void VisitFields(V& v, RbpfMotionNoise& o) {
+  v("xy_per_m", o.xy_per_m);
+  v("xy_per_rad", o.xy_per_rad);
+  v("yaw_per_m", o.yaw_per_m);
+  v("yaw_per_rad", o.yaw_per_rad);
+  v("min_xy_m", o.min_xy_m);
+  v("min_yaw_rad", o.min_yaw_rad);
+}
+
+/// Everything the Rao-Blackwellised particle filter (slam/pf/rbpf.h) can be told.
+struct RbpfOptions {
+  int num_particles = 30;
+  std::uint64_t seed = 1;  ///< seeds one stream per particle and step, and the resampling
+
+  ScanPointsOptions points{0.1, 30.0, 1, 0.05};  ///< beams used for matching (voxel-filtered)
+  RbpfMatcherOptions matcher;
+  RbpfMotionNoise motion;
+  /// The proposal's sample points: a 3 x 3 x 3 grid of these steps around the match (GMapping's
+  /// llsamplestep, lasamplestep), weighted by likelihood times motion prior.
+  double proposal_xy_step_m = 0.01;
+  double proposal_yaw_step_rad = 0.005;
+  /// p(z | m, x) = exp(observation_scale * log-likelihood): below 1 the beams count as
+  /// correlated (GMapping flattens its weights in the same way).
+  double observation_scale = 0.2;
+
+  ResamplingScheme resampling = ResamplingScheme::kSystematic;
+  /// Resample when Neff < resample_neff_ratio * num_particles (selective resampling).
+  double resample_neff_ratio = 0.5;
+
+  OccupancyGridOptions map;  ///< every particle's map
+
+  /// Filter only after the robot moved this far or turned this much since the last update; in
+  /// between, poses follow the odometry and the maps are left alone.
+  double min_update_distance_m = 0.25;
+  double min_update_angle_rad = 0.1;
+
+  int num_threads = 1;  ///< worker threads for the per-particle work (results do not depend on it)
+
+  /// One message per broken rule, e.g. "particles = 0; must be > 0".
+  std::vector<std::string> Validate() const;
+};
+
+/// The field table of RbpfOptions: the keys of `slam: {NAME: {algorithm: rbpf, ...}}` and of
+/// `--set`. `seed` is not a field: it derives from the run's seed.
+template <typename V>
+void VisitFields(V& v, RbpfOptions& o) {
+  v("particles", o.num_particles);
+  v.Struct("points", o.points);
+  v.Struct("matcher", o.matcher);
+  v.Struct("motion", o.motion);
+  v("proposal_xy_step_m", o.proposal_xy_step_m);
+  v("proposal_yaw_step_rad", o.proposal_yaw_step_rad);
+  v("observation_scale", o.observation_scale);
+  v.Enum("resampling", o.resampling,
+         {{ResamplingScheme::kSystematic, "systematic"},
+          {ResamplingScheme::kStratified, "stratified"}});
+  v("resample_neff_ratio", o.resample_neff_ratio);
+  v.Struct("map", o.map);
+  v("min_update_distance_m", o.min_update_distance_m);
+  v("min_update_angle_rad", o.min_update_angle_rad);
+  v("threads", o.num_threads);
+}
+
+}  // namespace slamrig::slam

@@ -1,0 +1,173 @@
+#include "slam/pf/rbpf.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "slam/odometry/scan_sync.h"
+#include "slam/pf/testing/synthetic_run.h"
+
+namespace slamrig::slam {
+namespace {
+
+// One leg and a corner of the office loop at 10 Hz, with miscalibrated wheels.
+struct ShortRun {
+  testing::SyntheticRun run;
+  std::vector<SyncedScan> scans;
+};
+
+const ShortRun& GetShortRun() {
+  static const ShortRun* run = [] {
+    auto* r = new ShortRun;
+    testing::SyntheticRunOptions options;
+    options.waypoints = testing::OfficeLoop();
+    options.max_duration_s = 36.0;
+    options.scan_rate_hz = 10.0;
+    options.lidar.num_beams = 271;
+    options.lidar.angle_increment_rad = 1.0 * 3.14159265358979 / 180.0;
+    options.right_scale_error = 0.03;
+    options.left_scale_error = -0.03;
+    options.gyro_bias_rad_s = 0.01;
+    r->run = testing::MakeSyntheticRun(testing::SegmentWorld::Office(), options);
+    r->scans = SyncToScans(r->run.records, ScanSyncOptions{}).scans;
+    return r;
+  }();
+  return *run;
+}
+
+// Position RMSE against the truth, the estimate anchored at the first true pose.
+double PositionRmse(const std::vector<Pose2>& estimate, const std::vector<GroundTruthPose>& truth) {
+  const Pose2 anchor = truth.front().map_from_base;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < estimate.size(); ++i) {
+    sum +=
+        ((anchor * estimate[i]).translation() - truth[i].map_from_base.translation()).squaredNorm();
+  }
+  return std::sqrt(sum / static_cast<double>(estimate.size()));
+}
+
+RbpfOptions FastOptions() {
+  RbpfOptions options;
+  options.num_particles = 20;
+  options.seed = 5;
+  return options;
+}
+
+struct RbpfRun {
+  std::vector<Pose2> online;
+  std::vector<Pose2> updates;  // the best particle's path at the end
+  int resamples = 0;
+};
+
+RbpfRun RunFilter(const std::vector<SyncedScan>& scans, const RbpfOptions& options) {
+  Rbpf filter(options);
+  RbpfRun run;
+  for (const SyncedScan& s : scans)
+    run.online.push_back(filter.AddScan(s.scan, s.increment).best_pose);
+  run.updates = filter.BestUpdatePoses();
+  run.resamples = filter.resample_count();
+  return run;
+}
+
+TEST(RbpfTest, BeatsDeadReckoningOnASyntheticOfficeRun) {
+  const ShortRun& run = GetShortRun();
+  const double dr = PositionRmse(DeadReckoningPoses(run.scans), run.run.truth);
+  const RbpfRun rbpf = RunFilter(run.scans, FastOptions());
+  const double rmse = PositionRmse(rbpf.online, run.run.truth);
+  RecordProperty("dead_reckoning_rmse_m", std::to_string(dr));
+  RecordProperty("rbpf_rmse_m", std::to_string(rmse));
+  EXPECT_GT(dr, 0.3);
+  EXPECT_LT(rmse, 0.1) << "dead reckoning " << dr;
+  EXPECT_LT(rmse, 0.3 * dr);
+  EXPECT_GT(rbpf.resamples, 0);
+}
+
+TEST(RbpfTest, SameSeedSameTrajectoryWhateverTheThreadCount) {
+  const ShortRun& run = GetShortRun();
+  const std::vector<SyncedScan> scans(run.scans.begin(), run.scans.begin() + 80);
+  RbpfOptions options = FastOptions();
+  const RbpfRun a = RunFilter(scans, options);
+  options.num_threads = 3;
+  const RbpfRun b = RunFilter(scans, options);
+  ASSERT_EQ(a.online.size(), scans.size());
+  EXPECT_EQ(a.online, b.online);
+  EXPECT_EQ(a.updates, b.updates);
+  options.seed = 6;
+  const RbpfRun c = RunFilter(scans, options);
+  EXPECT_NE(a.online.back(), c.online.back());
+}
+
+// The path is one node per update, shared between particles with a common past, and the best
+// particle's path ends at the pose the filter reports.
+TEST(RbpfTest, ParticlesShareTheirPastAndTheirMapTiles) {
+  const ShortRun& run = GetShortRun();
+  RbpfOptions options = FastOptions();
+  Rbpf filter(options);
+  RbpfStep step;
+  for (std::size_t i = 0; i < 120; ++i)
+    step = filter.AddScan(run.scans[i].scan, run.scans[i].increment);
+  const std::vector<Pose2> path = filter.BestUpdatePoses();
+  ASSERT_EQ(static_cast<int>(path.size()), filter.update_count());
+  EXPECT_EQ(path.front(), Pose2());
+  if (step.updated) {
+    EXPECT_EQ(path.back(), step.best_pose);
+  }
+  ASSERT_GT(filter.resample_count(), 0);
+
+  // Every path reaches back to the one root; after resampling, paths share their older nodes.
+  const RbpfPoseNode* root = nullptr;
+  int shared_with_best = 0;
+  for (const RbpfParticle& p : filter.particles()) {
+    const RbpfPoseNode* node = p.history.get();
+    while (node->parent) node = node->parent.get();
+    if (!root) root = node;
+    EXPECT_EQ(node, root);
+    // Particles whose parent node is the best's parent share everything before the last update.
+    shared_with_best += p.history->parent == filter.best().history->parent;
+  }
+  EXPECT_GT(shared_with_best, 0);
+
+  // The maps share tiles: fewer distinct tiles than particles times tiles per map.
+  const int per_map = filter.best().map.num_tiles();
+  ASSERT_GT(per_map, 10);
+  EXPECT_LT(filter.DistinctTiles(), options.num_particles * per_map * 3 / 4);
+  EXPECT_GE(filter.DistinctTiles(), per_map);
+  int shared = 0;
+  for (const RbpfParticle& p : filter.particles()) shared += p.map.SharedTiles(filter.best().map);
+  EXPECT_GT(shared, per_map);  // some tile of the best map is held by another particle too
+}
+
+TEST(RbpfTest, FiltersOnlyAfterEnoughMotion) {
+  const ShortRun& run = GetShortRun();
+  RbpfOptions options = FastOptions();
+  options.min_update_distance_m = 0.25;
+  options.min_update_angle_rad = 10.0;
+  Rbpf filter(options);
+  filter.AddScan(run.scans[0].scan, Pose2());
+  const RbpfStep a = filter.AddScan(run.scans[1].scan, Pose2(0.1, 0.0, 0.05));
+  const RbpfStep b = filter.AddScan(run.scans[2].scan, Pose2(0.1, 0.0, 0.0));
+  EXPECT_FALSE(a.updated);
+  EXPECT_FALSE(b.updated);
+  EXPECT_EQ(filter.update_count(), 1);
+  const Pose2 expected = Pose2(0.1, 0.0, 0.05) * Pose2(0.1, 0.0, 0.0);
+  EXPECT_NEAR(b.best_pose.x(), expected.x(), 1e-12);
+  EXPECT_NEAR(b.best_pose.y(), expected.y(), 1e-12);
+  const RbpfStep c = filter.AddScan(run.scans[3].scan, Pose2(0.1, 0.0, 0.0));
+  EXPECT_TRUE(c.updated);
+  EXPECT_EQ(filter.update_count(), 2);
+}
+
+TEST(RbpfTest, ValidateNamesFieldValueAndRule) {
+  RbpfOptions options;
+  options.num_particles = 0;
+  options.matcher.kernel_cells = -1;
+  options.motion.min_xy_m = 0.0;
+  EXPECT_THAT(options.Validate(), ::testing::ElementsAre("particles = 0; must be > 0",
+                                                         "matcher.kernel_cells = -1; must be >= 0",
+                                                         "motion.min_xy_m = 0; must be > 0"));
+  EXPECT_TRUE(RbpfOptions{}.Validate().empty());
+}
+
+}  // namespace
+}  // namespace slamrig::slam

@@ -1,0 +1,78 @@
+#include "slam/pipeline/rbpf_estimator.h"
+
+#include <cmath>
+#include <limits>
+
+#include "slam/types/check.h"
+
+namespace slamrig::slam {
+
+RbpfOptions RbpfEstimator::Seeded(RbpfOptions options, std::uint64_t seed) {
+  options.seed = seed;
+  return options;
+}
+
+RbpfEstimator::RbpfEstimator(const RbpfOptions& options, const EstimatorContext& context)
+    : filter_(Seeded(options, context.seed)), map_(options.map) {}
+
+ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
+  const RbpfStep step = filter_.AddScan(scan.scan, scan.increment);
+  offset_ = step.updated ? Pose2() : offset_ * scan.increment;
+  scan_offsets_.emplace_back(filter_.update_count() - 1, offset_);
+  neff_sum_ += step.neff;
+  updates_ += step.updated;
+  failed_matches_ += step.failed_matches;
+  return {step.best_pose,
+          step.mean_pose,
+          {{"neff", step.neff}, {"matched_fraction", step.matched_fraction}},
+          std::nullopt};
+}
+
+std::optional<std::vector<Pose2>> RbpfEstimator::RevisedPoses() const {
+  const std::vector<Pose2> updates = filter_.BestUpdatePoses();
+  std::vector<Pose2> poses;
+  poses.reserve(scan_offsets_.size());
+  for (const auto& [update, offset] : scan_offsets_) {
+    SLAMRIG_CHECK(update >= 0 && static_cast<std::size_t>(update) < updates.size(),
+                  "rbpf: a scan follows an update the best path does not hold");
+    poses.push_back(updates[static_cast<std::size_t>(update)] * offset);
+  }
+  return poses;
+}
+
+const OccupancyGrid& RbpfEstimator::map() const {
+  if (map_version_ != filter_.update_count() && !filter_.particles().empty()) {
+    map_ = filter_.best().map.ToOccupancyGrid();
+    map_version_ = filter_.update_count();
+  }
+  return map_;
+}
+
+std::map<std::string, double> RbpfEstimator::Statistics() const {
+  const int scans = static_cast<int>(scan_offsets_.size());
+  const int tiles = filter_.particles().empty() ? 0 : filter_.DistinctTiles();
+  return {{"mean_neff", scans > 0 ? neff_sum_ / scans : 0.0},
+          {"resamples", filter_.resample_count()},
+          {"updates", updates_},
+          {"failed_matches", failed_matches_},
+          {"map_tiles", tiles},
+          {"map_tiles_per_particle",
+           filter_.particles().empty()
+               ? 0.0
+               : static_cast<double>(tiles) / static_cast<double>(filter_.particles().size())}};
+}
+
+EstimatorView RbpfEstimator::View() const {
+  EstimatorView view;
+  const std::vector<RbpfParticle>& particles = filter_.particles();
+  if (particles.empty()) return view;
+  double max_log = -std::numeric_limits<double>::infinity();
+  for (const RbpfParticle& p : particles) max_log = std::max(max_log, p.log_weight);
+  double total = 0.0;
+  for (const RbpfParticle& p : particles) total += std::exp(p.log_weight - max_log);
+  for (const RbpfParticle& p : particles)
+    view.particles.push_back({p.pose, std::exp(p.log_weight - max_log) / total});
+  return view;
+}
+
+}  // namespace slamrig::slam

@@ -1,0 +1,45 @@
+#pragma once
+
+#include <utility>
+#include <vector>
+
+#include "slam/pf/rbpf.h"
+#include "slam/pf/rbpf_options.h"
+#include "slam/pipeline/algorithm.h"
+#include "slam/pipeline/estimator.h"
+
+namespace slamrig::slam {
+
+/// The Rao-Blackwellised particle filter (slam/pf/rbpf.h) behind the Estimator interface: the
+/// online pose is the particle with the most likely path, its map the map, and its whole path
+/// the revised trajectory (an RBPF revises its past when resampling drops other paths).
+class RbpfEstimator final : public Estimator {
+ public:
+  /// `context.seed` replaces `options.seed`.
+  RbpfEstimator(const RbpfOptions& options, const EstimatorContext& context);
+
+  ScanEstimate AddScan(const SyncedScan& scan) override;
+  std::optional<std::vector<Pose2>> RevisedPoses() const override;
+  /// The best particle's map, converted when asked for after it changed.
+  const OccupancyGrid& map() const override;
+  /// mean_neff, resamples, updates, failed_matches (particle matches that fell back on the
+  /// odometry), map_tiles (distinct tiles over all particles at the end) and
+  /// map_tiles_per_particle.
+  std::map<std::string, double> Statistics() const override;
+  EstimatorView View() const override;
+
+ private:
+  static RbpfOptions Seeded(RbpfOptions options, std::uint64_t seed);
+
+  Rbpf filter_;
+  // Per scan: the update it follows and the odometry since that update.
+  std::vector<std::pair<int, Pose2>> scan_offsets_;
+  Pose2 offset_;
+  double neff_sum_ = 0.0;
+  int updates_ = 0;
+  int failed_matches_ = 0;
+  mutable OccupancyGrid map_;
+  mutable int map_version_ = -1;  // update count the map was converted at
+};
+
+}  // namespace slamrig::slam
