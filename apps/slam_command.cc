@@ -25,7 +25,6 @@
 #include "slam/io/map_server.h"
 #include "slam/io/tum_io.h"
 #include "slam/odometry/scan_sync.h"
-#include "slam/odometry/wheel_odometry.h"
 #include "slam/pipeline/estimator_runner.h"
 #include "slam/types/error.h"
 
@@ -52,26 +51,6 @@ const char* SourceName(slam::OdometrySource s) {
       break;
   }
   return "auto";
-}
-
-// Dead reckoning straight from the encoders (and gyro), one pose per encoder record: for logs
-// without a lidar, such as the shared ECE276A data.
-Trajectory EncoderDeadReckoning(const std::vector<Record>& records,
-                                const slam::ScanSyncOptions& sync) {
-  slam::WheelOdometryOptions options;
-  options.robot = sync.robot;
-  options.use_gyro = sync.use_gyro;
-  slam::WheelOdometry odometry(options);
-  Trajectory trajectory;
-  for (const Record& r : records) {
-    if (const auto* imu = std::get_if<ImuSample>(&r)) odometry.AddImu(*imu);
-    if (const auto* ticks = std::get_if<WheelTicks>(&r)) {
-      const OdometryPose p = odometry.AddTicks(*ticks);
-      if (trajectory.empty() || trajectory.poses().back().time <= p.time)
-        trajectory.Append(p.time, p.odom_from_base);
-    }
-  }
-  return trajectory;
 }
 
 // Progress on stderr, at most every two seconds, for logs that take a while.
@@ -245,8 +224,8 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   bool encoder_only = false;
   if (!has_scans) {
     // Logs without a lidar (the shared ECE276A data): the trajectory an estimator reports at its
-    // records' rate (the EKF from encoders and gyro), or for dead reckoning the encoders' (and
-    // gyro's) own, one pose per encoder record.
+    // records' rate (dead reckoning and the EKF, from encoders and gyro, one pose per encoder
+    // record).
     const slam::OdometrySource source =
         slam::ResolveOdometrySource(data.records, config.odometry.source);
     slam::EstimatorRunner runner(config, source, seed);
@@ -256,8 +235,6 @@ int RunSlamCommand(const std::vector<std::string>& args) {
     if (!run.record_rate.empty()) {
       run.final = run.online = run.record_rate;
       run.covariances = run.record_rate_covariances;
-    } else if (config.algorithm == "dead-reckoning") {
-      run.final = run.online = EncoderDeadReckoning(data.records, config.odometry);
     } else {
       throw ParseError(path + ": no laser scans; " + config.algorithm +
                        " needs them (dead-reckoning and ekf run on encoder records alone)");

@@ -25,6 +25,7 @@
 #include "scenarios/plot.h"
 #include "scenarios/scenario_spec.h"
 #include "scenarios/slurm_sweep.h"
+#include "slam/fusion/consistency.h"
 #include "slam/io/atomic_file.h"
 #include "slam/types/error.h"
 #include "slam/types/interrupt.h"
@@ -650,6 +651,78 @@ int WriteSweepSummary(const SweepSpec& spec, const std::string& out_dir) {
       html += "<h2>" + options.title + "</h2><img src=\"" + file + "\">";
       ++plots;
     }
+  }
+  // Consistency: the final pose's NEES is independent across seeds, so its mean over a grid
+  // point's seeds is an ANEES with a chi-square acceptance region (Bar-Shalom et al. 2001,
+  // Sec. 5.4.2). A time-averaged NEES (mean_nees) is not: its samples are correlated in time.
+  const std::string nees_suffix = "final_nees";
+  for (std::size_t m = first_metric; m + 1 < header.size(); ++m) {
+    const std::string& name = header[m];
+    if (name.size() < nees_suffix.size() ||
+        name.compare(name.size() - nees_suffix.size(), nees_suffix.size(), nees_suffix) != 0) {
+      continue;
+    }
+    // One group per grid point (the swept values), in results.csv order.
+    std::vector<std::string> labels;
+    std::map<std::string, std::vector<double>> samples;
+    for (const auto& row : rows) {
+      if (row.size() != header.size()) continue;
+      std::string label;
+      for (std::size_t q = 0; q < num_params; ++q)
+        label += (label.empty() ? "" : ", ") + spec.parameters[q].key + "=" + row[1 + q];
+      if (label.empty()) label = "all runs";
+      const double v = number(row[m]);
+      if (!std::isfinite(v)) continue;
+      if (!samples.count(label)) labels.push_back(label);
+      samples[label].push_back(v);
+    }
+    if (labels.empty()) continue;
+    html +=
+        "<h2>ANEES of " + name +
+        " (pose, 3 dof) with the two-sided 95 % chi-square region</h2><table><tr><th>grid "
+        "point</th><th>runs</th><th>ANEES</th><th>lower</th><th>upper</th><th>verdict</th></tr>";
+    PlotSeries anees, lower, upper;
+    anees.label = "ANEES";
+    anees.colour = PaletteColour(0);
+    anees.markers = true;
+    lower.label = "95 % lower";
+    upper.label = "95 % upper";
+    lower.colour = upper.colour = PaletteColour(1);
+    lower.dashed = upper.dashed = true;
+    for (std::size_t g = 0; g < labels.size(); ++g) {
+      const std::vector<double>& v = samples[labels[g]];
+      double sum = 0.0;
+      for (const double x : v) sum += x;
+      const double mean = sum / static_cast<double>(v.size());
+      const slam::NeesBounds bounds = slam::AneesBounds(3, static_cast<int>(v.size()));
+      const bool inside = mean >= bounds.lower && mean <= bounds.upper;
+      char cells[256];
+      std::snprintf(cells, sizeof(cells), "<td>%zu</td><td>%.3f</td><td>%.3f</td><td>%.3f</td>",
+                    v.size(), mean, bounds.lower, bounds.upper);
+      html += "<tr><td>" + labels[g] + "</td>" + cells + "<td>" +
+              (inside ? "inside"
+                      : (mean < bounds.lower ? "below (pessimistic)" : "above (optimistic)")) +
+              "</td></tr>";
+      // The bounds span [g - 0.4, g + 0.4] round each point, so that one point draws them too.
+      anees.x.push_back(static_cast<double>(g));
+      anees.y.push_back(mean);
+      for (const double x : {static_cast<double>(g) - 0.4, static_cast<double>(g) + 0.4}) {
+        lower.x.push_back(x);
+        upper.x.push_back(x);
+        lower.y.push_back(bounds.lower);
+        upper.y.push_back(bounds.upper);
+      }
+    }
+    html += "</table>";
+    PlotOptions options;
+    options.title = "ANEES of " + name + " per grid point";
+    options.x_label = "grid point (table order)";
+    options.y_label = "ANEES";
+    const std::string file = "summary_anees_" + name + ".png";
+    slam::WriteFileAtomically((fs::path(out_dir) / file).string(),
+                              RenderLinePlotPng({anees, lower, upper}, options));
+    html += "<img src=\"" + file + "\">";
+    ++plots;
   }
   html += "</body></html>\n";
   slam::WriteFileAtomically((fs::path(out_dir) / "summary.html").string(), html);

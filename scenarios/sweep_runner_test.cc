@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
 
 #include "slam/types/error.h"
@@ -104,6 +106,30 @@ TEST(SweepTest, RefusesResultsOfAnotherSweep) {
   std::filesystem::create_directories(f.dir.File("out"));
   f.dir.Write("out/results.csv", "run,x,seed,status,pf.ate_rmse_m,wall_time_s\n");
   EXPECT_THROW(RunSweep(f.spec, f.options), ConfigError);
+}
+
+// The summary states each grid point's ANEES of a final_nees column with the chi-square region
+// of its number of runs: here 2 runs of a.noise=1 (mean 2.5) and 1 of a.noise=2 (a NaN skipped).
+TEST(SweepTest, SummaryShowsTheAneesWithItsChiSquareBounds) {
+  testing::TempDir dir;
+  dir.Write("scenario.yaml", "name: x\n");
+  const SweepSpec spec =
+      LoadSweepSpec(dir.Write("sweep.yaml",
+                              "scenario: scenario.yaml\nseeds: 2\nparameters:\n  a.noise: [1, 2]\n"
+                              "metrics: [ekf.final_nees]\n"));
+  std::filesystem::create_directories(dir.File("out"));
+  dir.Write("out/results.csv",
+            "run,a.noise,seed,status,ekf.final_nees,wall_time_s\n"
+            "r1,1,1,pass,2,1\nr2,1,2,pass,3,1\nr3,2,1,pass,40,1\nr4,2,2,error,,1\n");
+  EXPECT_EQ(WriteSweepSummary(spec, dir.File("out")), 2);  // the metric's plot and the ANEES's
+  std::ifstream in(dir.File("out/summary.html"));
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // chi2_6(0.025) / 2 = 1.2373 / 2, chi2_6(0.975) / 2 = 14.4494 / 2; chi2_3: 0.2158, 9.3484.
+  EXPECT_THAT(html, ::testing::HasSubstr("<td>a.noise=1</td><td>2</td><td>2.500</td><td>0.619</td>"
+                                         "<td>7.225</td><td>inside</td>"));
+  EXPECT_THAT(html, ::testing::HasSubstr("<td>a.noise=2</td><td>1</td><td>40.000</td><td>0.216</td>"
+                                         "<td>9.348</td><td>above (optimistic)</td>"));
+  EXPECT_TRUE(std::filesystem::exists(dir.File("out/summary_anees_ekf.final_nees.png")));
 }
 
 TEST(SweepTest, BadSweepFilesNameFileLineAndKey) {

@@ -9,9 +9,10 @@
 namespace slamrig::slam {
 namespace {
 
-constexpr int kN = 7;
+constexpr int kN = 8;
 constexpr int kYaw = 5;
 constexpr int kBias = 6;
+constexpr int kScale = 7;
 
 double Squared(double v) { return v * v; }
 
@@ -27,22 +28,25 @@ Eigen::MatrixXd JosephUpdate(const Eigen::MatrixXd& p, const Eigen::MatrixXd& k,
 PoseEkf::PoseEkf(const PoseEkfOptions& options) : options_(options) {
   SLAMRIG_CHECK(options.Validate().empty(), "PoseEkf: invalid options");
   p_(kBias, kBias) = Squared(options.gyro_bias_sigma_rad_s);
+  p_(kScale, kScale) = Squared(options.gyro_scale_sigma);
 }
 
 void PoseEkf::ResetPose(const Pose2& pose) {
-  const double bias_variance = p_(kBias, kBias);
+  const Eigen::Matrix2d gyro = p_.bottomRightCorner<2, 2>();
   p_.setZero();
-  p_(kBias, kBias) = bias_variance;
+  p_.bottomRightCorner<2, 2>() = gyro;
   x_.head<3>() << pose.x(), pose.y(), pose.theta();
   x_.segment<3>(3) = x_.head<3>();
 }
 
 void PoseEkf::PredictGyro(double rate_rad_s, double dt_s) {
   if (!(dt_s > 0.0)) return;
-  // yaw' = yaw + (rate - b) dt: F is the identity but for d yaw / d b = -dt.
-  x_(kYaw) = NormalizeAngle(x_(kYaw) + (rate_rad_s - x_(kBias)) * dt_s);
+  // yaw' = yaw + (rate - s rate - b) dt: F is the identity but for d yaw / d b = -dt and
+  // d yaw / d s = -rate dt.
+  x_(kYaw) = NormalizeAngle(x_(kYaw) + (rate_rad_s - x_(kScale) * rate_rad_s - x_(kBias)) * dt_s);
   Eigen::Matrix<double, kN, kN> f = Eigen::Matrix<double, kN, kN>::Identity();
   f(kYaw, kBias) = -dt_s;
+  f(kYaw, kScale) = -rate_rad_s * dt_s;
   p_ = f * p_ * f.transpose();
   p_(kYaw, kYaw) += Squared(options_.gyro_sigma_rad_s * dt_s);
   p_(kBias, kBias) += Squared(options_.gyro_bias_walk_rad_s_sqrt_s) * dt_s;
@@ -100,7 +104,8 @@ void PoseEkf::PredictIncrement(const Pose2& increment, double distance_m, double
   p_(kYaw, kYaw) += syaw * syaw;
 }
 
-EkfUpdate PoseEkf::UpdateRelativePose(const Pose2& z, const Eigen::Matrix3d& r) {
+EkfUpdate PoseEkf::UpdateRelativePose(const Pose2& z, const Eigen::Matrix3d& r,
+                                      std::optional<double> inflation_gate) {
   const Pose2 predicted = clone().Between(pose());
   const double c = std::cos(x_(2)), s = std::sin(x_(2));
   const Eigen::Vector2d d = x_.segment<2>(3) - x_.head<2>();
@@ -121,7 +126,32 @@ EkfUpdate PoseEkf::UpdateRelativePose(const Pose2& z, const Eigen::Matrix3d& r) 
   Eigen::VectorXd innovation(3);
   innovation << z.x() - predicted.x(), z.y() - predicted.y(),
       NormalizeAngle(z.theta() - predicted.theta());
-  return Update(innovation, h, r);
+  const Eigen::Matrix3d motion = h * p_ * h.transpose();  // the motion's covariance since the clone
+  const auto nis = [&](double scale) {
+    return innovation.dot((scale * motion + r).ldlt().solve(innovation));
+  };
+  double inflation = 1.0;
+  if (inflation_gate && nis(1.0) > *inflation_gate) {
+    // The motion model failed (a wheel slipped): the smallest scale of the motion's covariance
+    // that brings the NIS down to the gate (it falls monotonically with the scale), by bisection
+    // on a log scale, added as process noise on the current pose alone (Mehra 1972's
+    // innovation-based adaptation, one step at a time).
+    double lo = 1.0, hi = 1e6;
+    if (nis(hi) <= *inflation_gate) {
+      for (int i = 0; i < 40; ++i) {
+        const double mid = std::sqrt(lo * hi);
+        (nis(mid) > *inflation_gate ? lo : hi) = mid;
+      }
+    }
+    inflation = hi;
+    // The clone-frame covariance rotated into the fixed frame: the pose's own noise.
+    Eigen::Matrix3d g = Eigen::Matrix3d::Identity();
+    g.topLeftCorner<2, 2>() << c, -s, s, c;
+    p_.block<3, 3>(3, 3) += (inflation - 1.0) * g * motion * g.transpose();
+  }
+  EkfUpdate update = Update(innovation, h, r);
+  update.inflation = inflation;
+  return update;
 }
 
 EkfUpdate PoseEkf::UpdateZeroRate(double rate_rad_s) {
@@ -153,7 +183,7 @@ void PoseEkf::Clone() {
   // c' = pose: the clone rows and columns become copies of the pose's.
   Eigen::Matrix<double, kN, kN> j = Eigen::Matrix<double, kN, kN>::Zero();
   j.block<3, 3>(0, 3).setIdentity();
-  j.block<4, 4>(3, 3).setIdentity();
+  j.block<kN - 3, kN - 3>(3, 3).setIdentity();
   x_.head<3>() = x_.segment<3>(3);
   p_ = j * p_ * j.transpose();
 }

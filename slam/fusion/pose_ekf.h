@@ -23,10 +23,13 @@ Eigen::MatrixXd JosephUpdate(const Eigen::MatrixXd& p, const Eigen::MatrixXd& k,
 struct EkfUpdate {
   double nis = 0.0;   ///< normalised innovation squared, nu^T S^-1 nu
   int dimension = 0;  ///< the measurement's dimension (the NIS's chi-square degrees of freedom)
+  /// The factor the motion's covariance was scaled by before the update (1: none).
+  double inflation = 1.0;
 };
 
 /// The filter. State: the clone c = (x, y, yaw) of the pose at the last clone, the current pose
-/// (x, y, yaw) and the gyro bias b (rad/s); 7 x 7 covariance. Poses in one fixed frame.
+/// (x, y, yaw), the gyro bias b (rad/s) and the gyro's scale error s (the gyro reads
+/// (1 + s) times the rate, plus b); 8 x 8 covariance. Poses in one fixed frame.
 /// Deterministic; not thread-safe.
 class PoseEkf {
  public:
@@ -35,7 +38,7 @@ class PoseEkf {
   /// Sets the current pose and the clone to `pose` with zero pose covariance; the bias and its
   /// variance stay (the estimator's frame starts here).
   void ResetPose(const Pose2& pose);
-  /// The gyro z sample `rate_rad_s` held for `dt_s` seconds: yaw += (rate - b) dt.
+  /// The gyro z sample `rate_rad_s` held for `dt_s` seconds: yaw += (rate - s rate - b) dt.
   void PredictGyro(double rate_rad_s, double dt_s);
   /// One encoder interval: the wheels rolled `right_m` and `left_m`; `gyro_yaw_rad` is the yaw the
   /// gyro added since the previous interval (the translation follows the mean heading), or
@@ -44,8 +47,11 @@ class PoseEkf {
                      std::optional<double> gyro_yaw_rad);
   /// A robot-frame increment from odometry poses, `distance_m` travelled and `turn_rad` turned.
   void PredictIncrement(const Pose2& increment, double distance_m, double turn_rad);
-  /// Measures clone^-1 * pose = `z` with covariance `r` (x, y, yaw in the clone's frame).
-  EkfUpdate UpdateRelativePose(const Pose2& z, const Eigen::Matrix3d& r);
+  /// Measures clone^-1 * pose = `z` with covariance `r` (x, y, yaw in the clone's frame). With
+  /// `inflation_gate`, an NIS above it means the motion since the clone broke its model (wheel
+  /// slip): the motion's covariance is scaled up until the NIS meets the gate, then the update.
+  EkfUpdate UpdateRelativePose(const Pose2& z, const Eigen::Matrix3d& r,
+                               std::optional<double> inflation_gate = std::nullopt);
   /// A gyro sample taken at standstill measures the bias: b = rate.
   EkfUpdate UpdateZeroRate(double rate_rad_s);
   /// The clone becomes the current pose (the next relative measurement starts here).
@@ -54,18 +60,19 @@ class PoseEkf {
   Pose2 pose() const { return {x_(3), x_(4), x_(5)}; }
   Pose2 clone() const { return {x_(0), x_(1), x_(2)}; }
   double gyro_bias() const { return x_(6); }
+  double gyro_scale_error() const { return x_(7); }
   /// Covariance of (x, y, yaw) of pose().
   Eigen::Matrix3d PoseCovariance() const { return p_.block<3, 3>(3, 3); }
-  /// The whole 7 x 7 covariance.
-  const Eigen::Matrix<double, 7, 7>& covariance() const { return p_; }
+  /// The whole 8 x 8 covariance.
+  const Eigen::Matrix<double, 8, 8>& covariance() const { return p_; }
 
  private:
   EkfUpdate Update(const Eigen::VectorXd& innovation, const Eigen::MatrixXd& h,
                    const Eigen::MatrixXd& r);
 
   PoseEkfOptions options_;
-  Eigen::Matrix<double, 7, 1> x_ = Eigen::Matrix<double, 7, 1>::Zero();
-  Eigen::Matrix<double, 7, 7> p_ = Eigen::Matrix<double, 7, 7>::Zero();
+  Eigen::Matrix<double, 8, 1> x_ = Eigen::Matrix<double, 8, 1>::Zero();
+  Eigen::Matrix<double, 8, 8> p_ = Eigen::Matrix<double, 8, 8>::Zero();
 };
 
 }  // namespace slamrig::slam

@@ -15,6 +15,7 @@ std::vector<std::string> PoseEkfOptions::Validate() const {
       {"gyro_sigma_rad_s", gyro_sigma_rad_s},
       {"gyro_bias_sigma_rad_s", gyro_bias_sigma_rad_s},
       {"gyro_bias_walk_rad_s_sqrt_s", gyro_bias_walk_rad_s_sqrt_s},
+      {"gyro_scale_sigma", gyro_scale_sigma},
       {"increment_sigma_xy_per_m", increment_sigma_xy_per_m},
       {"increment_sigma_xy_floor_m", increment_sigma_xy_floor_m},
       {"increment_sigma_yaw_per_rad", increment_sigma_yaw_per_rad},

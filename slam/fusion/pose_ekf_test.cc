@@ -45,6 +45,33 @@ TEST(JosephUpdateTest, EqualsShortFormForOptimalGain) {
   EXPECT_LT((JosephUpdate(p, k, h, r) - short_form).norm(), 1e-12);
 }
 
+// A slip the motion model cannot explain (0.3 m on a 1 m drive whose model allows 2 %): the
+// motion's covariance is scaled until the NIS meets the gate exactly, so the match wins; an
+// innovation within the gate leaves the model alone.
+TEST(PoseEkfTest, InflatesTheMotionCovarianceUntilTheNisMeetsTheGate) {
+  for (const double slip_m : {0.3, 0.0}) {
+    PoseEkf ekf{PoseEkfOptions{}};
+    ekf.ResetPose(Pose2());
+    for (int i = 0; i < 10; ++i) ekf.PredictWheels(0.1, 0.1, 0.4, 0.0);
+    const Eigen::Matrix3d r = Eigen::Vector3d(1e-4, 1e-4, 1e-6).asDiagonal();
+    const Pose2 z(1.0 + slip_m, 0.0, 0.0);
+    const double gate = 16.27;
+    // The NIS without inflation, from the same state.
+    PoseEkf plain = ekf;
+    const EkfUpdate without = plain.UpdateRelativePose(z, r);
+    const EkfUpdate with = ekf.UpdateRelativePose(z, r, gate);
+    if (slip_m > 0.0) {
+      EXPECT_GT(without.nis, gate);
+      EXPECT_GT(with.inflation, 1.0);
+      EXPECT_NEAR(with.nis, gate, 1e-3 * gate);
+      EXPECT_NEAR(ekf.pose().x(), 1.0 + slip_m, 0.02);  // the match, not the wheels
+    } else {
+      EXPECT_EQ(with.inflation, 1.0);
+      EXPECT_EQ(with.nis, without.nis);
+    }
+  }
+}
+
 TEST(PoseEkfTest, CovarianceStaysSymmetricPositiveDefiniteThroughAManyStepRun) {
   PoseEkf ekf{PoseEkfOptions{}};
   ekf.ResetPose(Pose2());
@@ -60,7 +87,7 @@ TEST(PoseEkfTest, CovarianceStaysSymmetricPositiveDefiniteThroughAManyStepRun) {
     }
     const Eigen::MatrixXd p = ekf.covariance();
     ASSERT_EQ((p - p.transpose()).norm(), 0.0) << step;
-    ASSERT_GT(MinEigenvalue(p + 1e-15 * Eigen::MatrixXd::Identity(7, 7)), 0.0) << step;
+    ASSERT_GT(MinEigenvalue(p + 1e-15 * Eigen::MatrixXd::Identity(8, 8)), 0.0) << step;
   }
 }
 

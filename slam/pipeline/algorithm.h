@@ -17,6 +17,7 @@ namespace slamrig::slam {
 struct EstimatorContext {
   std::uint64_t seed = 1;  ///< the estimator's own random seed (a named stream of the run's)
   DiffDriveParams robot;   ///< the wheel geometry of the source (for estimators that read ticks)
+  bool use_gyro = true;    ///< odometry.use_gyro: estimators that read the IMU themselves honour it
 };
 
 /// One algorithm's options behind one interface: a plain options struct with a VisitFields

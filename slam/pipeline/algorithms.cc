@@ -36,7 +36,8 @@ const std::vector<Algorithm>& Algorithms() {
        "EKF pose fusion: encoders and gyro predict, scan-to-local-map ICP increments correct, "
        "the gyro bias estimated; a covariance with every pose",
        {"default"},
-       {"gyro_bias_rad_s", "scan_updates", "zero_rate_updates", "mean_nis"},
+       {"gyro_bias_rad_s", "gyro_scale_error", "scan_updates", "zero_rate_updates", "mean_nis",
+        "slip_inflations", "matched", "keyframes"},
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<AlgorithmOptionsFor<EkfOptions, EkfEstimator>>(EkfOptions{});
        }},

@@ -1,10 +1,12 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "slam/fusion/pose_ekf.h"
 #include "slam/grid/occupancy_grid.h"
+#include "slam/odometry/wheel_odometry.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
 
@@ -29,11 +31,16 @@ void VisitFields(V& v, DeadReckoningOptions& o) {
 
 /// Dead reckoning: the odometry increments composed from the first scan, with the map built
 /// along them, and the odometry noise propagated into a covariance with every pose (so that its
-/// NEES can be shown). The baseline every SLAM result is compared with.
+/// NEES can be shown). The baseline every SLAM result is compared with. Wheel ticks are also
+/// integrated as they arrive (WheelOdometry, with the gyro as odometry.use_gyro says), one pose
+/// per ticks record: the record-rate trajectory, all there is on a log without scans.
 class DeadReckoningEstimator final : public Estimator {
  public:
   DeadReckoningEstimator(const DeadReckoningOptions& options, const EstimatorContext& context);
 
+  void AddRecord(const Record& record) override;
+  /// The wheel odometry's pose after each ticks record (no covariance).
+  std::optional<ScanEstimate> RecordEstimate() const override;
   ScanEstimate AddScan(const SyncedScan& scan) override;
   const OccupancyGrid& map() const override { return map_; }
 
@@ -41,6 +48,8 @@ class DeadReckoningEstimator final : public Estimator {
   OccupancyGrid map_;
   PoseEkf noise_;
   bool started_ = false;
+  WheelOdometry wheels_;
+  bool last_record_was_ticks_ = false;
 };
 
 }  // namespace slamrig::slam

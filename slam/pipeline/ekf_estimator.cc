@@ -32,6 +32,7 @@ std::vector<std::string> EkfOptions::Validate() const {
     errors.push_back(
         RuleViolation("match_sigma_floor_yaw_rad", match_sigma_floor_yaw_rad, "must be >= 0"));
   }
+  if (!(slip_gate >= 0.0)) errors.push_back(RuleViolation("slip_gate", slip_gate, "must be >= 0"));
   AppendErrors(&errors, PrefixErrors("map", map.Validate()));
   return errors;
 }
@@ -39,6 +40,7 @@ std::vector<std::string> EkfOptions::Validate() const {
 EkfEstimator::EkfEstimator(const EkfOptions& options, const EstimatorContext& context)
     : options_(options),
       robot_(context.robot),
+      use_gyro_(context.use_gyro),
       ekf_(options.filter),
       icp_(IcpOdometryOptions{}),
       map_(options.map) {}
@@ -59,6 +61,8 @@ std::optional<ScanEstimate> EkfEstimator::RecordEstimate() const {
 }
 
 void EkfEstimator::AddImu(const ImuSample& imu) {
+  // odometry.use_gyro: false leaves the heading to the encoders (and the scan matches).
+  if (!use_gyro_) return;
   const double rate = imu.angular_velocity_rad_s.z();
   if (!std::isfinite(rate)) return;
   // Each sample is held from the previous one (zero-order hold).
@@ -98,51 +102,70 @@ void EkfEstimator::AddTicks(const WheelTicks& ticks) {
 }
 
 ScanEstimate EkfEstimator::AddScan(const SyncedScan& scan) {
-  const bool first = scans_ == 0;
-  ++scans_;
-  if (first) {
-    ekf_.ResetPose(Pose2());
-  } else if (!saw_ticks_) {
+  if (scans_ > 0 && !saw_ticks_) {
     const double distance = scan.increment.translation().norm();
     ekf_.PredictIncrement(scan.increment, distance, scan.increment.theta());
   }
+  return Correct(scan.scan);
+}
+
+ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
+  const bool first = scans_ == 0;
+  ++scans_;
+  if (first) ekf_.ResetPose(Pose2());
   ScanEstimate estimate;
   if (options_.scan_matching) {
-    const Pose2 prior = ekf_.clone().Between(ekf_.pose());
-    const IcpOdometryStep step = icp_.Add(scan.scan, prior);
+    const Pose2 prior = previous_pose_.Between(ekf_.pose());
+    const IcpOdometryStep step = icp_.Add(scan, prior);
     const bool usable =
         step.outcome == IcpOdometryOutcome::kMatched ||
         (options_.update_on_degenerate && step.outcome == IcpOdometryOutcome::kDegenerate);
-    if (!first && usable) {
+    if (!first && usable && (step.keyframe || !options_.keyframe_updates)) {
       // The match's covariance of the absolute pose in the ICP frame, as the covariance of the
-      // increment in the previous scan's frame (that pose held fixed), inflated and floored.
+      // increment in the previous keyframe's frame (that pose held fixed), scaled and floored.
       Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-      const double c = std::cos(icp_previous_.theta()), s = std::sin(icp_previous_.theta());
+      const double c = std::cos(icp_keyframe_.theta()), s = std::sin(icp_keyframe_.theta());
       rotation.topLeftCorner<2, 2>() << c, s, -s, c;
       Eigen::Matrix3d r =
           options_.match_covariance_scale * rotation * step.covariance * rotation.transpose();
       r(0, 0) += options_.match_sigma_floor_xy_m * options_.match_sigma_floor_xy_m;
       r(1, 1) += options_.match_sigma_floor_xy_m * options_.match_sigma_floor_xy_m;
       r(2, 2) += options_.match_sigma_floor_yaw_rad * options_.match_sigma_floor_yaw_rad;
-      const EkfUpdate update = ekf_.UpdateRelativePose(icp_previous_.Between(step.pose), r);
+      const EkfUpdate update = ekf_.UpdateRelativePose(
+          icp_keyframe_.Between(step.pose), r,
+          options_.slip_gate > 0.0 ? std::optional<double>(options_.slip_gate) : std::nullopt);
+      if (update.inflation > 1.0) ++slip_inflations_;
       nis_sum_ += update.nis;
       ++scan_updates_;
-      estimate.trace.push_back({"nis", update.nis});
+      last_nis_ = update.nis;
     }
-    icp_previous_ = step.pose;
+    if (first || step.keyframe) {
+      ++keyframes_;
+      icp_keyframe_ = step.pose;
+      ekf_.Clone();
+    }
+  } else {
+    ekf_.Clone();
   }
-  ekf_.Clone();
+  previous_pose_ = ekf_.pose();
   estimate.pose = ekf_.pose();
   estimate.covariance = ekf_.PoseCovariance();
+  // Every trace has a value at every scan (the report plots them against the scan times): the
+  // NIS is the latest update's, held between keyframes.
+  estimate.trace.push_back({"nis", last_nis_});
   estimate.trace.push_back({"gyro_bias_rad_s", ekf_.gyro_bias()});
-  map_.InsertScan(scan.scan, estimate.pose);
+  map_.InsertScan(scan, estimate.pose);
   return estimate;
 }
 
 std::map<std::string, double> EkfEstimator::Statistics() const {
   return {{"gyro_bias_rad_s", ekf_.gyro_bias()},
+          {"gyro_scale_error", ekf_.gyro_scale_error()},
           {"scan_updates", scan_updates_},
           {"zero_rate_updates", zero_rate_updates_},
+          {"slip_inflations", slip_inflations_},
+          {"matched", icp_.counts().matched},
+          {"keyframes", keyframes_},
           {"mean_nis", scan_updates_ > 0 ? nis_sum_ / scan_updates_ : 0.0}};
 }
 

@@ -17,13 +17,22 @@ namespace slamrig::slam {
 struct EkfOptions {
   PoseEkfOptions filter;      ///< motion and bias noise (its keys sit at this level)
   bool scan_matching = true;  ///< correct with scan-to-local-map ICP increments
-  /// The ICP covariance is multiplied by this (a Hessian estimate is optimistic) ...
-  double match_covariance_scale = 4.0;
-  /// ... and a floor added: standard deviations of the increment's x, y and yaw.
-  double match_sigma_floor_xy_m = 0.005;
-  double match_sigma_floor_yaw_rad = 0.002;
+  /// The ICP covariance is multiplied by this ...
+  double match_covariance_scale = 1.0;
+  /// ... and a floor added: standard deviations of the increment's x, y and yaw (what a match
+  /// between keyframes errs by beyond its Hessian estimate; set so that the mean NIS on the
+  /// office loop is near its expected 3, a check that needs no truth).
+  double match_sigma_floor_xy_m = 0.0015;
+  double match_sigma_floor_yaw_rad = 0.0005;
   /// Also update on matches IcpOdometry calls degenerate (the prior fills their weak direction).
   bool update_on_degenerate = false;
+  /// Update once per ICP keyframe (the keyframe-to-keyframe increment); false: at every matched
+  /// scan, against the last keyframe's clone (the updates then share the map's error: the
+  /// covariance comes out optimistic).
+  bool keyframe_updates = true;
+  /// A match whose NIS exceeds this (chi2_3 at 0.999) says the motion model failed (a wheel
+  /// slipped on ice): the motion's covariance is inflated until it does not. 0: never.
+  double slip_gate = 16.27;
   OccupancyGridOptions map;
 
   /// One message per broken rule ("match_covariance_scale = 0; must be > 0").
@@ -39,14 +48,20 @@ void VisitFields(V& v, EkfOptions& o) {
   v("match_sigma_floor_xy_m", o.match_sigma_floor_xy_m);
   v("match_sigma_floor_yaw_rad", o.match_sigma_floor_yaw_rad);
   v("update_on_degenerate", o.update_on_degenerate);
+  v("keyframe_updates", o.keyframe_updates);
+  v("slip_gate", o.slip_gate);
   v.Struct("map", o.map);
 }
 
 /// EKF pose fusion (PoseEkf): wheel encoders and the gyro predict as their records arrive
 /// (odometry-pose increments at the scans when the source has no encoders), gyro samples at
-/// standstill measure the gyro bias, and each scan's IcpOdometry match against the local map
-/// corrects the increment since the previous scan with the match's covariance. Reports the pose
-/// covariance with every pose, the NIS of each scan update as the trace `nis`.
+/// standstill measure the gyro bias (and turns its scale error), and IcpOdometry matches each
+/// scan against its local map. At each ICP keyframe the match's pose relative to the previous
+/// keyframe's corrects the filter's pose relative to its clone of that keyframe (stochastic
+/// cloning), with the match's covariance; a keyframe is cloned anew. Matching every scan but
+/// updating once per keyframe keeps the updates' errors nearly independent: the scans between two
+/// keyframes meet the same map, so their matches' errors are not. Reports the pose
+/// covariance with every pose, the NIS of the latest scan update as the trace `nis`.
 class EkfEstimator final : public Estimator {
  public:
   EkfEstimator(const EkfOptions& options, const EstimatorContext& context);
@@ -61,13 +76,17 @@ class EkfEstimator final : public Estimator {
  private:
   void AddImu(const ImuSample& imu);
   void AddTicks(const WheelTicks& ticks);
+  /// Matches `scan` at the filter's current pose, updates, clones; the estimate at the scan.
+  ScanEstimate Correct(const LaserScan& scan);
 
   EkfOptions options_;
   DiffDriveParams robot_;
+  bool use_gyro_ = true;
   PoseEkf ekf_;
   IcpOdometry icp_;
   OccupancyGrid map_;
-  Pose2 icp_previous_;
+  Pose2 icp_keyframe_;
+  Pose2 previous_pose_;
   int scans_ = 0;
   bool saw_ticks_ = false;
   bool last_record_was_ticks_ = false;
@@ -77,7 +96,10 @@ class EkfEstimator final : public Estimator {
   double gyro_yaw_since_ticks_ = 0.0;
   int scan_updates_ = 0;
   int zero_rate_updates_ = 0;
+  int slip_inflations_ = 0;
+  int keyframes_ = 0;
   double nis_sum_ = 0.0;
+  double last_nis_ = 0.0;
 };
 
 }  // namespace slamrig::slam

@@ -109,6 +109,7 @@ std::unique_ptr<Estimator> MakeEstimator(const EstimatorConfig& config, std::uin
   EstimatorContext context;
   context.seed = RandomStream(run_seed, "slam." + config.name).NextU64();
   context.robot = config.odometry.robot;
+  context.use_gyro = config.odometry.use_gyro;
   return config.options->MakeEstimator(context);
 }
 
