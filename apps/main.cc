@@ -8,6 +8,9 @@
 
 #include "apps/commands.h"
 #include "slam/types/error.h"
+#ifdef SLAMRIG_HAS_PYTHON
+#include "python/embed.h"
+#endif
 
 namespace slamrig::app {
 
@@ -49,6 +52,9 @@ void PrintHelp() {
 }
 
 int Main(int argc, char** argv) {
+#ifdef SLAMRIG_HAS_PYTHON
+  python::EnableEmbeddedPython();
+#endif
   const std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) {
     PrintHelp();

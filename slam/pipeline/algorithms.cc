@@ -7,6 +7,7 @@
 #include "slam/pipeline/graph_slam_estimator.h"
 #include "slam/pipeline/icp_odometry_estimator.h"
 #include "slam/pipeline/particle_filter_estimator.h"
+#include "slam/pipeline/python_estimator.h"
 
 namespace slamrig::slam {
 
@@ -57,6 +58,14 @@ const std::vector<Algorithm>& Algorithms() {
          return std::make_unique<
              AlgorithmOptionsFor<GraphSlamEstimatorOptions, GraphSlamEstimator>>(
              GraphSlamEstimatorOptions{});
+       }},
+      {"python",
+       "an estimator written in Python: `module:` and `class:` (found beside the scenario, then "
+       "on PYTHONPATH), every other key passed to the class as a keyword",
+       {"default"},
+       {},
+       [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
+         return std::make_unique<PythonAlgorithmOptions>();
        }},
   };
   return algorithms;
