@@ -32,6 +32,7 @@
 #include "slam/pipeline/estimator_runner.h"
 #include "slam/pipeline/python_estimator.h"
 #include "slam/types/error.h"
+#include "slam/types/random_stream.h"
 
 namespace slamrig::python {
 namespace {
@@ -554,6 +555,14 @@ void DefineCore(py::module_& m, bool embedded) {
         return slam::ResolveOdometrySource(d.records, wanted);
       },
       py::arg("dataset"), py::arg("wanted") = slam::OdometrySource::kAuto);
+  m.def(
+      "estimator_seed",
+      [](std::uint64_t run_seed, const std::string& name) {
+        return RandomStream(run_seed, "slam." + name).NextU64();
+      },
+      py::arg("run_seed"), py::arg("name"),
+      "The seed a configuration `name` gets in a run seeded `run_seed` (the stream "
+      "slam.<name>): what a Python estimator's `seed` keyword receives.");
   m.def("algorithm_names", [] {
     std::vector<std::string> names;
     for (const auto& a : slam::Algorithms()) names.push_back(a.name);
