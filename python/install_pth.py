@@ -1,6 +1,6 @@
 """Makes `import slamrig` work from any folder: writes slamrig.pth (the build's python/ folder)
 into the site-packages of this interpreter and of `python3` on PATH when that is another
-interpreter of the same Python version, plus debian-numpy.pth (/usr/lib/python3/dist-packages)
+interpreter of the same Python version (and of /usr/bin/python3 likewise), plus debian-numpy.pth (/usr/lib/python3/dist-packages)
 where numpy is missing and Debian's is built for the same version."""
 
 import os
@@ -46,17 +46,21 @@ def version(python):
 def main():
     package_dir = os.path.abspath(sys.argv[1])
     install(sys.executable, package_dir)
-    on_path = shutil.which("python3")
-    if on_path:
-        real = subprocess.run([on_path, "-c", "import sys; print(sys.executable)"],
+    done = {os.path.realpath(sys.executable)}
+    for other in (shutil.which("python3"), "/usr/bin/python3"):
+        if not other or not os.access(other, os.X_OK):
+            continue
+        real = subprocess.run([other, "-c", "import sys; print(sys.executable)"],
                               capture_output=True, text=True).stdout.strip()
-        if real and os.path.realpath(real) != os.path.realpath(sys.executable):
-            if version(on_path) == str(sys.version_info[:2]):
-                install(on_path, package_dir)
-            else:
-                print("%s is Python %s; the module is built for %s (configure with "
-                      "-DPython3_EXECUTABLE=%s to build for it)"
-                      % (on_path, version(on_path), sys.version_info[:2], on_path))
+        if not real or os.path.realpath(real) in done:
+            continue
+        done.add(os.path.realpath(real))
+        if version(other) == str(sys.version_info[:2]):
+            install(other, package_dir)
+        else:
+            print("%s is Python %s; the module is built for %s (configure with "
+                  "-DPython3_EXECUTABLE=%s to build for it)"
+                  % (other, version(other), sys.version_info[:2], other))
     # The module must import where it was installed, from a neutral folder.
     subprocess.run([sys.executable, "-c", "import slamrig"], check=True, cwd="/")
 
