@@ -18,7 +18,7 @@ def _cli():
     if not cli:
         from slamrig import _paths
         cli = _paths.CLI
-    return cli
+    return os.path.abspath(cli)
 
 
 @pytest.fixture(scope="session")
