@@ -12,6 +12,9 @@
 #include "apps/commands.h"
 #include "slam/types/error.h"
 #include "slam/types/interrupt.h"
+#ifdef SLAMRIG_HAS_PYTHON
+#include "python/embed.h"
+#endif
 
 namespace slamrig::app {
 
@@ -65,6 +68,9 @@ void PrintHelp() {
 
 int Main(int argc, char** argv) {
   InstallInterruptHandlers();
+#ifdef SLAMRIG_HAS_PYTHON
+  python::EnableEmbeddedPython();
+#endif
   const std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) {
     PrintHelp();

@@ -7,6 +7,7 @@
 
 #include "slam/grid/occupancy_grid.h"
 #include "slam/io/carmen_reader.h"
+#include "slam/io/log_reader.h"
 
 namespace slamrig {
 namespace {
@@ -32,6 +33,17 @@ void BM_MapIntelScans(benchmark::State& state) {
   state.counters["scans"] = static_cast<double>(log.scans.size());
 }
 BENCHMARK(BM_MapIntelScans)->Unit(benchmark::kMillisecond);
+
+// Parsing the gzip log into records and reference, as `slamrig slam` and `slamrig run` read
+// any log (ReadLog): the command line's side of bench/python_timing.py's read figure.
+void BM_ReadLogIntel(benchmark::State& state) {
+  const std::string path = IntelPath();
+  for (auto _ : state) {
+    const slam::Dataset data = slam::ReadLog(path);
+    benchmark::DoNotOptimize(data.records.data());
+  }
+}
+BENCHMARK(BM_ReadLogIntel)->Unit(benchmark::kMillisecond);
 
 // Parsing the gzip log plus mapping: what `slamrig map` spends before writing files.
 void BM_ReadAndMapIntel(benchmark::State& state) {

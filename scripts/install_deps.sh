@@ -12,6 +12,7 @@ packages=(
   libegl-dev libegl-mesa0 libgl1-mesa-dri
   slurm-wlm munge
   procps
+  pybind11-dev python3-dev python3-numpy python3-pytest
 )
 
 missing=()

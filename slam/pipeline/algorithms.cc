@@ -8,6 +8,7 @@
 #include "slam/pipeline/icp_odometry_estimator.h"
 #include "slam/pipeline/particle_filter_estimator.h"
 #include "slam/pipeline/rbpf_estimator.h"
+#include "slam/pipeline/python_estimator.h"
 
 namespace slamrig::slam {
 
@@ -69,6 +70,14 @@ const std::vector<Algorithm>& Algorithms() {
         "map_tiles_per_particle"},
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<AlgorithmOptionsFor<RbpfOptions, RbpfEstimator>>(RbpfOptions{});
+       }},
+      {"python",
+       "an estimator written in Python: `module:` and `class:` (found beside the scenario, then "
+       "on PYTHONPATH), every other key passed to the class as a keyword",
+       {"default"},
+       {},
+       [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
+         return std::make_unique<PythonAlgorithmOptions>();
        }},
   };
   return algorithms;
