@@ -68,7 +68,6 @@ ParticleFilterOptions ParticleFilterOptions::ReportsPreset() {
   o.min_update_distance_m = 0.0;
   o.min_update_angle_rad = 0.0;
   o.degeneracy_ratio = 0.0;
-  o.relocalisation.enabled = false;
   return o;
 }
 

@@ -172,6 +172,7 @@ TEST(ParticleFilterTest, FindsItselfLostAfterAKidnappingAndRelocalises) {
   ParticleFilterOptions options = FastOptions();
   // In this world of long bare walls a displaced scan still scores ~0.7 of its usual quality
   // (in the simulated office it drops to ~0.35): a stricter ratio than the default's 0.5.
+  options.relocalisation.enabled = true;
   options.relocalisation.lost_ratio = 0.7;
   ParticleFilter filter(options);
   for (std::size_t i = 0; i < jump_at; ++i)
