@@ -5,7 +5,12 @@
 //    alpha_k <- alpha_k exp(corr_k) / sum (Wang, Eq. 7; Zafari, step 5), or the likelihood field;
 //  - map update from the best particle with log-odds +log 4 / free decrement / clamps (Wang, Eq.
 //  17);
-//  - resampling when Neff = 1 / sum alpha^2 < 0.5 N (Zafari, Eq. 6), stratified or systematic.
+//  - resampling when Neff = 1 / sum alpha^2 < 0.5 N (Zafari, Eq. 6), stratified or systematic;
+//  - degeneracy: solution remapping along the directions the scan's geometry leaves open (Zhang,
+//    Kaess, Singh, ICRA 2016, Eq. 11);
+//  - lost-filter detection from short- and long-term averages of the match quality (augmented
+//    MCL, Probabilistic Robotics, Table 8.3) and relocalisation by a global branch-and-bound
+//    match on the map built so far (Hess et al., ICRA 2016, Sec. V).
 #include "slam/pf/particle_filter.h"
 
 #include <algorithm>
@@ -13,9 +18,15 @@
 #include <limits>
 
 #include "slam/matching/scan_points.h"
+#include "slam/odometry/gaussian.h"
+#include "slam/pf/solution_remapping.h"
 #include "slam/types/check.h"
 
 namespace slamrig::slam {
+namespace {
+// Surface normals from the scan points within this distance along the scan.
+constexpr double kNeighbourM = 0.3;
+}  // namespace
 
 Pose2 WeightedMeanPose(const std::vector<Particle>& particles) {
   double x = 0.0, y = 0.0, c = 0.0, s = 0.0, total = 0.0;
@@ -61,7 +72,7 @@ void ParticleFilter::Predict(const Pose2& odometry_increment) {
 }
 
 std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& points,
-                                          float* best_score) {
+                                          const MatchConstraints& constraints, float* best_score) {
   const int n = options_.num_particles;
   const bool use_field = options_.observation == ObservationModel::kLikelihoodField;
   GridView field_view;
@@ -91,6 +102,9 @@ std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& po
   }
   const float field_max = static_cast<float>(likelihood_field_.Score(0.0));
   std::vector<CorrelationResult> results(static_cast<std::size_t>(n));
+  const double ratio = options_.degeneracy_ratio;
+  const bool weak = ratio > 0.0 && constraints.WeakCount(ratio) > 0;
+  const Pose2 cloud_mean = WeightedMeanPose(particles_);
   auto score_block = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
       CorrelationResult& r = results[static_cast<std::size_t>(i)];
@@ -103,6 +117,17 @@ std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& po
             refiner_.Refine(field_view, field_max, points, r.pose, predicted);
         r.pose = refined.pose;
         if (use_field) r.score = static_cast<float>(refined.score);
+      }
+      // Degeneracy: along the directions the scan does not constrain the particle keeps its
+      // prediction, and its weight is the score with those coordinates replaced by the cloud's
+      // mean, so that it cannot depend on them: a map built from behind scores poses that lag
+      // higher, and resampling on that would drag the cloud back along a corridor.
+      if (weak) {
+        r.pose = RemapAlongWeakDirections(predicted, r.pose, constraints, ratio);
+        if (use_field) {
+          const Pose2 weighed = RemapAlongWeakDirections(cloud_mean, r.pose, constraints, ratio);
+          r.score = static_cast<float>(ScanRefiner::Score(field_view, points, weighed));
+        }
       }
     }
   };
@@ -119,6 +144,127 @@ std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& po
     if (options_.move_to_best_shift) particles_[i].pose = results[i].pose;
   }
   return scores;
+}
+
+double ParticleFilter::Quality(float score, std::size_t num_points) const {
+  const double field_max = likelihood_field_.Score(0.0);
+  if (num_points == 0 || !(field_max > 0.0)) return 0.0;
+  return std::clamp(static_cast<double>(score) / (field_max * static_cast<double>(num_points)), 0.0,
+                    1.0);
+}
+
+bool ParticleFilter::TrackQuality(double quality, Time now) {
+  const RelocalisationOptions& o = options_.relocalisation;
+  if (!o.enabled || options_.observation != ObservationModel::kLikelihoodField) return false;
+  ++tracked_updates_;
+  if (tracked_updates_ == 1) {
+    quality_fast_ = quality_slow_ = quality;
+    return false;
+  }
+  const bool warm = tracked_updates_ > o.warmup_updates;
+  const bool suspect = warm && quality < o.lost_ratio * quality_slow_;
+  quality_fast_ += o.fast_rate * (quality - quality_fast_);
+  // The long-term average is the level to come back to: suspect scans do not drag it down.
+  if (!suspect) quality_slow_ += o.slow_rate * (quality - quality_slow_);
+  if (warm && quality_fast_ < o.lost_ratio * quality_slow_) {
+    lost_ = true;
+    lost_since_ = now;
+    lost_pose_ = last_step_.best_pose;
+    ++lost_count_;
+    candidate_.reset();
+    global_matcher_.reset();
+  }
+  return suspect;
+}
+
+void ParticleFilter::Relocalise(const std::vector<Eigen::Vector2d>& points, const LaserScan& scan,
+                                ParticleFilterStep* step) {
+  const RelocalisationOptions& o = options_.relocalisation;
+  // While lost the map is frozen and the particles only follow the odometry.
+  step->lost = true;
+  std::size_t best = 0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    if (particles_[i].weight > particles_[best].weight) best = i;
+  }
+  step->best_pose = particles_[best].pose;
+  step->mean_pose = WeightedMeanPose(particles_);
+  step->neff = EffectiveSampleSize(SoftmaxWeights(log_weights_));
+  std::vector<Eigen::Vector2d> near;
+  for (const Eigen::Vector2d& p : points) {
+    if (p.norm() <= o.search_max_range_m) near.push_back(p);
+  }
+  const std::optional<Pose2> found = near.size() >= 10 ? GlobalMatch(near, points) : std::nullopt;
+  if (found && candidate_ &&
+      (found->translation() - candidate_->translation()).norm() <= o.confirm_distance_m &&
+      std::abs(NormalizeAngle(found->theta() - candidate_->theta())) <= o.confirm_angle_rad) {
+    // Two matches in a row agree with the odometry between them: put the cloud there.
+    const double uniform = 1.0 / options_.num_particles;
+    for (Particle& p : particles_) {
+      p.pose = Pose2(found->x() + o.reset_sigma_xy_m * StandardNormal(rng_),
+                     found->y() + o.reset_sigma_xy_m * StandardNormal(rng_),
+                     found->theta() + o.reset_sigma_yaw_rad * StandardNormal(rng_));
+      p.weight = uniform;
+    }
+    std::fill(log_weights_.begin(), log_weights_.end(), 0.0);
+    lost_ = false;
+    candidate_.reset();
+    global_matcher_.reset();
+    quality_fast_ = quality_slow_;
+    ++relocalisation_count_;
+    step->lost = false;
+    step->relocalised = true;
+    step->best_pose = *found;
+    step->mean_pose = *found;
+    step->neff = static_cast<double>(options_.num_particles);
+    return;
+  }
+  candidate_ = found;
+  if (SecondsBetween(scan.time, lost_since_) > o.max_lost_s) {
+    // Nowhere on the map fits: the robot is somewhere new, map on from the odometry.
+    lost_ = false;
+    candidate_.reset();
+    global_matcher_.reset();
+    tracked_updates_ = 0;
+    step->lost = false;
+    map_.InsertScan(scan, step->best_pose);
+  }
+}
+
+std::optional<Pose2> ParticleFilter::GlobalMatch(const std::vector<Eigen::Vector2d>& near,
+                                                 const std::vector<Eigen::Vector2d>& points) {
+  const RelocalisationOptions& o = options_.relocalisation;
+  if (!global_matcher_) {
+    // The map is frozen while lost: one set of precomputation grids serves every search. The
+    // window is the map's extent, up to search_window_m around where the filter was lost.
+    const Eigen::Vector2d extent = Eigen::Vector2d(map_.width(), map_.height()) * map_.resolution();
+    const Eigen::Vector2d lo = map_.origin(), hi = map_.origin() + extent;
+    const Eigen::Vector2d w = Eigen::Vector2d::Constant(o.search_window_m);
+    const Eigen::Vector2d from = lost_pose_.translation() - w, to = lost_pose_.translation() + w;
+    const Eigen::Vector2d a = from.cwiseMax(lo), b = to.cwiseMin(hi);
+    search_centre_ = 0.5 * (a + b);
+    CorrelativeMatcherOptions m;
+    m.linear_window_m = 0.5 * (b - a).cwiseMax(0.0).maxCoeff();
+    m.angular_window_rad = 3.14159265358979;  // every heading
+    m.min_score = 0.0;
+    global_matcher_ = std::make_unique<CorrelativeMatcher>(m, map_);
+  }
+  const std::optional<MatchResult> match =
+      global_matcher_->Match(near, Pose2(search_centre_.x(), search_centre_.y(), 0.0));
+  if (!match) return std::nullopt;
+  // Judge it as the tracking judges itself: refined on the likelihood field, all points.
+  double reach = 0.0;
+  for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
+  const Eigen::Vector2d margin = Eigen::Vector2d::Constant(reach + o.confirm_distance_m +
+                                                           options_.likelihood_field.cutoff_sigmas *
+                                                               options_.likelihood_field.sigma_m);
+  likelihood_field_.Update(map_, Eigen::AlignedBox2d(match->pose.translation() - margin,
+                                                     match->pose.translation() + margin));
+  const float field_max = static_cast<float>(likelihood_field_.Score(0.0));
+  const RefineResult refined =
+      refiner_.Refine(likelihood_field_.view(), field_max, points, match->pose);
+  const double quality = Quality(static_cast<float>(refined.score), points.size());
+  if (quality < o.accept_ratio * quality_slow_) return std::nullopt;
+  return refined.pose;
 }
 
 ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
@@ -146,13 +292,24 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
     return step;
   }
   Predict(pending_motion_);
+  if (candidate_) candidate_ = *candidate_ * pending_motion_;
   pending_motion_ = Pose2();
   step.updated = true;
 
-  const std::vector<Eigen::Vector2d> points = ScanToBasePoints(scan, options_.points);
+  const std::vector<Eigen::Vector2d> all_points = ScanToBasePoints(scan, options_.points);
+  const SelectedPoints selected = DropGrazingPoints(
+      all_points, SurfaceNormals(all_points, kNeighbourM), options_.max_incidence_rad);
+  const std::vector<Eigen::Vector2d>& points = selected.points;
   step.points_used = static_cast<int>(points.size());
+  if (lost_) {
+    Relocalise(points, scan, &step);
+    last_step_ = step;
+    return step;
+  }
   if (!points.empty()) {
-    const std::vector<double> scores = Score(points, &step.best_score);
+    const MatchConstraints constraints =
+        DecomposeInformation(ScanInformation(points, selected.normals));
+    const std::vector<double> scores = Score(points, constraints, &step.best_score);
     for (std::size_t i = 0; i < scores.size(); ++i) {
       log_weights_[i] += options_.observation_scale * scores[i];
     }
@@ -168,9 +325,18 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
   }
   step.best_pose = particles_[best].pose;
   step.mean_pose = WeightedMeanPose(particles_);
-  map_.InsertScan(scan, step.best_pose);
-
+  step.quality = Quality(step.best_score, points.size());
+  // A scan that matches the map much worse than usual is not inserted: after a kidnapping it
+  // would paint the new place onto the old one before the averages call the filter lost.
+  const bool suspect = TrackQuality(step.quality, scan.time);
+  step.lost = lost_;
+  if (!suspect) map_.InsertScan(scan, step.best_pose);
   step.neff = EffectiveSampleSize(weights);
+  if (lost_) {
+    // Just lost: the weights say nothing now; keep the cloud for the odometry to carry.
+    last_step_ = step;
+    return step;
+  }
   if (step.neff < options_.resample_neff_ratio * options_.num_particles) {
     const std::vector<int> keep = Resample(weights, options_.resampling, rng_);
     std::vector<Particle> resampled;

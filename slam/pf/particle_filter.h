@@ -1,13 +1,16 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "slam/grid/occupancy_grid.h"
+#include "slam/matching/correlative_matcher.h"
 #include "slam/matching/likelihood_field.h"
 #include "slam/matching/map_correlator.h"
 #include "slam/matching/scan_refiner.h"
 #include "slam/pf/particle_filter_options.h"
+#include "slam/pf/solution_remapping.h"
 #include "slam/pf/thread_pool.h"
 #include "slam/types/pose2.h"
 #include "slam/types/records.h"
@@ -29,6 +32,10 @@ struct ParticleFilterStep {
   bool updated = false;     ///< false: the robot moved too little, poses follow the odometry
   float best_score = 0.0f;  ///< observation score of the best particle
   int points_used = 0;      ///< scan points used for weighting
+  /// The best particle's match quality: its score / (points x the field's maximum), in [0, 1].
+  double quality = 0.0;
+  bool lost = false;         ///< the filter is lost: the map is frozen, poses follow odometry
+  bool relocalised = false;  ///< a global match was confirmed and the cloud put there
 };
 
 /// Particle-filter SLAM on one shared log-odds map, as in the UCSD ECE276A reports (Wang,
@@ -50,10 +57,21 @@ class ParticleFilter {
   const ParticleFilterOptions& options() const { return options_; }
   /// Number of resampling events so far.
   int resample_count() const { return resample_count_; }
+  /// Times the filter found itself lost, and was relocalised by a global match.
+  int lost_count() const { return lost_count_; }
+  int relocalisation_count() const { return relocalisation_count_; }
 
  private:
   void Predict(const Pose2& odometry_increment);
-  std::vector<double> Score(const std::vector<Eigen::Vector2d>& points, float* best_score);
+  double Quality(float score, std::size_t num_points) const;
+  // Updates the quality averages; true when this scan is suspect (not to be inserted).
+  bool TrackQuality(double quality, Time now);
+  void Relocalise(const std::vector<Eigen::Vector2d>& points, const LaserScan& scan,
+                  ParticleFilterStep* step);
+  std::optional<Pose2> GlobalMatch(const std::vector<Eigen::Vector2d>& near,
+                                   const std::vector<Eigen::Vector2d>& points);
+  std::vector<double> Score(const std::vector<Eigen::Vector2d>& points,
+                            const MatchConstraints& constraints, float* best_score);
 
   ParticleFilterOptions options_;
   OccupancyGrid map_;
@@ -69,6 +87,18 @@ class ParticleFilter {
   Pose2 pending_motion_;  // odometry since the last update
   ParticleFilterStep last_step_;
   int resample_count_ = 0;
+  // Lost-filter detection (augmented MCL's averages) and relocalisation.
+  int tracked_updates_ = 0;
+  double quality_fast_ = 0.0;
+  double quality_slow_ = 0.0;
+  bool lost_ = false;
+  Time lost_since_;
+  Pose2 lost_pose_;  // the best pose at the last update before the loss
+  Eigen::Vector2d search_centre_ = Eigen::Vector2d::Zero();
+  std::optional<Pose2> candidate_;  // the last global match, carried by the odometry
+  std::unique_ptr<CorrelativeMatcher> global_matcher_;
+  int lost_count_ = 0;
+  int relocalisation_count_ = 0;
 };
 
 /// Weighted mean of particle poses: arithmetic in x, y; circular in yaw.

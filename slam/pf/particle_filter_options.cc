@@ -16,6 +16,36 @@ void Prefixed(const char* key, const std::vector<std::string>& from, std::vector
 
 }  // namespace
 
+std::vector<std::string> RelocalisationOptions::Validate() const {
+  std::vector<std::string> errors;
+  auto in_unit = [&](const char* field, double v) {
+    if (!(v > 0.0 && v <= 1.0)) errors.push_back(Rule(field, v, "must be in (0, 1]"));
+  };
+  auto positive = [&](const char* field, double v) {
+    if (!(v > 0.0)) errors.push_back(Rule(field, v, "must be > 0"));
+  };
+  in_unit("fast_rate", fast_rate);
+  in_unit("slow_rate", slow_rate);
+  in_unit("lost_ratio", lost_ratio);
+  in_unit("accept_ratio", accept_ratio);
+  if (!(slow_rate <= fast_rate)) {
+    errors.push_back(Rule("slow_rate", slow_rate, "must be <= fast_rate"));
+  }
+  if (warmup_updates < 1) errors.push_back(Rule("warmup_updates", warmup_updates, "must be >= 1"));
+  positive("confirm_distance_m", confirm_distance_m);
+  positive("confirm_angle_rad", confirm_angle_rad);
+  positive("search_max_range_m", search_max_range_m);
+  positive("search_window_m", search_window_m);
+  positive("max_lost_s", max_lost_s);
+  if (!(reset_sigma_xy_m >= 0.0)) {
+    errors.push_back(Rule("reset_sigma_xy_m", reset_sigma_xy_m, "must be >= 0"));
+  }
+  if (!(reset_sigma_yaw_rad >= 0.0)) {
+    errors.push_back(Rule("reset_sigma_yaw_rad", reset_sigma_yaw_rad, "must be >= 0"));
+  }
+  return errors;
+}
+
 ParticleFilterOptions ParticleFilterOptions::ReportsPreset() {
   ParticleFilterOptions o;
   o.motion_noise = MotionNoiseModel::kGaussianPerStep;
@@ -37,6 +67,7 @@ ParticleFilterOptions ParticleFilterOptions::ReportsPreset() {
   o.map.update_once_per_scan = false;
   o.min_update_distance_m = 0.0;
   o.min_update_angle_rad = 0.0;
+  o.degeneracy_ratio = 0.0;
   return o;
 }
 
@@ -58,12 +89,20 @@ std::vector<std::string> ParticleFilterOptions::Validate() const {
   if (!(min_update_angle_rad >= 0.0)) {
     errors.push_back(Rule("min_update_angle_rad", min_update_angle_rad, "must be >= 0"));
   }
+  if (!(degeneracy_ratio >= 0.0 && degeneracy_ratio < 1.0)) {
+    errors.push_back(Rule("degeneracy_ratio", degeneracy_ratio, "must be in [0, 1)"));
+  }
+  if (!(max_incidence_rad > 0.0 && max_incidence_rad <= 1.5707963267948966)) {
+    errors.push_back(Rule("max_incidence_rad", max_incidence_rad, "must be in (0, pi/2]"));
+  }
   if (num_threads < 1) errors.push_back(Rule("threads", num_threads, "must be >= 1"));
   Prefixed("rot_trans_rot", rot_trans_rot.Validate(), errors);
   Prefixed("points", points.Validate(), errors);
   Prefixed("correlation", correlation.Validate(), errors);
   Prefixed("likelihood_field", likelihood_field.Validate(), errors);
   Prefixed("refiner", refiner.Validate(), errors);
+  Prefixed("relocalisation", relocalisation.Validate(), errors);
+
   if (observation == ObservationModel::kLikelihoodField &&
       correlation.value != CorrelationValue::kRawValue) {
     errors.push_back("correlation.value = occupied; must be log_odds with the likelihood field");

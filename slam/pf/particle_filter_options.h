@@ -30,6 +30,60 @@ enum class ObservationModel {
   kLikelihoodField,  ///< sum of likelihood-field log-likelihoods (Probabilistic Robotics, 6.4)
 };
 
+/// Lost-filter detection and global relocalisation against the map built so far (Thrun et al.,
+/// Probabilistic Robotics, Table 8.3, augmented MCL: short- and long-term averages of the
+/// measurement likelihood; the global search is the branch-and-bound correlative matcher of Hess
+/// et al. 2016). The match quality of an update is the best particle's score over the points
+/// divided by the likelihood field's maximum, in [0, 1].
+struct RelocalisationOptions {
+  /// Off by default: on the belgioioso and edmonton logs single scans drop to a third of the
+  /// usual quality (as a kidnapping does) and the global match then jumps to a wrong place. Only
+  /// the likelihood-field observation model has a quality in [0, 1] to watch.
+  bool enabled = false;
+  /// alpha_fast of the short-term average of the quality: 1 reacts to the first bad scan (a
+  /// kidnapped filter soon fits the scan somewhere near by, in a self-similar building, and the dip
+  /// is gone).
+  double fast_rate = 1.0;
+  double slow_rate = 0.02;  ///< alpha_slow of the long-term average
+  double lost_ratio = 0.5;  ///< lost when the short-term average < this x the long-term one
+  int warmup_updates = 20;  ///< updates before the long-term average is trusted
+  /// A global match is accepted when its quality reaches this x the long-term average from before
+  /// the loss, and a second match one update later agrees with it moved by the odometry.
+  double accept_ratio = 0.8;
+  double confirm_distance_m = 0.3;
+  double confirm_angle_rad = 0.1;
+  double search_max_range_m = 10.0;  ///< points used by the global search (a finer yaw step)
+  /// The global search covers x and y within this of where the filter was lost (all of a
+  /// building's floor; it bounds the cost on a city-sized map), every heading.
+  double search_window_m = 20.0;
+  /// Lost this long (data time) without a confirmed match: the robot is taken to be somewhere
+  /// new, and the filter maps on from its odometry.
+  double max_lost_s = 30.0;
+  double reset_sigma_xy_m = 0.02;      ///< particles are redrawn around the match with this
+  double reset_sigma_yaw_rad = 0.005;  ///< spread
+
+  /// One message per broken rule (prefixed "relocalisation.").
+  std::vector<std::string> Validate() const;
+};
+
+/// The field table of RelocalisationOptions (slam/config/fields.h).
+template <typename V>
+void VisitFields(V& v, RelocalisationOptions& o) {
+  v("enabled", o.enabled);
+  v("fast_rate", o.fast_rate);
+  v("slow_rate", o.slow_rate);
+  v("lost_ratio", o.lost_ratio);
+  v("warmup_updates", o.warmup_updates);
+  v("accept_ratio", o.accept_ratio);
+  v("confirm_distance_m", o.confirm_distance_m);
+  v("confirm_angle_rad", o.confirm_angle_rad);
+  v("search_max_range_m", o.search_max_range_m);
+  v("search_window_m", o.search_window_m);
+  v("max_lost_s", o.max_lost_s);
+  v("reset_sigma_xy_m", o.reset_sigma_xy_m);
+  v("reset_sigma_yaw_rad", o.reset_sigma_yaw_rad);
+}
+
 /// Everything the particle filter can be told. Defaults are the improved filter (likelihood
 /// field, x/y/yaw search, best-shift moves, Gauss-Newton refinement, rot-trans-rot noise,
 /// systematic resampling, updates every 0.25 m or 0.1 rad; tuned on intel-corrected over 16
@@ -58,6 +112,19 @@ struct ParticleFilterOptions {
   /// (needs move_to_best_shift); with the likelihood-field model the weight uses the refined score.
   bool refine = true;
   ScanRefinerOptions refiner;
+  /// Degeneracy: a translation direction whose information in the scan's own geometry (an
+  /// eigenvalue of its point-to-line J^T J, yaw marginalised) is below this fraction of the
+  /// largest keeps each particle's odometry prediction (solution remapping, Zhang et al. 2016),
+  /// and the weights do not depend on it: along a corridor's axis the scan says nothing.
+  /// 0 = off.
+  double degeneracy_ratio = 0.05;
+  /// Beams meeting their surface at a larger incidence angle (beam to surface normal, the normal
+  /// from the neighbouring points) are left out of the weighting and the degeneracy analysis.
+  /// pi / 2 (the default) keeps every point: with the degeneracy handling on, dropping grazing
+  /// points also drops the near walls' constraints and did worse in the corridor.
+  double max_incidence_rad = 1.5707963267948966;
+
+  RelocalisationOptions relocalisation;
 
   ResamplingScheme resampling = ResamplingScheme::kSystematic;
   /// Resample when Neff = 1 / sum(w^2) < resample_neff_ratio * num_particles (reports: 0.5).
@@ -106,6 +173,9 @@ void VisitFields(V& v, ParticleFilterOptions& o) {
   v("move_to_best_shift", o.move_to_best_shift);
   v("refine", o.refine);
   v.Struct("refiner", o.refiner);
+  v("degeneracy_ratio", o.degeneracy_ratio);
+  v("max_incidence_rad", o.max_incidence_rad);
+  v.Struct("relocalisation", o.relocalisation);
   v("min_update_distance_m", o.min_update_distance_m);
   v("min_update_angle_rad", o.min_update_angle_rad);
   v.Enum("resampling", o.resampling,

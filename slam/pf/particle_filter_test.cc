@@ -162,6 +162,65 @@ TEST(ParticleFilterTest, FiltersOnlyAfterEnoughMotion) {
   EXPECT_NE(filter.particles()[7].pose, before[7].pose);
 }
 
+// A kidnapping into the mapped part: the scans jump back to where the robot was 15 s earlier while
+// the odometry says nothing. The filter must call itself lost at the jump, leave the map alone
+// while lost, relocalise on the map and end where the truth is.
+TEST(ParticleFilterTest, FindsItselfLostAfterAKidnappingAndRelocalises) {
+  const ShortRun& run = GetShortRun();
+  const std::size_t jump_at = 300, back_to = 100;
+  ASSERT_GT(run.scans.size(), jump_at);
+  ParticleFilterOptions options = FastOptions();
+  // In this world of long bare walls a displaced scan still scores ~0.7 of its usual quality
+  // (in the simulated office it drops to ~0.35): a stricter ratio than the default's 0.5.
+  options.relocalisation.enabled = true;
+  options.relocalisation.lost_ratio = 0.7;
+  ParticleFilter filter(options);
+  for (std::size_t i = 0; i < jump_at; ++i)
+    filter.AddScan(run.scans[i].scan, run.scans[i].increment);
+  ASSERT_EQ(filter.lost_count(), 0);
+  int lost_at = -1, relocalised_at = -1;
+  std::vector<float> map_while_lost;
+  bool was_lost = false;
+  ParticleFilterStep step;
+  for (std::size_t i = back_to; i < run.scans.size(); ++i) {
+    // The first scan after the jump comes with no motion at all.
+    step = filter.AddScan(run.scans[i].scan, i == back_to ? Pose2() : run.scans[i].increment);
+    const int k = static_cast<int>(i - back_to);
+    if (step.lost && lost_at < 0) lost_at = k;
+    if (step.lost && !was_lost) map_while_lost = filter.map().log_odds();
+    was_lost = step.lost;
+    if (step.lost) {
+      EXPECT_EQ(filter.map().log_odds(), map_while_lost) << k;
+    }
+    if (step.relocalised && relocalised_at < 0) relocalised_at = k;
+  }
+  EXPECT_GE(lost_at, 0);
+  EXPECT_LT(lost_at, 10);
+  EXPECT_GT(relocalised_at, lost_at);
+  EXPECT_LT(relocalised_at, 40);  // 4 s of data at 10 Hz
+  EXPECT_GE(filter.relocalisation_count(), 1);
+  EXPECT_EQ(filter.lost_count(), filter.relocalisation_count()) << "lost at the end";
+  const Pose2 end = run.run.truth.front().map_from_base * step.best_pose;
+  // Without relocalisation it ends ~10 m off (the next test).
+  EXPECT_LT((end.translation() - run.run.truth.back().map_from_base.translation()).norm(), 0.2);
+}
+
+// Without relocalisation the same filter stays where the jump left it.
+TEST(ParticleFilterTest, WithoutRelocalisationAKidnappingIsNotUndone) {
+  const ShortRun& run = GetShortRun();
+  ParticleFilterOptions options = FastOptions();
+  options.relocalisation.enabled = false;
+  ParticleFilter filter(options);
+  for (std::size_t i = 0; i < 250; ++i) filter.AddScan(run.scans[i].scan, run.scans[i].increment);
+  ParticleFilterStep step;
+  for (std::size_t i = 100; i < run.scans.size(); ++i) {
+    step = filter.AddScan(run.scans[i].scan, i == 100 ? Pose2() : run.scans[i].increment);
+    EXPECT_FALSE(step.lost);
+  }
+  const Pose2 end = run.run.truth.front().map_from_base * step.best_pose;
+  EXPECT_GT((end.translation() - run.run.truth.back().map_from_base.translation()).norm(), 2.0);
+}
+
 TEST(ParticleFilterTest, ValidateNamesFieldValueAndRule) {
   ParticleFilterOptions options;
   options.num_particles = 0;

@@ -1,5 +1,7 @@
 #include "slam/pipeline/particle_filter_estimator.h"
 
+#include <cmath>
+
 namespace slamrig::slam {
 
 ParticleFilterOptions ParticleFilterEstimator::Seeded(ParticleFilterOptions options,
@@ -14,16 +16,31 @@ ParticleFilterEstimator::ParticleFilterEstimator(const ParticleFilterOptions& op
 
 ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
   const ParticleFilterStep step = filter_.AddScan(scan.scan, scan.increment);
+  if (scans_ == 0) start_ = scan.scan.time;
   neff_sum_ += step.neff;
   ++scans_;
   updates_ += step.updated;
-  return {step.best_pose, step.mean_pose, {{"neff", step.neff}}, std::nullopt};
+  // The events, in data time since the first scan: the first loss and the first recovery after.
+  const double t = SecondsBetween(scan.scan.time, start_);
+  if (step.lost && !was_lost_ && std::isnan(lost_at_s_)) lost_at_s_ = t;
+  if (step.relocalised && !std::isnan(lost_at_s_) && std::isnan(relocalised_at_s_)) {
+    relocalised_at_s_ = t;
+  }
+  was_lost_ = step.lost;
+  return {step.best_pose,
+          step.mean_pose,
+          {{"neff", step.neff}, {"match_quality", step.quality}, {"lost", step.lost ? 1.0 : 0.0}},
+          std::nullopt};
 }
 
 std::map<std::string, double> ParticleFilterEstimator::Statistics() const {
   return {{"mean_neff", scans_ > 0 ? neff_sum_ / scans_ : 0.0},
           {"resamples", filter_.resample_count()},
-          {"updates", updates_}};
+          {"updates", updates_},
+          {"lost", filter_.lost_count()},
+          {"relocalisations", filter_.relocalisation_count()},
+          {"lost_at_s", lost_at_s_},
+          {"relocalised_at_s", relocalised_at_s_}};
 }
 
 EstimatorView ParticleFilterEstimator::View() const {

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <cmath>
+
 #include "slam/pf/particle_filter.h"
 #include "slam/pf/particle_filter_options.h"
 #include "slam/pipeline/algorithm.h"
@@ -16,7 +18,9 @@ class ParticleFilterEstimator final : public Estimator {
 
   ScanEstimate AddScan(const SyncedScan& scan) override;
   const OccupancyGrid& map() const override { return filter_.map(); }
-  /// mean_neff (over scans), resamples, updates (scans the filter ran on, not just odometry).
+  /// mean_neff (over scans), resamples, updates (scans the filter ran on, not just odometry);
+  /// lost and relocalisations (counts), lost_at_s and relocalised_at_s (the first loss and the
+  /// first relocalisation after it, seconds since the first scan; NaN when none).
   std::map<std::string, double> Statistics() const override;
   EstimatorView View() const override;
 
@@ -27,6 +31,10 @@ class ParticleFilterEstimator final : public Estimator {
   double neff_sum_ = 0.0;
   int scans_ = 0;
   int updates_ = 0;
+  Time start_;
+  bool was_lost_ = false;
+  double lost_at_s_ = NAN;
+  double relocalised_at_s_ = NAN;
 };
 
 }  // namespace slamrig::slam
