@@ -7,8 +7,8 @@
 #include "slam/pipeline/graph_slam_estimator.h"
 #include "slam/pipeline/icp_odometry_estimator.h"
 #include "slam/pipeline/particle_filter_estimator.h"
-#include "slam/pipeline/rbpf_estimator.h"
 #include "slam/pipeline/python_estimator.h"
+#include "slam/pipeline/rbpf_estimator.h"
 
 namespace slamrig::slam {
 
