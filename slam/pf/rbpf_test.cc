@@ -11,40 +11,11 @@
 namespace slamrig::slam {
 namespace {
 
-// One leg and a corner of the office loop at 10 Hz, with miscalibrated wheels.
-struct ShortRun {
-  testing::SyntheticRun run;
-  std::vector<SyncedScan> scans;
-};
+using ShortRun = testing::ShortOfficeRun;
+const ShortRun& GetShortRun() { return testing::GetShortOfficeRun(); }
 
-const ShortRun& GetShortRun() {
-  static const ShortRun* run = [] {
-    auto* r = new ShortRun;
-    testing::SyntheticRunOptions options;
-    options.waypoints = testing::OfficeLoop();
-    options.max_duration_s = 36.0;
-    options.scan_rate_hz = 10.0;
-    options.lidar.num_beams = 271;
-    options.lidar.angle_increment_rad = 1.0 * 3.14159265358979 / 180.0;
-    options.right_scale_error = 0.03;
-    options.left_scale_error = -0.03;
-    options.gyro_bias_rad_s = 0.01;
-    r->run = testing::MakeSyntheticRun(testing::SegmentWorld::Office(), options);
-    r->scans = SyncToScans(r->run.records, ScanSyncOptions{}).scans;
-    return r;
-  }();
-  return *run;
-}
-
-// Position RMSE against the truth, the estimate anchored at the first true pose.
 double PositionRmse(const std::vector<Pose2>& estimate, const std::vector<GroundTruthPose>& truth) {
-  const Pose2 anchor = truth.front().map_from_base;
-  double sum = 0.0;
-  for (std::size_t i = 0; i < estimate.size(); ++i) {
-    sum +=
-        ((anchor * estimate[i]).translation() - truth[i].map_from_base.translation()).squaredNorm();
-  }
-  return std::sqrt(sum / static_cast<double>(estimate.size()));
+  return testing::AnchoredPositionRmse(estimate, truth);
 }
 
 RbpfOptions FastOptions() {

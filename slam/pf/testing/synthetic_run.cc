@@ -85,4 +85,34 @@ SyntheticRun MakeSyntheticRun(const SegmentWorld& world, const SyntheticRunOptio
   return run;
 }
 
+const ShortOfficeRun& GetShortOfficeRun() {
+  static const ShortOfficeRun* run = [] {
+    auto* r = new ShortOfficeRun;
+    SyntheticRunOptions options;
+    options.waypoints = OfficeLoop();
+    options.max_duration_s = 36.0;
+    options.scan_rate_hz = 10.0;
+    options.lidar.num_beams = 271;
+    options.lidar.angle_increment_rad = 1.0 * 3.14159265358979 / 180.0;
+    options.right_scale_error = 0.03;
+    options.left_scale_error = -0.03;
+    options.gyro_bias_rad_s = 0.01;
+    r->run = MakeSyntheticRun(SegmentWorld::Office(), options);
+    r->scans = SyncToScans(r->run.records, ScanSyncOptions{}).scans;
+    return r;
+  }();
+  return *run;
+}
+
+double AnchoredPositionRmse(const std::vector<Pose2>& estimate,
+                            const std::vector<GroundTruthPose>& truth) {
+  const Pose2 anchor = truth.front().map_from_base;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < estimate.size(); ++i) {
+    sum +=
+        ((anchor * estimate[i]).translation() - truth[i].map_from_base.translation()).squaredNorm();
+  }
+  return std::sqrt(sum / static_cast<double>(estimate.size()));
+}
+
 }  // namespace slamrig::slam::testing
