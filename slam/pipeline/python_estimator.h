@@ -65,7 +65,9 @@ class PythonAlgorithmOptions final : public AlgorithmOptions {
     writer("module", options_.module);
     writer("class", options_.class_name);
     writer("path", options_.path);
-    for (auto& [key, value] : options_.options) {
+    for (auto& entry : options_.options) {
+      // Not a structured binding: clang 14 (the fuzz build) cannot capture one in a lambda.
+      const std::string& key = entry.first;
       std::visit(
           [&](auto v) {
             if constexpr (std::is_same_v<decltype(v), std::int64_t>) {
@@ -80,7 +82,7 @@ class PythonAlgorithmOptions final : public AlgorithmOptions {
               writer(key.c_str(), v);
             }
           },
-          value);
+          entry.second);
     }
   }
 
