@@ -10,20 +10,7 @@
 namespace slamrig::slam {
 namespace {
 
-const std::vector<Record>& Records() {
-  static const testing::SyntheticRun* run = [] {
-    testing::SyntheticRunOptions options;
-    options.waypoints = testing::OfficeLoop();
-    options.max_duration_s = 20.0;
-    options.scan_rate_hz = 10.0;
-    options.lidar.num_beams = 181;
-    options.lidar.angle_increment_rad = 1.5 * 3.14159265358979 / 180.0;
-    options.right_scale_error = 0.02;
-    return new testing::SyntheticRun(
-        testing::MakeSyntheticRun(testing::SegmentWorld::Office(), options));
-  }();
-  return run->records;
-}
+const std::vector<Record>& Records() { return testing::SmallOfficeRecords(); }
 
 EstimatorConfig SmallPf() {
   EstimatorConfig config = DefaultEstimatorConfig("pf", "pf");

@@ -104,6 +104,20 @@ const ShortOfficeRun& GetShortOfficeRun() {
   return *run;
 }
 
+const std::vector<Record>& SmallOfficeRecords() {
+  static const SyntheticRun* run = [] {
+    SyntheticRunOptions options;
+    options.waypoints = OfficeLoop();
+    options.max_duration_s = 20.0;
+    options.scan_rate_hz = 10.0;
+    options.lidar.num_beams = 181;
+    options.lidar.angle_increment_rad = 1.5 * 3.14159265358979 / 180.0;
+    options.right_scale_error = 0.02;
+    return new SyntheticRun(MakeSyntheticRun(SegmentWorld::Office(), options));
+  }();
+  return run->records;
+}
+
 double AnchoredPositionRmse(const std::vector<Pose2>& estimate,
                             const std::vector<GroundTruthPose>& truth) {
   const Pose2 anchor = truth.front().map_from_base;

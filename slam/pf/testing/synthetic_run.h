@@ -54,6 +54,10 @@ struct ShortOfficeRun {
 };
 const ShortOfficeRun& GetShortOfficeRun();
 
+/// The records of a 20 s stretch of the office loop (scans at 10 Hz, 181 beams, the right wheel
+/// 2 % long), for estimator-seam tests. Built once per process.
+const std::vector<Record>& SmallOfficeRecords();
+
 /// Position RMSE of `estimate` (one pose per true pose) against the truth, the estimate anchored
 /// at the first true pose.
 double AnchoredPositionRmse(const std::vector<Pose2>& estimate,
