@@ -280,7 +280,7 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
     if (!c.texture) continue;
     write_rgb(c.name + "_texture.png", c.texture->colors);
     html_texture += "<figure><img src=\"" + c.name + "_texture.png\"><figcaption>" + Html(c.name) +
-                    "'s texture map from its final poses (PSNR " +
+                    "'s texture map from its final poses, in the frame ATE aligns them to (PSNR " +
                     Number(c.texture->score.psnr_db.value_or(NAN)) + " dB).</figcaption></figure>";
   }
 

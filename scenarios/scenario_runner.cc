@@ -202,8 +202,12 @@ void Finish(Runners& runners, const Pose2& map_from_start, double data_time_s,
     c.mean_estimate = InMapFrame(c.run.mean, map_from_start);
     Score(*result, data_time_s, &c);
     if (texture) {
-      c.texture = texture->WithPoses(c.estimate);
+      // Scored in the frame ATE aligns the trajectory to (a map's frame is defined up to a rigid
+      // motion), and as anchored at the start pose, which the other maps of a simulation use.
+      c.texture = texture->WithAlignedPoses(c.estimate, result->truth);
       ScoreTextureMetrics(*c.texture, result->truth_metrics["texture_psnr_db"], &c.metrics);
+      c.metrics["texture_psnr_anchored_db"] =
+          texture->WithPoses(c.estimate).score.psnr_db.value_or(NAN);
     }
     result->configs.push_back(std::move(c));
   }

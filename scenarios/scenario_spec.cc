@@ -160,7 +160,8 @@ const std::vector<std::string>& KnownMetrics() {
                                                    "texture_mean_abs_error",
                                                    "texture_coverage",
                                                    "texture_frames",
-                                                   "texture_psnr_loss_db"};
+                                                   "texture_psnr_loss_db",
+                                                   "texture_psnr_anchored_db"};
   return metrics;
 }
 

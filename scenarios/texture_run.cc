@@ -2,6 +2,9 @@
 
 #include <utility>
 
+#include "slam/eval/pose_association.h"
+#include "slam/eval/trajectory_error.h"
+
 namespace slamrig::scenario {
 
 TextureRun::TextureRun(const slam::TextureMapOptions& options, cv::Mat3b truth,
@@ -41,6 +44,20 @@ TextureResult TextureRun::WithPoses(const Trajectory& map_from_base) const {
     ++frames;
   }
   return Score(map, frames);
+}
+
+TextureResult TextureRun::WithAlignedPoses(const Trajectory& map_from_base,
+                                           const Trajectory& truth) const {
+  if (slam::AssociatePoses(map_from_base, truth).size() < 2) return WithPoses(map_from_base);
+  const Pose2 reference_from_estimate =
+      slam::ComputeAte(map_from_base, truth).reference_from_estimate;
+  Trajectory aligned;
+  for (const StampedPose& p : map_from_base.poses()) {
+    aligned.Append(p.time, reference_from_estimate * p.pose);
+  }
+  TextureResult r = WithPoses(aligned);
+  r.reference_from_estimate = reference_from_estimate;
+  return r;
 }
 
 }  // namespace slamrig::scenario

@@ -19,6 +19,8 @@ struct TextureResult {
   cv::Mat1b observed;  ///< 255 where a cell was seen
   slam::TextureScore score;
   int frames = 0;  ///< frames mapped (those with a pose at their time)
+  /// The rigid motion applied to the poses before mapping (identity unless aligned).
+  Pose2 reference_from_estimate;
 };
 
 /// The texture side of a scenario run with a camera. Each frame is reduced once to its floor
@@ -40,6 +42,13 @@ class TextureRun {
   /// The map from `map_from_base` (map frame) interpolated at each frame's time; frames outside
   /// its time span are left out.
   TextureResult WithPoses(const Trajectory& map_from_base) const;
+  /// The map from `map_from_base` moved by the SE(2) alignment ATE applies to it against
+  /// `truth` (the true poses at the scans; slam::ComputeAte), so the texture is scored in the
+  /// frame the trajectory is. A SLAM map's frame is defined up to a rigid motion, and on a
+  /// checkered floor a rigid shift of the whole map by 2 cm costs about 3 dB that says nothing
+  /// about the map's shape (sim/camera/office_texture_test.cc). With fewer than two pose pairs
+  /// there is no alignment and the poses are used as they are.
+  TextureResult WithAlignedPoses(const Trajectory& map_from_base, const Trajectory& truth) const;
 
   const slam::TextureMapOptions& options() const { return options_; }
   /// The true floor texture, r, g, b.

@@ -1,13 +1,19 @@
 // The scenario runner with a camera: texture metrics per configuration and for the true poses,
 // and the camera's mistakes as one error naming the key.
+#include "scenarios/texture_run.h"
+
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 #include "scenarios/scenario_runner.h"
 #include "scenarios/scenario_spec.h"
+#include "sim/camera/camera_test_world.h"
+#include "sim/camera/rgbd_camera.h"
 #include "slam/types/error.h"
 
 namespace slamrig::scenario {
@@ -58,6 +64,81 @@ TEST(TextureRunTest, EveryConfigurationAndTheTruthGetTextureMetrics) {
   EXPECT_NEAR(m.at("texture_psnr_loss_db"),
               r.truth_metrics.at("texture_psnr_db") - m.at("texture_psnr_db"), 1e-12);
   EXPECT_GE(m.at("texture_frames"), 4.0);
+  // The same map anchored at the start pose (the loss is of the aligned one).
+  EXPECT_TRUE(std::isfinite(m.at("texture_psnr_anchored_db")));
+  EXPECT_GT(m.at("texture_psnr_anchored_db"), 10.0);
+}
+
+// The small room's tiled floor seen by a half-size Kinect along an L-shaped drive: the truth at
+// 20 Hz ("scans") and a frame every fourth pose.
+struct LDrive {
+  TextureRun run;
+  Trajectory truth;
+};
+
+LDrive DriveAnL() {
+  const sim::WorldSpec world = sim::testing::SmallRoom();
+  sim::CameraSpec spec;  // tiles.png floor, disparity noise
+  spec.width_px = 320;
+  spec.height_px = 240;
+  spec.intrinsics = {292.5, 292.5, 158.0, 121.5};
+  spec.zones.clear();
+  sim::RgbdCamera camera(world, spec, 5);
+  slam::TextureMapOptions options;
+  options.min_m = {-1.0, -2.0};
+  options.max_m = {5.0, 2.0};
+  options.pixel_stride = 2;
+  LDrive d{
+      TextureRun(options, camera.floor().TruthColors(options), camera.floor().FloorMask(options)),
+      {}};
+  for (int k = 0; k <= 120; ++k) {
+    // 2.4 m east along y = -1.3, a quarter turn left in place, then 1.2 m north.
+    const double s = 0.03 * std::min(k, 80);
+    const double turn = std::clamp((k - 80) / 10.0, 0.0, 1.0) * M_PI / 2;
+    const double north = 0.04 * std::max(0, k - 90);
+    const Pose2 pose(-0.5 + s, -1.3 + north, turn);
+    const Time t = Time::FromSeconds(0.05 * k);
+    d.truth.Append(t, pose);
+    if (k % 4 == 0) d.run.Add(camera.Render(pose, t), pose);
+  }
+  return d;
+}
+
+TEST(TextureRunTest, AlignedScoringUndoesARigidMotionButNotADistortion) {
+  const LDrive d = DriveAnL();
+  const double truth_db = *d.run.WithTruePoses().score.psnr_db;
+  // The true poses at the scans, interpolated at the frames, give the frames' own map.
+  EXPECT_NEAR(*d.run.WithPoses(d.truth).score.psnr_db, truth_db, 1e-9);
+
+  // The whole estimate 4 cm and 0.6 degrees off: anchored, the checkered floor loses several dB;
+  // aligned as ATE aligns it, nothing.
+  const Pose2 offset(0.04, -0.03, 0.01);
+  Trajectory moved, bent;
+  for (const StampedPose& p : d.truth.poses()) {
+    moved.Append(p.time, offset * p.pose);
+    // A distortion: an error that grows along the path to 5 cm.
+    const double grow = 0.05 * p.time.seconds() / 6.0;
+    bent.Append(p.time, Pose2(p.pose.x() + grow, p.pose.y(), p.pose.theta()));
+  }
+  const TextureResult anchored = d.run.WithPoses(moved);
+  const TextureResult aligned = d.run.WithAlignedPoses(moved, d.truth);
+  std::printf("true poses %.2f dB, moved %.2f dB anchored, %.2f dB aligned\n", truth_db,
+              *anchored.score.psnr_db, *aligned.score.psnr_db);
+  EXPECT_LT(*anchored.score.psnr_db, truth_db - 3.0);
+  EXPECT_NEAR(*aligned.score.psnr_db, truth_db, 0.05);
+  const Pose2 back = aligned.reference_from_estimate * offset;  // identity when undone
+  EXPECT_NEAR(back.x(), 0.0, 1e-6);
+  EXPECT_NEAR(back.y(), 0.0, 1e-6);
+  EXPECT_NEAR(back.theta(), 0.0, 1e-9);
+
+  // A distortion stays: the best rigid motion halves it at most.
+  const double bent_db = *d.run.WithAlignedPoses(bent, d.truth).score.psnr_db;
+  std::printf("growing error: %.2f dB aligned\n", bent_db);
+  EXPECT_LT(bent_db, truth_db - 1.0);
+  // Too few pose pairs to align: the poses are used as they are.
+  Trajectory one;
+  one.Append(d.truth.poses().front().time, offset * d.truth.poses().front().pose);
+  EXPECT_EQ(d.run.WithAlignedPoses(one, d.truth).frames, 1);
 }
 
 TEST(TextureRunTest, ACameraThatSeesNoFloorIsOneErrorNamingIt) {
