@@ -1,5 +1,6 @@
 // `slamrig simulate WORLD --out DIR`: a simulated run written as a CARMEN log plus ground truth,
-// or (`--format mcap|sqlite3`) as a ROS 2 bag; both through scenario::RecordSimulation.
+// or (`--format mcap|sqlite3`) as a ROS 2 bag, or (`--format ece276a`) in the UCSD ECE276A
+// layout; all through scenario::RecordSimulation.
 
 #include <algorithm>
 #include <chrono>
@@ -26,7 +27,7 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
   std::vector<std::string> topic_flags;
   double duration_s = 0.0, physics_rate_hz = 200.0;
   std::uint64_t seed = 1;
-  int laps = 0;
+  int laps = 0, dataset = 20;
   bool no_noise = false;
   ArgParser parser(
       "slamrig simulate", "WORLD [--robot R] [--duration S] [--seed N] --out DIR [options]",
@@ -36,7 +37,9 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
       "resolved DIR/world.yaml, DIR/robot.yaml and DIR/sim.yaml. Same arguments, same bytes.\n"
       "--format mcap or sqlite3 writes a ROS 2 bag DIR/run instead of run.log (/scan, /imu,\n"
       "/joint_states, /odom and /tf from the same robot odometry, /tf_static, /clock,\n"
-      "/ground_truth/odom); truth.tum and the yaml files are written for every format.");
+      "/ground_truth/odom). --format ece276a writes DIR/Encoders<N>.npz, Imu<N>.npz,\n"
+      "Hokuyo<N>.npz and, with a camera, Kinect<N>.npz and dataRGBD/ as the ECE276A course\n"
+      "data (N from --dataset). truth.tum and the yaml files are written for every format.");
   parser.AddPositional("WORLD", "world file, or a name in worlds/ (office, corridor, ...)",
                        &world_arg);
   parser.AddOption("robot", "R", "robot file, or a name in robots/ (ece276a, small_diff)",
@@ -48,7 +51,10 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
   parser.AddOption("physics-rate", "HZ", "physics steps per second", &physics_rate_hz);
   parser.AddFlag("no-noise", "switch off every sensor noise and calibration error", &no_noise);
   parser.AddOption("out", "DIR", "output folder (created)", &out_dir);
-  parser.AddOption("format", "F", "carmen (run.log), mcap or sqlite3 (ROS 2 bag DIR/run)", &format);
+  parser.AddOption("format", "F",
+                   "carmen (run.log), mcap or sqlite3 (ROS 2 bag DIR/run), ece276a (npz + PNG)",
+                   &format);
+  parser.AddOption("dataset", "N", "ece276a: the dataset number in the file names (20)", &dataset);
   parser.AddOption("compression", "C", "MCAP chunk compression: zstd, lz4 or none", &compression);
   parser.AddRepeated("topic", "KEY=NAME",
                      "a bag topic name, e.g. scan=/front/scan (keys: " +
@@ -56,14 +62,24 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
                      &topic_flags);
   if (!parser.Parse(args)) return 0;
   if (out_dir.empty()) throw ConfigError("slamrig simulate: --out DIR is required");
-  if (format != "carmen" && format != "mcap" && format != "sqlite3") {
-    throw ConfigError("slamrig simulate: --format: expected carmen, mcap or sqlite3, got '" +
-                      format + "'");
+  if (format != "carmen" && format != "mcap" && format != "sqlite3" && format != "ece276a") {
+    throw ConfigError(
+        "slamrig simulate: --format: expected carmen, mcap, sqlite3 or ece276a, got '" + format +
+        "'");
   }
   scenario::RecordingOptions recording;
-  recording.format = format == "carmen" ? scenario::RecordingFormat::kCarmen
-                     : format == "mcap" ? scenario::RecordingFormat::kMcap
-                                        : scenario::RecordingFormat::kSqlite3;
+  recording.format = format == "carmen"    ? scenario::RecordingFormat::kCarmen
+                     : format == "mcap"    ? scenario::RecordingFormat::kMcap
+                     : format == "ece276a" ? scenario::RecordingFormat::kEce276a
+                                           : scenario::RecordingFormat::kSqlite3;
+  if (dataset < 0) {
+    throw ConfigError("slamrig simulate: --dataset: expected a number >= 0, got " +
+                      std::to_string(dataset));
+  }
+  if (dataset != 20 && recording.format != scenario::RecordingFormat::kEce276a) {
+    throw ConfigError("slamrig simulate: --dataset needs --format ece276a");
+  }
+  recording.ece276a_dataset = dataset;
   if (compression == "zstd") {
     recording.compression = slam::McapCompression::kZstd;
   } else if (compression == "lz4") {
@@ -75,8 +91,9 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
                       compression + "'");
   }
   recording.topics = ParseTopicFlags("slamrig simulate", topic_flags);
-  if (recording.format == scenario::RecordingFormat::kCarmen &&
-      (!topic_flags.empty() || compression != "zstd")) {
+  const bool bag = recording.format == scenario::RecordingFormat::kMcap ||
+                   recording.format == scenario::RecordingFormat::kSqlite3;
+  if (!bag && (!topic_flags.empty() || compression != "zstd")) {
     throw ConfigError("slamrig simulate: --topic and --compression need --format mcap or sqlite3");
   }
 

@@ -105,10 +105,24 @@ void RunNpz(std::string_view data) {
   const std::string npz = dir.Write("Encoders20.npz", data);
   CheckNpz(slam::ReadNpz(npz));
   const std::string encoders_csv = dir.Write("encoders21.csv", "0.0,1,2,3,4\n");
-  for (const slam::Ece276aFiles& files :
-       {slam::Ece276aFiles{.encoders = npz, .imu = "", .hokuyo = ""},
-        slam::Ece276aFiles{.encoders = encoders_csv, .imu = npz, .hokuyo = ""},
-        slam::Ece276aFiles{.encoders = encoders_csv, .imu = "", .hokuyo = npz}}) {
+  for (const slam::Ece276aFiles& files : {slam::Ece276aFiles{.encoders = npz,
+                                         .imu = "",
+                                         .hokuyo = "",
+                                         .kinect = "",
+                                         .kinect_images = "",
+                                         .dataset = 0},
+                                          slam::Ece276aFiles{.encoders = encoders_csv,
+                                          .imu = npz,
+                                          .hokuyo = "",
+                                          .kinect = "",
+                                          .kinect_images = "",
+                                          .dataset = 0},
+                                          slam::Ece276aFiles{.encoders = encoders_csv,
+                                          .imu = "",
+                                          .hokuyo = npz,
+                                          .kinect = "",
+                                          .kinect_images = "",
+                                          .dataset = 0}}) {
     try {
       CheckDataset(slam::ReadEce276a(files));
     } catch (const ParseError&) {

@@ -13,7 +13,9 @@
 #include "slam/io/atomic_file.h"
 #include "slam/io/bag/bag_sink.h"
 #include "slam/io/carmen_sink.h"
+#include "slam/io/ece276a_writer.h"
 #include "slam/io/tum_io.h"
+#include "slam/odometry/robot_odometry.h"
 #include "slam/types/check.h"
 #include "slam/types/error.h"
 #include "slam/types/interrupt.h"
@@ -53,6 +55,12 @@ std::vector<std::string> RunOptions::Validate() const {
 }
 
 std::vector<std::string> RecordingOptions::Validate() const {
+  if (format == RecordingFormat::kEce276a) {
+    if (ece276a_dataset < 0) {
+      return {RuleViolation("ece276a_dataset", ece276a_dataset, "must be >= 0")};
+    }
+    return {};
+  }
   if (format == RecordingFormat::kCarmen) return {};
   return topics.Validate();
 }
@@ -85,8 +93,15 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
   // One sink, by format; the concrete one is kept for its counters.
   std::unique_ptr<slam::CarmenSink> carmen_sink;
   std::unique_ptr<slam::BagSink> bag_sink;
+  std::unique_ptr<slam::Ece276aSink> ece276a_sink;
+  // The ECE276A layout has no odometry: the summary's comes from the same integration.
+  std::optional<slam::RobotOdometry> ece276a_odometry;
   const std::string run_name = recording.format == RecordingFormat::kCarmen ? "run.log" : "run";
-  if (recording.format == RecordingFormat::kCarmen) {
+  if (recording.format == RecordingFormat::kEce276a) {
+    ece276a_sink = std::make_unique<slam::Ece276aSink>(
+        out_dir, slam::Ece276aWriteOptions{.dataset = recording.ece276a_dataset});
+    ece276a_odometry.emplace(odometry);
+  } else if (recording.format == RecordingFormat::kCarmen) {
     slam::CarmenSinkOptions carmen;
     carmen.odometry = odometry;
     carmen.params = {
@@ -111,13 +126,16 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
     if (fs::exists(fs::path(dir + run_name) / "metadata.yaml")) fs::remove_all(dir + run_name);
     bag_sink = std::make_unique<slam::BagSink>(dir + run_name, bag);
   }
-  slam::RecordSink& log = carmen_sink ? static_cast<slam::RecordSink&>(*carmen_sink) : *bag_sink;
+  slam::RecordSink& log = carmen_sink    ? static_cast<slam::RecordSink&>(*carmen_sink)
+                          : ece276a_sink ? static_cast<slam::RecordSink&>(*ece276a_sink)
+                                         : *bag_sink;
 
   Trajectory truth_at_scans;
   auto consume = [&](const sim::StepResult& step) {
     for (std::size_t i = 0; i < step.records.size(); ++i) {
       const Record& record = step.records[i];
       const GroundTruthPose truth = step.truth[i].ToGroundTruthPose();
+      if (ece276a_odometry) ece276a_odometry->Add(record);
       if (const auto* scan = std::get_if<LaserScan>(&record)) {
         truth_at_scans.Append(scan->time, truth.map_from_base);
         log.Add(record, &truth);
@@ -140,21 +158,33 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
   consume(advance(true));
   log.Commit();
 
-  summary.num_scans = carmen_sink ? carmen_sink->scans() : bag_sink->scans();
-  summary.num_odometry =
-      carmen_sink ? carmen_sink->odometry_lines() : bag_sink->odometry_messages();
-  summary.num_imu = carmen_sink ? carmen_sink->imu_samples() : bag_sink->imu_samples();
+  if (ece276a_sink) {
+    summary.num_scans = ece276a_sink->scans();
+    summary.num_odometry = ece276a_sink->encoder_readings();
+    summary.num_imu = ece276a_sink->imu_samples();
+    summary.final_odometry = ece276a_odometry->pose();
+  } else {
+    summary.num_scans = carmen_sink ? carmen_sink->scans() : bag_sink->scans();
+    summary.num_odometry =
+        carmen_sink ? carmen_sink->odometry_lines() : bag_sink->odometry_messages();
+    summary.num_imu = carmen_sink ? carmen_sink->imu_samples() : bag_sink->imu_samples();
+    summary.final_odometry = carmen_sink ? carmen_sink->odometry_pose() : bag_sink->odometry_pose();
+  }
   summary.num_frames = rig ? rig->frames() : 0;
   summary.frames_skipped = carmen_sink ? carmen_sink->frames_skipped() : 0;
   summary.duration_s = sim.time().seconds();
   summary.drive_finished = sim.drive_finished();
   summary.final_truth = sim.Truth().map_from_base;
-  summary.final_odometry = carmen_sink ? carmen_sink->odometry_pose() : bag_sink->odometry_pose();
   slam::WriteTum(dir + "truth.tum", truth_at_scans);
   slam::WriteFileAtomically(dir + "world.yaml", sim::WorldSpecToYaml(options.world));
   slam::WriteFileAtomically(dir + "robot.yaml", sim::RobotSpecToYaml(options.robot));
   slam::WriteFileAtomically(dir + "sim.yaml", SimSettingsYaml(options, summary));
-  for (const std::string& name : {run_name, std::string("truth.tum"), std::string("world.yaml"),
+  if (ece276a_sink) {
+    summary.files = ece276a_sink->files();
+  } else {
+    summary.files.push_back(dir + run_name);
+  }
+  for (const std::string& name : {std::string("truth.tum"), std::string("world.yaml"),
                                   std::string("robot.yaml"), std::string("sim.yaml")}) {
     summary.files.push_back(dir + name);
   }

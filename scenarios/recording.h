@@ -25,6 +25,7 @@ enum class RecordingFormat {
   kCarmen,   ///< run.log, a CARMEN log (slam::CarmenSink)
   kMcap,     ///< run/, a ROS 2 bag with MCAP storage (slam::BagSink)
   kSqlite3,  ///< run/, a ROS 2 bag with sqlite3 storage (slam::BagSink)
+  kEce276a,  ///< Encoders<N>.npz, Imu<N>.npz, Hokuyo<N>.npz, Kinect<N>.npz, dataRGBD/ (ECE276A)
 };
 
 /// How a recorded run is written.
@@ -34,6 +35,8 @@ struct RecordingOptions {
   slam::McapCompression compression = slam::McapCompression::kZstd;
   /// Bags only: topic names (the ROS defaults).
   slam::BagTopicNames topics;
+  /// ECE276A only: the dataset number <N> in the file names.
+  int ece276a_dataset = 20;
 
   /// One RuleViolation() message per broken rule; empty when valid.
   std::vector<std::string> Validate() const;
@@ -63,8 +66,12 @@ struct RunSummary {
 ///  - with kMcap or kSqlite3, run/: a ROS 2 bag through slam::BagSink (the records, the same
 ///    robot odometry on /odom and /tf, the truth at every scan on /ground_truth/odom); a bag
 ///    folder left by an earlier run is replaced;
+///  - with kEce276a, the files of the UCSD ECE276A project 2 data through slam::Ece276aSink
+///    (encoder ticks, IMU, Hokuyo scans, Kinect images), which the reports' own code and
+///    slam::ReadEce276a read; the layout has no odometry or truth (truth.tum has it);
 ///  - a robot with a camera (robot.camera) renders frames into the stream (sim::CameraRig); a
-///    bag carries them as sensor_msgs/Image and CameraInfo, a CARMEN log skips and counts them;
+///    bag carries them as sensor_msgs/Image and CameraInfo, the ECE276A layout as its RGB and
+///    disparity PNGs, a CARMEN log skips and counts them;
 ///  - in every format, truth.tum: ground truth at every scan time (TUM format); world.yaml,
 ///    robot.yaml: the resolved world and robot; sim.yaml: seed, rates, duration, written last
 ///    (an earlier one removed first), so that a folder with a sim.yaml is complete.

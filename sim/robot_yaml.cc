@@ -1,5 +1,7 @@
 #include "sim/robot_yaml.h"
 
+#include <filesystem>
+
 #include "sim/mount_pose.h"
 #include "slam/config/fields.h"
 
@@ -175,6 +177,18 @@ RobotSpec ParseRobotSpec(const YamlNode& node) {
   RobotSpec spec;
   FieldReader reader(node);
   VisitFields(reader, spec);
+  // The camera's texture folder, like a world's map file, is relative to the file naming it.
+  if (spec.camera && !spec.camera->texture_dir.empty()) {
+    namespace fs = std::filesystem;
+    const YamlNode dir_node = node.Required("camera").Required("texture_dir");
+    fs::path dir(spec.camera->texture_dir);
+    if (dir.is_relative() && !node.file().empty()) dir = fs::path(node.file()).parent_path() / dir;
+    spec.camera->texture_dir = fs::absolute(dir).lexically_normal().string();
+    std::error_code error;
+    if (!fs::is_directory(spec.camera->texture_dir, error)) {
+      dir_node.Fail("no such folder '" + spec.camera->texture_dir + "'");
+    }
+  }
   node.ThrowIfInvalid(spec.Validate());
   return spec;
 }

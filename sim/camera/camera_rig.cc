@@ -1,8 +1,13 @@
 #include "sim/camera/camera_rig.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <utility>
+#include <vector>
+
+#include "slam/types/error.h"
 
 namespace slamrig::sim {
 
@@ -16,12 +21,48 @@ StepResult CameraRig::Step() {
   const Time now = simulator_.time();
   if (next_frame_ * period_ns_ <= now.ns) {
     TruthSample truth = simulator_.Truth();
-    pending_.push_back({camera_.Render(truth.map_from_base, now), std::move(truth)});
+    const World& world = simulator_.world();
+    std::vector<Eigen::Vector2d> obstacles;
+    for (std::size_t i = 0; i < world.spec().obstacles.size(); ++i) {
+      obstacles.push_back(world.ObstaclePositionAt(i, now));
+    }
+    RgbdFrame frame = camera_.Render(truth.map_from_base, now, obstacles);
+    CheckDepth(frame, truth.map_from_base);
+    pending_.push_back({std::move(frame), std::move(truth)});
     ++frames_;
     // One frame per step at most: a camera faster than the physics renders at the physics rate.
     while (next_frame_ * period_ns_ <= now.ns) ++next_frame_;
   }
   return Merge(std::move(step), simulator_.released_before());
+}
+
+void CameraRig::CheckDepth(const RgbdFrame& frame, const Pose2& map_from_base) {
+  const bool any =
+      std::any_of(frame.depth_m.begin(), frame.depth_m.end(), [](float z) { return z > 0.0f; });
+  if (any) {
+    blind_since_.reset();
+    return;
+  }
+  if (!blind_since_) blind_since_ = frame.time;
+  // A robot nosing a wall sees only nearer than min_depth_m for a moment; a first frame without
+  // depth, or seconds of them, is a camera set up to see nothing.
+  const double blind_s = static_cast<double>(frame.time.ns - blind_since_->ns) * 1e-9;
+  const bool first = frames_ == 0;  // counted after this check
+  if (!first && blind_s < kMaxBlindS) return;
+  const CameraSpec& spec = camera_.spec();
+  std::ostringstream msg;
+  msg << "camera '" << spec.name << "': no depth reading in any pixel ";
+  if (first) {
+    msg << "of the first frame,";
+  } else {
+    msg << "for " << kMaxBlindS << " s up to";
+  }
+  msg << " t = " << frame.time.seconds() << " s (robot at " << map_from_base.x() << ", "
+      << map_from_base.y() << ", " << map_from_base.theta() << "): everything it sees is nearer "
+      << "than camera.min_depth_m = " << spec.min_depth_m
+      << " or farther than camera.max_depth_m = " << spec.max_depth_m
+      << "; check those and camera.mount";
+  throw ConfigError(msg.str());
 }
 
 StepResult CameraRig::Flush() {

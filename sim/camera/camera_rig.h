@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <optional>
 
 #include "sim/camera/rgbd_camera.h"
 #include "sim/simulator.h"
@@ -15,8 +16,14 @@ namespace slamrig::sim {
 /// simulator's truth then. The simulator only ever sees Step() and Flush() calls through here;
 /// its other controls (Teleport, overrides) stay the caller's. The camera's noise has its own
 /// stream, so a run with the camera gives every other record bit for bit as one without.
+/// Moving obstacles are rendered where the simulator has them at each frame. A camera without a
+/// single depth reading in its first frame, or in every frame for kMaxBlindS seconds, is a
+/// ConfigError naming its min_depth_m, max_depth_m and mount: such a camera maps nothing.
 class CameraRig {
  public:
+  /// Seconds of frames without any depth reading after which the camera is judged blind.
+  static constexpr double kMaxBlindS = 5.0;
+
   /// Renders the camera `spec` in `simulator`'s world (which must outlive the rig). Throws as
   /// RgbdCamera does.
   CameraRig(Simulator* simulator, const CameraSpec& spec, std::uint64_t seed);
@@ -37,6 +44,7 @@ class CameraRig {
     TruthSample truth;
   };
   StepResult Merge(StepResult step, Time released_before);
+  void CheckDepth(const RgbdFrame& frame, const Pose2& map_from_base);
 
   Simulator& simulator_;
   RgbdCamera camera_;
@@ -44,6 +52,7 @@ class CameraRig {
   std::int64_t next_frame_ = 1;
   std::deque<Pending> pending_;  // rendered, waiting for the records stamped before them
   int frames_ = 0;
+  std::optional<Time> blind_since_;  // first of the latest run of frames without depth
 };
 
 }  // namespace slamrig::sim

@@ -2,12 +2,17 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <vector>
 
 #include "sim/camera/camera_test_world.h"
 #include "sim/presets.h"
 #include "sim/robot_yaml.h"
 #include "sim/world_yaml.h"
+#include "slam/types/error.h"
 
 namespace slamrig::sim {
 namespace {
@@ -76,6 +81,115 @@ TEST(CameraRigTest, FramesJoinTheStreamInTimeOrderAndChangeNoOtherRecord) {
       EXPECT_EQ(imu->angular_velocity_rad_s,
                 std::get<ImuSample>(without[i]).angular_velocity_rad_s);
     }
+  }
+}
+
+TEST(CameraRigTest, MovingObstaclesAreInTheFramesWhereTheSimulatorHasThem) {
+  // The robot at rest facing a person who walks across its view, 2 m ahead.
+  SimulatorOptions o = Office();
+  o.world.drive.mode = DriveMode::kIdle;
+  const Eigen::Vector2d ahead = o.world.spawn * Eigen::Vector2d(2.0, 0.0);
+  const Eigen::Vector2d side(-std::sin(o.world.spawn.theta()), std::cos(o.world.spawn.theta()));
+  ObstacleSpec person;
+  person.shape.type = ShapeType::kCircle;
+  person.shape.radius_m = 0.25;
+  person.path_m = {ahead - 2.0 * side, ahead + 2.0 * side};
+  person.speed_m_s = 1.0;
+  person.loop = false;
+  o.world.obstacles = {person};
+  CameraSpec spec;
+  spec.width_px = 80;
+  spec.height_px = 60;
+  spec.intrinsics = {73.1, 73.1, 39.5, 29.5};
+  spec.floor_texel_m = 0.05;  // a coarse floor texture builds fast
+  spec.rate_hz = 10.0;
+  spec.mount.pitch_rad = 0.0;
+  spec.mount.yaw_rad = 0.0;
+  spec.depth_offset_x_m = 0.0;
+  spec.depth_model = DepthModel::kIdeal;
+  Simulator sim(o);
+  CameraRig rig(&sim, spec, 5);
+  std::vector<TruthSample> truth;
+  const std::vector<Record> records = Drive(sim, &rig, 4.0, &truth);
+  int near = 0, far = 0;
+  for (const Record& r : records) {
+    const auto* f = std::get_if<RgbdFrame>(&r);
+    if (f == nullptr) continue;
+    const double centre = f->depth_m[29 * 80 + 39];
+    // Straight ahead: the person's near side (2 - 0.25 - 0.18 m from the camera) while crossing
+    // in front, else whatever lies beyond.
+    const Eigen::Vector2d p = sim.world().ObstaclePositionAt(0, f->time);
+    const double offset = std::abs(side.dot(p - ahead));
+    if (offset < 0.1) {
+      EXPECT_NEAR(centre, 2.0 - 0.25 - 0.18, 0.05) << f->time.seconds();
+      ++near;
+    } else if (offset > 0.4) {
+      EXPECT_TRUE(centre == 0.0 || centre > 2.0) << f->time.seconds() << ": " << centre;
+      ++far;
+    }
+  }
+  EXPECT_GE(near, 1);
+  EXPECT_GE(far, 10);
+}
+
+TEST(CameraRigTest, ACameraWithoutAnyDepthReadingIsAnError) {
+  SimulatorOptions o = Office();
+  CameraSpec spec;
+  spec.width_px = 80;
+  spec.height_px = 60;
+  spec.intrinsics = {73.1, 73.1, 39.5, 29.5};
+  spec.floor_texel_m = 0.05;  // a coarse floor texture builds fast
+  spec.min_depth_m = 0.1;
+  spec.max_depth_m = 0.2;  // nothing is that near
+  Simulator sim(o);
+  CameraRig rig(&sim, spec, 5);
+  try {
+    std::vector<TruthSample> truth;
+    Drive(sim, &rig, 1.0, &truth);
+    FAIL() << "expected a ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("camera 'kinect': no depth reading in any pixel of the "
+                                         "first frame, t = 0.1 s"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("camera.max_depth_m = 0.2"), std::string::npos);
+  }
+}
+
+TEST(CameraRigTest, TextureFolderIsRelativeToTheRobotFile) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "robot_tex";
+  std::filesystem::remove_all(dir);
+  testing::WriteSolidPng((dir / "my_textures").string(), "grey.png", {90, 90, 90});
+  const auto write = [&](const std::string& name, const std::string& camera) {
+    std::ifstream in(FindPresetFile("ece276a", "robots"));
+    std::stringstream yaml;
+    yaml << in.rdbuf() << "camera:\n" << camera;
+    std::ofstream((dir / name).string()) << yaml.str();
+    return (dir / name).string();
+  };
+  const RobotSpec robot = LoadRobotSpec(
+      write("ok.yaml", "  texture_dir: my_textures\n  floor_image: grey.png\n  wall_image: ''\n"));
+  EXPECT_EQ(robot.camera->texture_dir, (dir / "my_textures").string());
+  // A folder that is not there is the robot file's error, at its line.
+  const std::string bad = write("bad.yaml", "  texture_dir: no_such_folder\n");
+  try {
+    LoadRobotSpec(bad);
+    FAIL() << "expected a ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(bad + ":"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("camera.texture_dir"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no_such_folder"), std::string::npos) << e.what();
+  }
+  // A missing image in that folder names the file and the key.
+  const RobotSpec missing = LoadRobotSpec(write("missing.yaml", "  texture_dir: my_textures\n"));
+  try {
+    RgbdCamera camera(Office().world, *missing.camera);
+    FAIL() << "expected a ParseError";
+  } catch (const ParseError& e) {
+    EXPECT_NE(std::string(e.what()).find((dir / "my_textures" / "tiles.png").string() +
+                                         ": camera.floor_image: texture file not found"),
+              std::string::npos)
+        << e.what();
   }
 }
 

@@ -1,16 +1,12 @@
 #pragma once
 
+// The disparity model lives in slam/io, where the ECE276A reader and writer need it; the camera
+// renders through the same functions.
+#include "slam/io/kinect_disparity.h"
+
 namespace slamrig::sim {
 
-/// The ECE276A Kinect's depth from its raw disparity value `d` (Wang, "Simultaneous Localization
-/// and Mapping with Texture", ECE276A report, Eq. 18): depth = 1.03 / (-0.00304 d + 3.31) metres.
-/// Returns 0 (no reading) where the denominator is not positive (d >= ~1088.8).
-inline double KinectDepthFromDisparity(double d) {
-  const double denominator = -0.00304 * d + 3.31;
-  return denominator > 0.0 ? 1.03 / denominator : 0.0;
-}
-
-/// The inverse of KinectDepthFromDisparity for a depth > 0: d = (3.31 - 1.03 / depth) / 0.00304.
-inline double KinectDisparityFromDepth(double depth_m) { return (3.31 - 1.03 / depth_m) / 0.00304; }
+using slam::KinectDepthFromDisparity;
+using slam::KinectDisparityFromDepth;
 
 }  // namespace slamrig::sim

@@ -25,6 +25,8 @@ constexpr char kModelFile[] = "slamrig_camera.xml";
 constexpr char kFloorFile[] = "slamrig_floor.png";
 constexpr char kWallFile[] = "slamrig_wall.png";
 constexpr double kEdgeWallThicknessM = 0.05;  // polyline walls have no thickness in Box2D
+// Moving obstacles (people in the scenarios) in a blue-grey no floor texture or wall uses.
+constexpr double kObstacleRgb[3] = {0.25, 0.35, 0.6};
 
 // How the rendered (centred) image maps onto the requested one.
 struct RenderLayout {
@@ -65,9 +67,10 @@ RenderLayout Layout(const CameraSpec& spec) {
   return l;
 }
 
-// The MJCF of the world: walls, the textured floor plane, and the camera rig on a mocap body.
+// The MJCF of the world: walls, the textured floor plane, the camera rig on a mocap body, and a
+// mocap body per moving obstacle (named obstacle<i>, at the start of its path).
 std::string BuildMjcf(const CameraSpec& spec, const FloorTexture& floor, const RenderLayout& l,
-                      bool wall_texture) {
+                      bool wall_texture, const std::vector<ObstacleSpec>& obstacles) {
   std::ostringstream x;
   x.precision(9);
   const double h = spec.wall_height_m;
@@ -91,6 +94,8 @@ std::string BuildMjcf(const CameraSpec& spec, const FloorTexture& floor, const R
       << 1.0 / spec.wall_tile_m << "\"";
   }
   x << "/>\n";
+  x << "    <material name=\"obstacle\" rgba=\"" << kObstacleRgb[0] << ' ' << kObstacleRgb[1] << ' '
+    << kObstacleRgb[2] << " 1\" specular=\"0\" shininess=\"0\" reflectance=\"0\"/>\n";
   if (wall_texture) x << "    <texture name=\"wall\" type=\"2d\" file=\"" << kWallFile << "\"/>\n";
   int mesh_id = 0;
   std::ostringstream geoms;
@@ -148,8 +153,26 @@ std::string BuildMjcf(const CameraSpec& spec, const FloorTexture& floor, const R
     << "      <camera name=\"rgb\" pos=\"0 0 0\" fovy=\"" << l.fovy_deg << "\"/>\n"
     << "      <camera name=\"depth\" pos=\"" << spec.depth_offset_x_m << " 0 0\" fovy=\""
     << l.fovy_deg << "\"/>\n"
-    << "    </body>\n"
-    << "  </worldbody>\n"
+    << "    </body>\n";
+  for (std::size_t i = 0; i < obstacles.size(); ++i) {
+    const ObstacleSpec& o = obstacles[i];
+    const ShapeSpec& s = o.shape;
+    x << "    <body name=\"obstacle" << i << "\" mocap=\"true\" pos=\"" << o.path_m.front().x()
+      << ' ' << o.path_m.front().y() << " 0\">\n";
+    if (s.type == ShapeType::kCircle) {
+      x << "      <geom type=\"cylinder\" material=\"obstacle\" pos=\"" << s.center_m.x() << ' '
+        << s.center_m.y() << ' ' << h / 2 << "\" size=\"" << s.radius_m << ' ' << h / 2 << "\"/>\n";
+    } else if (s.type == ShapeType::kBox) {
+      x << "      <geom type=\"box\" material=\"obstacle\" pos=\"" << s.center_m.x() << ' '
+        << s.center_m.y() << ' ' << h / 2 << "\" size=\"" << s.size_m.x() / 2 << ' '
+        << s.size_m.y() / 2 << ' ' << h / 2 << "\" euler=\"0 0 " << s.angle_rad << "\"/>\n";
+    } else {
+      throw ConfigError("camera '" + spec.name + "': obstacles[" + std::to_string(i) + "] ('" +
+                        o.name + "'): the camera renders box and circle obstacles only");
+    }
+    x << "    </body>\n";
+  }
+  x << "  </worldbody>\n"
     << "</mujoco>\n";
   return x.str();
 }
@@ -187,6 +210,8 @@ struct RgbdCamera::Impl {
   double far_m = 0.0;
   std::vector<unsigned char> rgb_buffer;
   std::vector<float> depth_buffer;
+  int rig_mocap = 0;
+  std::vector<int> obstacle_mocap;  // mocap index of obstacle i
 
   Impl(const WorldSpec& world, const CameraSpec& s, std::uint64_t seed)
       : spec(s), floor(world, s), layout(Layout(s)), noise(seed, "camera") {
@@ -233,7 +258,7 @@ RgbdCamera::RgbdCamera(const WorldSpec& world, const CameraSpec& spec, std::uint
       AddToVfs(&vfs, kWallFile,
                EncodePng(ReadTextureImage(spec, spec.wall_image, "camera.wall_image")));
     }
-    const std::string xml = BuildMjcf(spec, m.floor, m.layout, wall_texture);
+    const std::string xml = BuildMjcf(spec, m.floor, m.layout, wall_texture, world.obstacles);
     AddToVfs(&vfs, kModelFile, std::vector<unsigned char>(xml.begin(), xml.end()));
   } catch (...) {
     mj_deleteVFS(&vfs);
@@ -246,6 +271,17 @@ RgbdCamera::RgbdCamera(const WorldSpec& world, const CameraSpec& spec, std::uint
     throw std::runtime_error("camera '" + spec.name + "': MuJoCo rejected the model: " + error);
   }
   m.data = mj_makeData(m.model);
+  const auto mocap = [&](const std::string& body) {
+    const int id = mj_name2id(m.model, mjOBJ_BODY, body.c_str());
+    if (id < 0 || m.model->body_mocapid[id] < 0) {
+      throw std::runtime_error("camera '" + spec.name + "': MuJoCo model has no mocap " + body);
+    }
+    return m.model->body_mocapid[id];
+  };
+  m.rig_mocap = mocap("rig");
+  for (std::size_t i = 0; i < world.obstacles.size(); ++i) {
+    m.obstacle_mocap.push_back(mocap("obstacle" + std::to_string(i)));
+  }
   m.near_m = m.model->vis.map.znear * m.model->stat.extent;
   m.far_m = m.model->vis.map.zfar * m.model->stat.extent;
 
@@ -274,8 +310,22 @@ const CameraSpec& RgbdCamera::spec() const { return impl_->spec; }
 const CameraIntrinsics& RgbdCamera::intrinsics() const { return impl_->layout.effective; }
 const FloorTexture& RgbdCamera::floor() const { return impl_->floor; }
 
-RgbdFrame RgbdCamera::Render(const Pose2& map_from_base, Time t) {
+RgbdFrame RgbdCamera::Render(const Pose2& map_from_base, Time t,
+                             const std::vector<Eigen::Vector2d>& obstacle_positions_m) {
   Impl& m = *impl_;
+  if (!obstacle_positions_m.empty()) {
+    if (obstacle_positions_m.size() != m.obstacle_mocap.size()) {
+      throw std::invalid_argument(
+          "camera '" + m.spec.name + "': " + std::to_string(obstacle_positions_m.size()) +
+          " obstacle positions for " + std::to_string(m.obstacle_mocap.size()) + " obstacles");
+    }
+    for (std::size_t i = 0; i < obstacle_positions_m.size(); ++i) {
+      double* p = m.data->mocap_pos + 3 * m.obstacle_mocap[i];
+      p[0] = obstacle_positions_m[i].x();
+      p[1] = obstacle_positions_m[i].y();
+      p[2] = 0.0;
+    }
+  }
   const CameraSpec& spec = m.spec;
   m.egl.MakeCurrent();
 
@@ -291,11 +341,13 @@ RgbdFrame RgbdCamera::Render(const Pose2& map_from_base, Time t) {
       0, 1, 0;
   const Eigen::Isometry3d world_from_rig = world_from_base * spec.mount.BaseFromCamera();
   const Eigen::Quaterniond q(world_from_rig.linear() * camera_from_mujoco);
-  for (int i = 0; i < 3; ++i) m.data->mocap_pos[i] = world_from_rig.translation()[i];
-  m.data->mocap_quat[0] = q.w();
-  m.data->mocap_quat[1] = q.x();
-  m.data->mocap_quat[2] = q.y();
-  m.data->mocap_quat[3] = q.z();
+  double* rig_pos = m.data->mocap_pos + 3 * m.rig_mocap;
+  double* rig_quat = m.data->mocap_quat + 4 * m.rig_mocap;
+  for (int i = 0; i < 3; ++i) rig_pos[i] = world_from_rig.translation()[i];
+  rig_quat[0] = q.w();
+  rig_quat[1] = q.x();
+  rig_quat[2] = q.y();
+  rig_quat[3] = q.z();
   mj_kinematics(m.model, m.data);
   mj_camlight(m.model, m.data);
 

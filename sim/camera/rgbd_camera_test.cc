@@ -197,6 +197,35 @@ TEST_F(RgbdCameraTest, ACameraThatSeesNothingIsAnError) {
   }
 }
 
+TEST_F(RgbdCameraTest, MovingObstaclesAreDrawnWhereTheyAreSaidToBe) {
+  ObstacleSpec person;
+  person.name = "person";
+  person.shape.type = ShapeType::kCircle;
+  person.shape.radius_m = 0.3;
+  person.path_m = {{3.0, 0.0}, {3.0, 1.8}};
+  ObstacleSpec cart;  // a box 0.4 m deep whose origin is 0.5 m behind its centre
+  cart.name = "cart";
+  cart.shape.center_m = {0.5, 0.0};
+  cart.shape.size_m = {0.4, 0.4};
+  cart.path_m = {{1.0, -1.5}, {1.0, 1.5}};
+  world_.obstacles = {person, cart};
+  RgbdCamera camera(world_, spec_);
+  // At first each stands at the start of its path: the person 2.6 m ahead of the camera.
+  const RgbdFrame at_start = camera.Render(Pose2(0.0, 0.0, 0.0), Time());
+  EXPECT_NEAR(DepthAt(at_start, 80, 60), 3.0 - 0.3 - 0.1, 0.01);
+  const cv::Vec3b blue_grey(64, 89, 153);
+  EXPECT_LE(cv::norm(RgbAt(at_start, 80, 60), blue_grey, cv::NORM_INF), 2.0);
+  // The person moved aside and the cart into view: its near face at 1.5 - 0.2 - 0.1.
+  const RgbdFrame moved = camera.Render(Pose2(0.0, 0.0, 0.0), Time(),
+                                        {Eigen::Vector2d(3.0, 1.8), Eigen::Vector2d(1.0, 0.0)});
+  EXPECT_NEAR(DepthAt(moved, 80, 60), 1.5 - 0.2 - 0.1, 0.01);
+  // The cart gone too: the east wall behind them.
+  const RgbdFrame clear = camera.Render(Pose2(0.0, 0.0, 0.0), Time(),
+                                        {Eigen::Vector2d(3.0, 1.8), Eigen::Vector2d(1.0, 1.5)});
+  EXPECT_NEAR(DepthAt(clear, 80, 60), 4.9, 0.01);
+  EXPECT_THROW(camera.Render(Pose2(), Time(), {Eigen::Vector2d(0.0, 0.0)}), std::invalid_argument);
+}
+
 TEST_F(RgbdCameraTest, BadSpecAndMissingTextureAreErrors) {
   CameraSpec bad = spec_;
   bad.intrinsics.fx_px = 100.0;

@@ -1,5 +1,6 @@
-// Reader for the UCSD ECE276A project 2 robot logs (Encoders/Imu/Hokuyo .npz, and the csv.gz
-// conversions in shared/datasets/ece276a_pr2_partial, whose SOURCE.md gives the layouts).
+// Reader for the UCSD ECE276A project 2 robot logs (Encoders/Imu/Hokuyo/Kinect .npz with the
+// dataRGBD images, and the csv.gz conversions in shared/datasets/ece276a_pr2_partial, whose
+// SOURCE.md gives the layouts).
 #include "slam/io/ece276a_reader.h"
 
 #include <algorithm>
@@ -8,8 +9,12 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "slam/io/kinect_disparity.h"
 #include "slam/io/line_reader.h"
 #include "slam/io/npz_reader.h"
 #include "slam/types/error.h"
@@ -109,6 +114,50 @@ void CheckStamp(double t, const std::string& path, std::size_t index) {
   }
 }
 
+// The stamps `key` of `path`, each representable and none earlier than the one before.
+std::vector<double> SortedStamps(const std::map<std::string, NpyArray>& arrays,
+                                 const std::string& key, const std::string& path) {
+  const std::vector<double> t = Stamps(arrays, key, path);
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (!(std::abs(t[i]) <= 9.2e9)) {
+      throw ParseError(path + ": " + key + "[" + std::to_string(i) + "]: " + std::to_string(t[i]) +
+                       " s is outside +-9.2e9 s");
+    }
+    if (i > 0 && t[i] < t[i - 1]) {
+      throw ParseError(path + ": " + key + "[" + std::to_string(i) + "]: earlier than the stamp " +
+                       "before it; images are indexed in time order");
+    }
+  }
+  return t;
+}
+
+// One image of the Kinect layout: `type` (CV_8UC3 or CV_16UC1), of the size of the first one read
+// (*width, *height; 0 until then). `what` says which frame it is.
+cv::Mat ReadKinectImage(const std::string& path, int type, const std::string& what, int* width,
+                        int* height) {
+  std::error_code error;
+  if (!fs::is_regular_file(path, error)) throw ParseError(path + ": missing (" + what + ")");
+  cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (image.empty()) {
+    throw ParseError(path + ": not an image OpenCV can read, corrupt or truncated (" + what + ")");
+  }
+  if (image.type() != type) {
+    throw ParseError(path + ": expected " +
+                     std::string(type == CV_16UC1 ? "a 16-bit one-channel" : "an 8-bit colour") +
+                     " PNG, got " + std::to_string(image.channels()) + " channel(s) of " +
+                     std::to_string(8 * image.elemSize1()) + " bits (" + what + ")");
+  }
+  if (*width == 0) {
+    *width = image.cols;
+    *height = image.rows;
+  } else if (image.cols != *width || image.rows != *height) {
+    throw ParseError(path + ": " + std::to_string(image.cols) + " x " + std::to_string(image.rows) +
+                     " pixels, the frames before it " + std::to_string(*width) + " x " +
+                     std::to_string(*height) + " (" + what + ")");
+  }
+  return image;
+}
+
 bool IsNpz(const std::string& path) { return fs::path(path).extension() == ".npz"; }
 
 // The dataset number and folder of a path, e.g. ("DIR", "20") for DIR/Encoders20.npz or DIR/20.
@@ -127,7 +176,8 @@ bool SplitDataset(const std::string& path, std::string* dir, std::string* number
   std::string prefix = name.substr(0, digits);
   std::transform(prefix.begin(), prefix.end(), prefix.begin(),
                  [](unsigned char c) { return std::tolower(c); });
-  if (!prefix.empty() && prefix != "encoders" && prefix != "imu" && prefix != "hokuyo")
+  if (!prefix.empty() && prefix != "encoders" && prefix != "imu" && prefix != "hokuyo" &&
+      prefix != "kinect")
     return false;
   *dir = p.has_parent_path() ? p.parent_path().string() : ".";
   *number = name.substr(digits);
@@ -165,6 +215,9 @@ Ece276aFiles FindEce276aFiles(const std::string& path) {
   }
   files.imu = FindOne(dir, "Imu" + number + ".npz", "imu" + number + ".csv.gz");
   files.hokuyo = FindOne(dir, "Hokuyo" + number + ".npz", "");
+  files.kinect = FindOne(dir, "Kinect" + number + ".npz", "");
+  files.kinect_images = (fs::path(dir) / "dataRGBD").string();
+  files.dataset = std::stoi(number.substr(0, 9));
   return files;
 }
 
@@ -285,6 +338,65 @@ Dataset ReadEce276a(const Ece276aFiles& files, const Ece276aReadOptions& options
     }
   } else {
     data.notes.push_back("no Hokuyo file: encoders and IMU only (dead reckoning, no map)");
+  }
+
+  // Kinect: each disparity image with the RGB image nearest in time, as the reports pair them.
+  if (!files.kinect.empty()) {
+    const std::string& path = files.kinect;
+    if (options.kinect_every < 1) {
+      throw ConfigError("kinect_every = " + std::to_string(options.kinect_every) +
+                        "; must be >= 1");
+    }
+    const auto arrays = ReadNpz(path);
+    const std::vector<double> td = SortedStamps(arrays, "disparity_time_stamps", path);
+    const std::vector<double> tr = SortedStamps(arrays, "rgb_time_stamps", path);
+    if (tr.empty() && !td.empty()) {
+      throw ParseError(path + ": rgb_time_stamps: empty, but there are disparity images");
+    }
+    const std::string n = std::to_string(files.dataset);
+    const fs::path images(files.kinect_images);
+    int width = 0, height = 0;
+    double widest_gap_s = 0.0;
+    std::size_t invalid = 0, frames = 0;
+    for (std::size_t i = 0; i < td.size(); i += static_cast<std::size_t>(options.kinect_every)) {
+      std::size_t j =
+          static_cast<std::size_t>(std::lower_bound(tr.begin(), tr.end(), td[i]) - tr.begin());
+      if (j == tr.size() || (j > 0 && td[i] - tr[j - 1] <= tr[j] - td[i])) --j;
+      widest_gap_s = std::max(widest_gap_s, std::abs(tr[j] - td[i]));
+      const std::string di = std::to_string(i + 1), rj = std::to_string(j + 1);
+      const cv::Mat disparity = ReadKinectImage(
+          (images / ("Disparity" + n) / ("disparity" + n + "_" + di + ".png")).string(), CV_16UC1,
+          "disparity image " + di + " of " + path, &width, &height);
+      const cv::Mat bgr = ReadKinectImage(
+          (images / ("RGB" + n) / ("rgb" + n + "_" + rj + ".png")).string(), CV_8UC3,
+          "RGB image " + rj + " of " + path + ", nearest disparity image " + di, &width, &height);
+      RgbdFrame frame;
+      frame.time = Time::FromSeconds(td[i]);
+      frame.width = width;
+      frame.height = height;
+      frame.intrinsics = options.camera_intrinsics;
+      frame.base_from_camera = options.base_from_camera;
+      frame.depth_offset_x_m = options.depth_offset_x_m;
+      cv::Mat rgb;
+      cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+      frame.rgb.assign(rgb.data, rgb.data + rgb.total() * 3);
+      frame.depth_m.resize(static_cast<std::size_t>(width) * height);
+      for (int v = 0; v < height; ++v) {
+        for (int u = 0; u < width; ++u) {
+          const std::uint16_t d = disparity.at<std::uint16_t>(v, u);
+          const double z = d >= kKinectNoDisparity ? 0.0 : KinectDepthFromDisparity(d);
+          if (z == 0.0) ++invalid;
+          frame.depth_m[static_cast<std::size_t>(v) * width + u] = static_cast<float>(z);
+        }
+      }
+      keyed.push_back({td[i], 2, std::move(frame)});
+      ++frames;
+    }
+    std::ostringstream note;
+    note << frames << " Kinect frames (every " << options.kinect_every
+         << ". disparity image, the nearest RGB image at most " << widest_gap_s * 1e3
+         << " ms away); " << invalid << " pixels without a depth reading";
+    data.notes.push_back(note.str());
   }
 
   std::stable_sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {

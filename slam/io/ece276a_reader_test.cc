@@ -199,7 +199,7 @@ TEST(Ece276aReaderTest, CsvAndNpzGiveTheSameRecords) {
   }
   gzclose(f);
   const Dataset csv = ReadEce276a(FindEce276aFiles(dir.File("98")));
-  const Dataset npz = ReadEce276a(Ece276aFiles{dir.File("Encoders99.npz"), "", ""});
+  const Dataset npz = ReadEce276a(Ece276aFiles{dir.File("Encoders99.npz"), "", "", "", "", 0});
   ASSERT_EQ(csv.records.size(), 120u);
   ASSERT_EQ(npz.records.size(), 120u);
   for (std::size_t i = 0; i < 120; ++i) {
@@ -231,7 +231,7 @@ TEST(Ece276aReaderTest, BadFilesAreParseErrorsNamingTheFileAndPlace) {
   // and broke the time order of the records.
   dir.Write("encoders93.csv", "1.0,1,2,3,4\n12988819529.5,1,2,3,4\n");
   try {
-    ReadEce276a(Ece276aFiles{dir.File("encoders93.csv"), "", ""});
+    ReadEce276a(Ece276aFiles{dir.File("encoders93.csv"), "", "", "", "", 0});
     FAIL();
   } catch (const ParseError& e) {
     EXPECT_STREQ(e.what(), (dir.File("encoders93.csv") +
@@ -296,7 +296,7 @@ TEST(Ece276aReaderTest, RealDataset20) {
       (std::filesystem::path(encoders).parent_path() / "encoders20.csv.gz").string();
   const std::string imu_csv =
       (std::filesystem::path(encoders).parent_path() / "imu20.csv.gz").string();
-  const Dataset csv = ReadEce276a(Ece276aFiles{csv_path, imu_csv, ""});
+  const Dataset csv = ReadEce276a(Ece276aFiles{csv_path, imu_csv, "", "", "", 0});
   ASSERT_EQ(npz.records.size(), 4956u + 12187u);
   ASSERT_EQ(csv.records.size(), npz.records.size());
   double right = 0.0, left = 0.0;

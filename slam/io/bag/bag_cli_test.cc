@@ -107,7 +107,7 @@ TEST(BagCliTest, SlamReadsABagAndRejectsADamagedOne) {
   r = slamrig::testing::RunCommand(std::string(SLAMRIG_BINARY) +
                                    " simulate office --format rosbag1 --out " + dir.File("x"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("--format: expected carmen, mcap or sqlite3, got 'rosbag1'"),
+  EXPECT_NE(r.output.find("--format: expected carmen, mcap, sqlite3 or ece276a, got 'rosbag1'"),
             std::string::npos)
       << r.output;
 }

@@ -266,8 +266,7 @@ void BagWriter::Write(const Record& record) {
   if (const auto* scan = std::get_if<LaserScan>(&record)) {
     if (!static_laser_ || !(*static_laser_ == scan->base_from_laser)) {
       static_laser_ = scan->base_from_laser;
-      EncodeTfMessage({{time, f.base, f.laser, scan->base_from_laser}}, &buffer_);
-      Emit(GetTopic(options_.topics.tf_static, static_cast<int>(RosType::kTfMessage), true), time);
+      EmitStaticTransforms(time);
     }
     EncodeLaserScan(*scan, f.laser, &buffer_);
     Emit(GetTopic(options_.topics.scan, static_cast<int>(RosType::kLaserScan), false), time);
@@ -295,6 +294,14 @@ void BagWriter::Write(const Record& record) {
     Emit(GetTopic(options_.topics.joint_states, static_cast<int>(RosType::kJointState), false),
          time);
   } else if (const auto* frame = std::get_if<RgbdFrame>(&record)) {
+    const Eigen::Isometry3d rgb = frame->BaseFromRgbOptical();
+    const Eigen::Isometry3d depth = frame->BaseFromDepthOptical();
+    if (!static_rgb_ || static_rgb_->matrix() != rgb.matrix() ||
+        static_depth_->matrix() != depth.matrix()) {
+      static_rgb_ = rgb;
+      static_depth_ = depth;
+      EmitStaticTransforms(time);
+    }
     EncodeRgbImage(*frame, f.camera, &buffer_);
     Emit(GetTopic(options_.topics.rgb, static_cast<int>(RosType::kImage), false), time);
     EncodeDepthImage(*frame, f.depth, &buffer_);
@@ -310,6 +317,23 @@ void BagWriter::Write(const Record& record) {
       Emit(GetTopic(options_.topics.tf, static_cast<int>(RosType::kTfMessage), false), time);
     }
   }
+}
+
+void BagWriter::EmitStaticTransforms(Time time) {
+  const BagFrames& f = options_.frames;
+  if (!static_rgb_) {
+    // The laser alone: the planar message every bag without a camera has always had.
+    EncodeTfMessage({{time, f.base, f.laser, *static_laser_}}, &buffer_);
+  } else {
+    std::vector<RosTransform3d> all;
+    if (static_laser_) {
+      all.push_back(RosTransform3d::From(RosTransform{time, f.base, f.laser, *static_laser_}));
+    }
+    all.push_back(RosTransform3d::From(time, f.base, f.camera, *static_rgb_));
+    all.push_back(RosTransform3d::From(time, f.base, f.depth, *static_depth_));
+    EncodeTfMessage(all, &buffer_);
+  }
+  Emit(GetTopic(options_.topics.tf_static, static_cast<int>(RosType::kTfMessage), true), time);
 }
 
 void BagWriter::Write(const GroundTruthPose& truth) {

@@ -93,8 +93,13 @@ std::optional<bool> WheelJointIsRight(std::string_view name);
 
 /// A record sink that writes a ROS 2 bag folder, as `ros2 bag record` would: `metadata.yaml`
 /// and `NAME_0.mcap` or `NAME_0.db3`, NAME being the folder's name. Records map to messages as:
-///   LaserScan -> /scan (sensor_msgs/msg/LaserScan, float32 fields, see EncodeLaserScan) and
-///     /tf_static base_link -> laser whenever base_from_laser changes;
+///   LaserScan -> /scan (sensor_msgs/msg/LaserScan, float32 fields, see EncodeLaserScan);
+///   RgbdFrame -> the rgb8 and 32FC1 sensor_msgs/msg/Image and the CameraInfo (see
+///     EncodeRgbImage, EncodeDepthImage, EncodeCameraInfo);
+///   /tf_static whenever base_from_laser or a frame's camera mounting changes: every static
+///     transform known so far in one message (a late subscriber of the latched topic sees only
+///     the last), base_link -> laser (planar) and base_link -> the colour and depth optical
+///     frames (BaseFromRgbOptical, BaseFromDepthOptical; quaternion with w >= 0);
 ///   ImuSample -> /imu (sensor_msgs/msg/Imu, no orientation);
 ///   WheelTicks -> /joint_states (sensor_msgs/msg/JointState): each wheel's position in radians
 ///     is its accumulated ticks since the first record times 2 pi / ticks_per_revolution, so a
@@ -153,7 +158,10 @@ class BagWriter {
   std::vector<Topic> topics_;
   std::map<int, std::uint16_t> mcap_schemas_;
   std::string buffer_;
+  void EmitStaticTransforms(Time time);
   std::optional<Pose2> static_laser_;
+  std::optional<Eigen::Isometry3d> static_rgb_;    // base_from_optical of the colour camera
+  std::optional<Eigen::Isometry3d> static_depth_;  // and of the depth camera
   std::vector<std::int64_t> tick_totals_;
   std::size_t right_wheels_ = 0;
   std::vector<std::string> joint_names_;

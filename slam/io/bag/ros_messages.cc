@@ -381,6 +381,50 @@ std::vector<RosTransform> DecodeTfMessage(std::string_view data) {
   return transforms;
 }
 
+RosTransform3d RosTransform3d::From(Time time, std::string parent, std::string child,
+                                    const Eigen::Isometry3d& t) {
+  RosTransform3d out{time, std::move(parent), std::move(child), t.translation(),
+                     Eigen::Quaterniond(t.linear())};
+  out.rotation.normalize();
+  if (out.rotation.w() < 0.0) out.rotation.coeffs() = -out.rotation.coeffs();
+  return out;
+}
+
+RosTransform3d RosTransform3d::From(const RosTransform& t) {
+  const double yaw = t.parent_from_child.theta();
+  return {t.time, t.parent_frame, t.child_frame,
+          Eigen::Vector3d(t.parent_from_child.x(), t.parent_from_child.y(), 0.0),
+          Eigen::Quaterniond(std::cos(0.5 * yaw), 0.0, 0.0, std::sin(0.5 * yaw))};
+}
+
+void EncodeTfMessage(const std::vector<RosTransform3d>& transforms, std::string* out) {
+  CdrWriter w(out);
+  w.Uint32(static_cast<std::uint32_t>(transforms.size()));
+  for (const RosTransform3d& t : transforms) {
+    WriteHeader(t.time, t.parent_frame, &w);
+    w.String(t.child_frame);
+    for (int i = 0; i < 3; ++i) w.Float64(t.translation[i]);
+    w.Float64(t.rotation.x());
+    w.Float64(t.rotation.y());
+    w.Float64(t.rotation.z());
+    w.Float64(t.rotation.w());
+  }
+}
+
+std::vector<RosTransform3d> DecodeTfMessage3d(std::string_view data) {
+  CdrReader r(data);
+  const std::uint32_t n = r.SequenceLength(72);
+  std::vector<RosTransform3d> transforms(n);
+  for (RosTransform3d& t : transforms) {
+    t.time = ReadHeader(&r, &t.parent_frame);
+    t.child_frame = r.String();
+    for (int i = 0; i < 3; ++i) t.translation[i] = r.Float64();
+    const double x = r.Float64(), y = r.Float64(), z = r.Float64(), w = r.Float64();
+    t.rotation = Eigen::Quaterniond(w, x, y, z);
+  }
+  return transforms;
+}
+
 void EncodeClock(Time time, std::string* out) {
   CdrWriter w(out);
   WriteStamp(time, &w);

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -50,6 +52,21 @@ struct RosTransform {
   Pose2 parent_from_child;
 };
 
+/// A transform in full 3-D (a camera's mounting): translation and unit quaternion as written.
+struct RosTransform3d {
+  Time time;
+  std::string parent_frame;
+  std::string child_frame;
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+
+  /// `t` with its rotation as the quaternion with w >= 0 (Eigen's conversion, sign fixed).
+  static RosTransform3d From(Time time, std::string parent, std::string child,
+                             const Eigen::Isometry3d& t);
+  /// A planar transform exactly as EncodeTfMessage writes it (z = 0, yaw quaternion).
+  static RosTransform3d From(const RosTransform& t);
+};
+
 /// A nav_msgs/Odometry message reduced to what slamrig carries: stamp, frames and planar pose.
 struct RosOdometry {
   Time time;
@@ -82,6 +99,8 @@ void EncodeJointState(Time time, const std::vector<std::string>& names,
 void EncodeOdometry(const RosOdometry& odometry, std::string* out);
 /// tf2_msgs/msg/TFMessage.
 void EncodeTfMessage(const std::vector<RosTransform>& transforms, std::string* out);
+/// tf2_msgs/msg/TFMessage of 3-D transforms.
+void EncodeTfMessage(const std::vector<RosTransform3d>& transforms, std::string* out);
 /// rosgraph_msgs/msg/Clock.
 void EncodeClock(Time time, std::string* out);
 /// sensor_msgs/Image of `frame`'s colour image ("rgb8", top row first).
@@ -106,6 +125,8 @@ RosJointState DecodeJointState(std::string_view data);
 RosOdometry DecodeOdometry(std::string_view data);
 /// tf2_msgs/msg/TFMessage.
 std::vector<RosTransform> DecodeTfMessage(std::string_view data);
+/// tf2_msgs/msg/TFMessage with each transform in full.
+std::vector<RosTransform3d> DecodeTfMessage3d(std::string_view data);
 /// rosgraph_msgs/msg/Clock.
 Time DecodeClock(std::string_view data);
 

@@ -151,6 +151,32 @@ TEST(CdrTest, TfMessageBytes) {
   EXPECT_EQ(back[0].parent_from_child, pose);
 }
 
+TEST(CdrTest, TfMessage3dCarriesACameraMountingAndPlanarOnesAsBefore) {
+  RgbdFrame frame;  // the ECE276A Kinect's mounting: pitched, yawed, 0.36 m up
+  const Eigen::Isometry3d mount = frame.BaseFromRgbOptical();
+  const RosTransform planar{Time{7}, "base_link", "laser", Pose2(0.133, 0.01, 0.2)};
+  std::string out;
+  EncodeTfMessage(
+      {RosTransform3d::From(planar), RosTransform3d::From(Time{7}, "base_link", "cam", mount)},
+      &out);
+  const std::vector<RosTransform3d> back = DecodeTfMessage3d(out);
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[1].child_frame, "cam");
+  EXPECT_TRUE(back[1].translation.isApprox(Eigen::Vector3d(0.18, 0.005, 0.36), 1e-15));
+  EXPECT_GE(back[1].rotation.w(), 0.0);
+  EXPECT_TRUE(back[1].rotation.toRotationMatrix().isApprox(mount.linear(), 1e-14));
+  // The optical z axis (forward) points ahead and 0.36 rad down.
+  const Eigen::Vector3d forward = back[1].rotation * Eigen::Vector3d::UnitZ();
+  EXPECT_NEAR(std::asin(-forward.z()), 0.36, 1e-12);
+  // A planar transform in a 3-D message is byte for byte the planar encoder's.
+  std::string planar_only;
+  EncodeTfMessage({planar}, &planar_only);
+  std::string as_3d;
+  EncodeTfMessage({RosTransform3d::From(planar)}, &as_3d);
+  EXPECT_EQ(as_3d, planar_only);
+  EXPECT_EQ(DecodeTfMessage(out)[0].parent_from_child, planar.parent_from_child);
+}
+
 TEST(CdrTest, RejectsTruncatedAndBadLengths) {
   std::string out;
   EncodeOdometry({Time{5}, "odom", "base_link", Pose2(1, 2, 3)}, &out);

@@ -5,16 +5,21 @@
 //
 // Usage: slamrig_write_test_bags OUT_DIR [DURATION_S]
 
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "slam/io/bag/bag_writer.h"
+#include "slam/io/bag/ros_messages.h"
 #include "slam/io/bag/testing/synthetic_records.h"
 
 namespace slamrig::slam {
@@ -60,6 +65,64 @@ std::string Tf(Time t, const std::string& parent, const std::string& child, cons
          ",\"rotation\":" + YawQuat(p.theta()) + "}}]}";
 }
 
+std::string Bytes(const std::uint8_t* data, std::size_t n) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < n; ++i) s += (i ? "," : "") + std::to_string(data[i]);
+  return s + "]";
+}
+std::string Doubles(std::initializer_list<double> values) {
+  std::string s = "[";
+  bool first = true;
+  for (double v : values) {
+    s += (first ? "" : ",") + Num(v);
+    first = false;
+  }
+  return s + "]";
+}
+// A geometry_msgs/TransformStamped of a 3-D transform: the rotation as Eigen's quaternion with
+// w >= 0, the convention BagWriter documents.
+std::string Tf3d(Time t, const std::string& parent, const std::string& child,
+                 const Eigen::Isometry3d& x) {
+  Eigen::Quaterniond q(x.linear());
+  q.normalize();
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+  const Eigen::Vector3d p = x.translation();
+  return "{\"header\":" + Header(t, parent) + ",\"child_frame_id\":" + Str(child) +
+         ",\"transform\":{\"translation\":" + Vec3(p.x(), p.y(), p.z()) +
+         ",\"rotation\":{\"x\":" + Num(q.x()) + ",\"y\":" + Num(q.y()) + ",\"z\":" + Num(q.z()) +
+         ",\"w\":" + Num(q.w()) + "}}}";
+}
+std::string Image(const RgbdFrame& f, const std::string& frame, const std::string& encoding,
+                  int bytes_per_pixel, const std::uint8_t* data) {
+  const std::size_t n = static_cast<std::size_t>(f.width) * f.height * bytes_per_pixel;
+  return "{\"header\":" + Header(f.time, frame) + ",\"height\":" + std::to_string(f.height) +
+         ",\"width\":" + std::to_string(f.width) + ",\"encoding\":" + Str(encoding) +
+         ",\"is_bigendian\":0,\"step\":" + std::to_string(bytes_per_pixel * f.width) +
+         ",\"data\":" + Bytes(data, n) + "}";
+}
+
+// Three small RGB-D frames for the Image, CameraInfo and /tf_static messages: the first before
+// any scan (the laser's transform joins the camera's later), the camera remounted for the last.
+void AddFrames(Dataset* data) {
+  const Time start = RecordTime(data->records.front());
+  for (int k = 0; k < 3; ++k) {
+    RgbdFrame f;
+    f.time = Time::FromNanoseconds(start.ns - 1'000'000 + k * 1'000'000'000LL + 1'234);
+    f.width = 5;
+    f.height = 3;
+    for (int i = 0; i < 15; ++i) {
+      f.rgb.insert(f.rgb.end(), {static_cast<std::uint8_t>(17 * i + k), 200, 3});
+      f.depth_m.push_back(i == 4 ? 0.0f : 0.5f + 0.25f * static_cast<float>(i));
+    }
+    f.intrinsics = {4.5, 4.5, 2.25, 1.0};
+    f.depth_offset_x_m = 0.025;
+    if (k == 2) f.base_from_camera.pitch_rad = 0.5;
+    const auto at = std::upper_bound(data->records.begin(), data->records.end(), f.time,
+                                     [](Time t, const Record& r) { return t < RecordTime(r); });
+    data->records.insert(at, std::move(f));
+  }
+}
+
 struct Expected {
   std::map<std::string, std::string> type;
   std::map<std::string, std::vector<std::pair<Time, std::string>>> messages;
@@ -82,6 +145,23 @@ Expected Expect(const Dataset& data, const BagWriterOptions& o) {
   };
   std::vector<std::int64_t> totals(4, 0);
   bool static_sent = false;
+  std::optional<Pose2> laser;
+  std::optional<Eigen::Isometry3d> camera, depth_camera;
+  // Every static transform known in one message: the laser's planar one (its yaw quaternion)
+  // first, then the two optical frames.
+  const auto static_tf = [&](Time t) {
+    if (!camera) {
+      e.Add(n.tf_static, "tf2_msgs/msg/TFMessage", t, Tf(t, f.base, f.laser, *laser));
+      return;
+    }
+    std::string tf = "{\"transforms\":[";
+    if (laser) {
+      const std::string planar = Tf(t, f.base, f.laser, *laser);
+      tf += planar.substr(15, planar.size() - 15 - 2) + ",";
+    }
+    tf += Tf3d(t, f.base, f.camera, *camera) + "," + Tf3d(t, f.base, f.depth, *depth_camera) + "]}";
+    e.Add(n.tf_static, "tf2_msgs/msg/TFMessage", t, tf);
+  };
   std::size_t g = 0;
   const auto truth_until = [&](Time t, bool inclusive) {
     while (g < data.reference.size() &&
@@ -99,7 +179,8 @@ Expected Expect(const Dataset& data, const BagWriterOptions& o) {
     if (const auto* s = std::get_if<LaserScan>(&r)) {
       if (!static_sent) {
         static_sent = true;
-        e.Add(n.tf_static, "tf2_msgs/msg/TFMessage", t, Tf(t, f.base, f.laser, s->base_from_laser));
+        laser = s->base_from_laser;
+        static_tf(t);
       }
       const double count = static_cast<double>(s->ranges_m.size());
       std::string ranges = "[";
@@ -136,6 +217,28 @@ Expected Expect(const Dataset& data, const BagWriterOptions& o) {
             "{\"header\":" + Header(t, "") +
                 ",\"name\":[\"wheel_fr\",\"wheel_rr\",\"wheel_fl\",\"wheel_rl\"],\"position\":" +
                 pos + "],\"velocity\":[],\"effort\":[]}");
+    } else if (const auto* frame = std::get_if<RgbdFrame>(&r)) {
+      const Eigen::Isometry3d rgb = frame->BaseFromRgbOptical();
+      if (!camera || camera->matrix() != rgb.matrix()) {
+        camera = rgb;
+        depth_camera = frame->BaseFromDepthOptical();
+        static_tf(t);
+      }
+      e.Add(n.rgb, "sensor_msgs/msg/Image", t,
+            Image(*frame, f.camera, "rgb8", 3, frame->rgb.data()));
+      e.Add(n.depth, "sensor_msgs/msg/Image", t,
+            Image(*frame, f.depth, "32FC1", 4,
+                  reinterpret_cast<const std::uint8_t*>(frame->depth_m.data())));
+      const CameraIntrinsics& k = frame->intrinsics;
+      e.Add(n.camera_info, "sensor_msgs/msg/CameraInfo", t,
+            "{\"header\":" + Header(t, f.camera) + ",\"height\":" + std::to_string(frame->height) +
+                ",\"width\":" + std::to_string(frame->width) +
+                ",\"distortion_model\":\"plumb_bob\",\"d\":" + Zeros(5) +
+                ",\"k\":" + Doubles({k.fx_px, 0, k.cx_px, 0, k.fy_px, k.cy_px, 0, 0, 1}) +
+                ",\"r\":" + Doubles({1, 0, 0, 0, 1, 0, 0, 0, 1}) +
+                ",\"p\":" + Doubles({k.fx_px, 0, k.cx_px, 0, 0, k.fy_px, k.cy_px, 0, 0, 0, 1, 0}) +
+                ",\"binning_x\":0,\"binning_y\":0,\"roi\":{\"x_offset\":0,\"y_offset\":0,"
+                "\"height\":0,\"width\":0,\"do_rectify\":false}}");
     } else if (const auto* odom = std::get_if<OdometryPose>(&r)) {
       e.Add(n.odom, "nav_msgs/msg/Odometry", t, Odometry(t, f.odom, f.base, odom->odom_from_base));
       e.Add(n.tf, "tf2_msgs/msg/TFMessage", t, Tf(t, f.odom, f.base, odom->odom_from_base));
@@ -155,7 +258,8 @@ int Main(int argc, char** argv) {
   const double duration = argc > 2 ? std::stod(argv[2]) : 3.0;
   std::filesystem::remove_all(out);
   std::filesystem::create_directories(out);
-  const Dataset data = testing::SyntheticRun(duration, 7);
+  Dataset data = testing::SyntheticRun(duration, 7);
+  AddFrames(&data);
   BagWriterOptions options;
   options.chunk_size_bytes = 64 * 1024;  // many chunks, so the indexes get exercised
   std::vector<std::string> bags;
