@@ -10,6 +10,7 @@
 #include "slam/eval/loop_closure_score.h"
 #include "slam/eval/map_score.h"
 #include "slam/eval/pose_association.h"
+#include "slam/eval/recovery_time.h"
 #include "slam/eval/trajectory_error.h"
 #include "slam/eval/trajectory_metrics.h"
 #include "slam/fusion/consistency.h"
@@ -19,6 +20,10 @@
 
 namespace slamrig::scenario {
 namespace {
+
+// A kidnapped estimate counts as recovered once it stays this close to the true position: the
+// kidnapping scenario's own bound on the final error, well above a tracking filter's ~0.05 m.
+constexpr double kRecoveredM = 0.3;
 
 using Runners = std::vector<std::unique_ptr<slam::EstimatorRunner>>;
 
@@ -128,6 +133,11 @@ void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
   if (!pairs.empty()) {
     m["final_error_m"] =
         (pairs.back().reference.translation() - pairs.back().estimate.translation()).norm();
+    // From the truth, for any estimator: how long after each kidnapping until the estimate is
+    // back within kRecoveredM of the true pose for good.
+    if (!run.kidnap_times.empty()) {
+      m["recovery_time_s"] = slam::WorstRecoveryTime(pairs, run.kidnap_times, kRecoveredM);
+    }
   }
   // Loop closures against the reference: one reference pose per scan, in scan order.
   if (run.truth.size() == c->estimate.size()) {
@@ -290,6 +300,7 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
         simulator.time().seconds() >= source.kidnaps[next_kidnap].at_s) {
       simulator.Teleport(source.kidnaps[next_kidnap++].to);
       ++result.kidnaps_done;
+      result.kidnap_times.push_back(simulator.time());
     }
     consume(step(false));
     const double now_s = simulator.time().seconds();
