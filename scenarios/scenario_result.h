@@ -57,7 +57,8 @@ struct ScenarioResult {
   int scans = 0;              ///< scans the lidar produced (or the log holds)
   int scans_blacked_out = 0;  ///< of them, withheld by lidar_blackout faults
   int kidnaps_done = 0;
-  int frames = 0;  ///< RGB-D frames in the records (the camera's, or a log's)
+  std::vector<Time> kidnap_times;  ///< when each kidnapping happened (data time)
+  int frames = 0;                  ///< RGB-D frames in the records (the camera's, or a log's)
   /// A run with a camera: the true floor texture and the map from the true poses (the `truth`
   /// pseudo-configuration's texture metrics, TruthMetrics()), else none.
   std::optional<cv::Mat3b> true_texture;

@@ -143,6 +143,7 @@ const std::vector<std::string>& KnownMetrics() {
                                                    "rpe_m_per_10m",
                                                    "rpe_rad_per_10m",
                                                    "final_error_m",
+                                                   "recovery_time_s",
                                                    "map_f1",
                                                    "map_iou",
                                                    "map_precision",

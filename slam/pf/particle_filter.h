@@ -25,7 +25,9 @@ struct Particle {
 
 /// What one AddScan did.
 struct ParticleFilterStep {
-  Pose2 best_pose;    ///< pose of the highest-weight particle (the map was updated there)
+  /// The estimate, where the map was updated: the weighted mean when the cloud is one tight mode
+  /// (ParticleFilterOptions::unimodal_radius_m), else the highest-weight particle.
+  Pose2 best_pose;
   Pose2 mean_pose;    ///< weighted mean (circular mean for yaw)
   double neff = 0.0;  ///< effective sample size after the update, before resampling
   bool resampled = false;
@@ -60,16 +62,30 @@ class ParticleFilter {
   /// Times the filter found itself lost, and was relocalised by a global match.
   int lost_count() const { return lost_count_; }
   int relocalisation_count() const { return relocalisation_count_; }
+  /// Lost alarms that ended with the tracked hypothesis matching well again (no relocalisation).
+  int resumed_count() const { return resumed_count_; }
 
  private:
   void Predict(const Pose2& odometry_increment);
   double Quality(float score, std::size_t num_points) const;
+  // Every particle that carries weight lies within unimodal_radius_m / unimodal_yaw_rad of `mean`.
+  bool Unimodal(const Pose2& mean) const;
   // Updates the quality averages; true when this scan is suspect (not to be inserted).
   bool TrackQuality(double quality, Time now);
-  void Relocalise(const std::vector<Eigen::Vector2d>& points, const LaserScan& scan,
+  // A pose matched on the likelihood field and its quality (Quality()).
+  struct ScoredPose {
+    Pose2 pose;
+    double quality = 0.0;
+  };
+  // One update while lost; false when tracking resumes and the scan is to be filtered as usual.
+  bool Relocalise(const std::vector<Eigen::Vector2d>& points, const LaserScan& scan,
                   ParticleFilterStep* step);
-  std::optional<Pose2> GlobalMatch(const std::vector<Eigen::Vector2d>& near,
-                                   const std::vector<Eigen::Vector2d>& points);
+  void ResumeTracking();
+  void GiveUpWhenLostTooLong(const LaserScan& scan, ParticleFilterStep* step);
+  // The shift search and refinement around `pose` on the (frozen) map.
+  ScoredPose LocalMatch(const std::vector<Eigen::Vector2d>& points, const Pose2& pose);
+  std::optional<ScoredPose> GlobalMatch(const std::vector<Eigen::Vector2d>& near,
+                                        const std::vector<Eigen::Vector2d>& points);
   std::vector<double> Score(const std::vector<Eigen::Vector2d>& points,
                             const MatchConstraints& constraints, float* best_score);
 
@@ -96,9 +112,11 @@ class ParticleFilter {
   Pose2 lost_pose_;  // the best pose at the last update before the loss
   Eigen::Vector2d search_centre_ = Eigen::Vector2d::Zero();
   std::optional<Pose2> candidate_;  // the last global match, carried by the odometry
+  int confirmations_ = 0;           // lost updates in a row whose global matches agree
   std::unique_ptr<CorrelativeMatcher> global_matcher_;
   int lost_count_ = 0;
   int relocalisation_count_ = 0;
+  int resumed_count_ = 0;
 };
 
 /// Weighted mean of particle poses: arithmetic in x, y; circular in yaw.

@@ -34,6 +34,11 @@ std::vector<std::string> RelocalisationOptions::Validate() const {
   if (warmup_updates < 1) errors.push_back(Rule("warmup_updates", warmup_updates, "must be >= 1"));
   positive("confirm_distance_m", confirm_distance_m);
   positive("confirm_angle_rad", confirm_angle_rad);
+  if (!(win_margin >= 0.0)) errors.push_back(Rule("win_margin", win_margin, "must be >= 0"));
+  positive("slip_radius_m", slip_radius_m);
+  if (confirm_updates < 1) {
+    errors.push_back(Rule("confirm_updates", confirm_updates, "must be >= 1"));
+  }
   positive("search_max_range_m", search_max_range_m);
   positive("search_window_m", search_window_m);
   positive("max_lost_s", max_lost_s);
@@ -68,6 +73,7 @@ ParticleFilterOptions ParticleFilterOptions::ReportsPreset() {
   o.min_update_distance_m = 0.0;
   o.min_update_angle_rad = 0.0;
   o.degeneracy_ratio = 0.0;
+  o.unimodal_radius_m = 0.0;  // the best particle, as in the reports
   return o;
 }
 
@@ -79,6 +85,12 @@ std::vector<std::string> ParticleFilterOptions::Validate() const {
     errors.push_back(Rule("sigma_yaw_rad", sigma_yaw_rad, "must be >= 0"));
   if (!(observation_scale > 0.0)) {
     errors.push_back(Rule("observation_scale", observation_scale, "must be > 0"));
+  }
+  if (!(unimodal_radius_m >= 0.0)) {
+    errors.push_back(Rule("unimodal_radius_m", unimodal_radius_m, "must be >= 0"));
+  }
+  if (!(unimodal_yaw_rad >= 0.0)) {
+    errors.push_back(Rule("unimodal_yaw_rad", unimodal_yaw_rad, "must be >= 0"));
   }
   if (!(resample_neff_ratio >= 0.0 && resample_neff_ratio <= 1.0)) {
     errors.push_back(Rule("resample_neff_ratio", resample_neff_ratio, "must be in [0, 1]"));

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "slam/odometry/gaussian.h"
 #include "slam/odometry/scan_sync.h"
 #include "slam/pf/testing/synthetic_run.h"
 #include "slam/types/trajectory.h"
@@ -175,6 +176,37 @@ TEST(ParticleFilterTest, FindsItselfLostAfterAKidnappingAndRelocalises) {
   EXPECT_EQ(filter.lost_count(), filter.relocalisation_count()) << "lost at the end";
   const Pose2 end = run.run.truth.front().map_from_base * step.best_pose;
   // Without relocalisation it ends ~10 m off (the next test).
+  EXPECT_LT((end.translation() - run.run.truth.back().map_from_base.translation()).norm(), 0.2);
+}
+
+// A few scans that match nowhere (a crowd around the robot: every beam ends 0.5-1.5 m out)
+// raise the alarm but are no kidnapping: nothing on the map fits them better than where the
+// robot is, so once the scans are clean again tracking resumes from the cloud, with no
+// relocalisation, and the run ends on the truth.
+TEST(ParticleFilterTest, ABadScanIsNotAKidnapping) {
+  const ShortRun& run = GetShortRun();
+  ASSERT_GT(run.scans.size(), 330u);
+  ParticleFilterOptions options = FastOptions();
+  options.relocalisation.enabled = true;
+  ParticleFilter filter(options);
+  RandomEngine rng(5);
+  ParticleFilterStep step;
+  bool lost = false;
+  for (std::size_t i = 0; i < run.scans.size(); ++i) {
+    LaserScan scan = run.scans[i].scan;
+    if (i >= 300 && i < 306) {
+      for (float& r : scan.ranges_m) r = static_cast<float>(0.5 + Uniform01(rng));
+    }
+    step = filter.AddScan(scan, run.scans[i].increment);
+    lost = lost || step.lost;
+    EXPECT_FALSE(step.relocalised) << i;
+  }
+  EXPECT_TRUE(lost) << "the crowd should raise the alarm";
+  EXPECT_GE(filter.lost_count(), 1);
+  EXPECT_EQ(filter.resumed_count(), filter.lost_count());
+  EXPECT_EQ(filter.relocalisation_count(), 0);
+  EXPECT_FALSE(step.lost);
+  const Pose2 end = run.run.truth.front().map_from_base * step.best_pose;
   EXPECT_LT((end.translation() - run.run.truth.back().map_from_base.translation()).norm(), 0.2);
 }
 

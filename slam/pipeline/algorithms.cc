@@ -26,7 +26,7 @@ const std::vector<Algorithm>& Algorithms() {
        "particle-filter SLAM on one log-odds map (presets: default, the improved filter; "
        "reports, the ECE276A reports' method)",
        {"default", "reports"},
-       {"mean_neff", "resamples", "updates", "lost", "relocalisations", "lost_at_s",
+       {"mean_neff", "resamples", "updates", "lost", "relocalisations", "resumed", "lost_at_s",
         "relocalised_at_s"},
        [](const std::string& preset) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<

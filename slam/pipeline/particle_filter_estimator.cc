@@ -39,6 +39,7 @@ std::map<std::string, double> ParticleFilterEstimator::Statistics() const {
           {"updates", updates_},
           {"lost", filter_.lost_count()},
           {"relocalisations", filter_.relocalisation_count()},
+          {"resumed", filter_.resumed_count()},
           {"lost_at_s", lost_at_s_},
           {"relocalised_at_s", relocalised_at_s_}};
 }
