@@ -143,6 +143,7 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
         RuleViolation("loop_max_covariance_ratio", loop_max_covariance_ratio, "must be > 1"));
   }
   positive("loop_chi2_gate", loop_chi2_gate);
+  positive("loop_pairwise_chi2", loop_pairwise_chi2);
   positive("loop_sigma_xy_floor_m", loop_sigma_xy_floor_m);
   positive("loop_sigma_yaw_floor_rad", loop_sigma_yaw_floor_rad);
   if (optimize_every_keyframes < 1) {
@@ -154,7 +155,10 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
 }
 
 GraphSlam::GraphSlam(const GraphSlamOptions& options)
-    : options_(options), odometry_(options.odometry), optimizer_(options.optimizer) {
+    : options_(options),
+      odometry_(options.odometry),
+      optimizer_(options.optimizer),
+      consistency_(options.loop_pairwise_chi2) {
   SLAMRIG_CHECK(options_.Validate().empty(), "invalid GraphSlamOptions");
 }
 
@@ -219,6 +223,7 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vec
         EdgeKind::kOdometry};
     graph_.AddEdge(edge);
     edge_variances_.push_back(node.edge_variance);
+    chain_.Append(relative, sxy * sxy, syaw * syaw);
   }
   nodes_.push_back(std::move(node));
   ++counts_.keyframes;
@@ -323,14 +328,54 @@ void GraphSlam::SearchLoops() {
       ++counts_.rejected;
       continue;
     }
-    closure_edges_.push_back(graph_.edges().size());
-    graph_.AddEdge(*edge);
-    const Eigen::Matrix3d covariance = edge->information.inverse();
-    edge_variances_.emplace_back(covariance(0, 0) + covariance(1, 1), covariance(2, 2));
-    closures_.push_back({nodes_[j].scan, nodes_[current].scan, edge->measurement});
-    ++counts_.loop_closures;
-    pending_closure_ = true;
+    AcceptClosure(*edge, {nodes_[j].scan, nodes_[current].scan, edge->measurement});
   }
+}
+
+void GraphSlam::AddClosureEdge(const PoseGraphEdge& edge, const LoopClosure& closure) {
+  closure_edges_.push_back(graph_.edges().size());
+  graph_.AddEdge(edge);
+  const Eigen::Matrix3d covariance = edge.information.inverse();
+  edge_variances_.emplace_back(covariance(0, 0) + covariance(1, 1), covariance(2, 2));
+  closures_.push_back(closure);
+  ++counts_.loop_closures;
+  pending_closure_ = true;
+}
+
+void GraphSlam::AcceptClosure(const PoseGraphEdge& edge, const LoopClosure& closure) {
+  if (options_.loop_consistency == LoopConsistency::kNone) {
+    AddClosureEdge(edge, closure);
+    return;
+  }
+  hypothesis_edges_.push_back(edge);
+  hypothesis_closures_.push_back(closure);
+  const bool changed =
+      consistency_.Add({edge.from, edge.to, edge.measurement, edge.information.inverse()}, chain_);
+  const std::vector<int>& kept = consistency_.kept();
+  counts_.inconsistent = consistency_.size() - static_cast<int>(kept.size());
+  if (!changed) {
+    if (!kept.empty() && kept.back() == consistency_.size() - 1) AddClosureEdge(edge, closure);
+    return;
+  }
+  // The consistent set changed: the graph keeps its vertices (at their current estimates) and
+  // odometry edges, and takes the kept closures in place of the ones it had.
+  PoseGraph rebuilt;
+  for (const PoseGraphVertex& v : graph_.vertices()) rebuilt.AddVertex(v.id, v.pose, v.fixed);
+  std::vector<Eigen::Vector2d> variances;
+  for (std::size_t e = 0; e < graph_.edges().size(); ++e) {
+    if (graph_.edges()[e].kind == EdgeKind::kLoopClosure) continue;
+    rebuilt.AddEdge(graph_.edges()[e]);
+    variances.push_back(edge_variances_[e]);
+  }
+  graph_ = std::move(rebuilt);
+  edge_variances_ = std::move(variances);
+  closure_edges_.clear();
+  closures_.clear();
+  switches_.clear();
+  counts_.loop_closures = 0;
+  for (const int k : kept) AddClosureEdge(hypothesis_edges_[k], hypothesis_closures_[k]);
+  // At once: the estimate still bends to the closures just dropped, and the loop search reads it.
+  Optimize();
 }
 
 std::optional<PoseGraphEdge> GraphSlam::TryClosure(int candidate, const Eigen::Vector2d& variance) {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "slam/graph/graph_slam_options.h"
+#include "slam/graph/pairwise_consistency.h"
 #include "slam/graph/pose_graph.h"
 #include "slam/graph/pose_graph_optimizer.h"
 #include "slam/matching/icp_odometry.h"
@@ -38,6 +39,9 @@ struct GraphSlamCounts {
   /// switchable robust loss; they no longer count as loop closures.
   int switched_off = 0;
   int odometry_rematched = 0;  ///< odometry edges the odometry check replaced
+  /// With pairwise consistency: closures that passed their own checks but are outside the
+  /// largest pairwise-consistent set (so not in the graph).
+  int inconsistent = 0;
 };
 
 /// Online graph SLAM over laser scans with an odometry increment each. Deterministic; not
@@ -77,6 +81,10 @@ class GraphSlam {
   Pose2 CheckedRelative(const Pose2& relative, const std::vector<Eigen::Vector2d>& points);
   void SearchLoops();
   std::optional<PoseGraphEdge> TryClosure(int candidate, const Eigen::Vector2d& variance);
+  // Adds an accepted closure to the graph, or with pairwise consistency to the hypotheses,
+  // rebuilding the graph's closures when the consistent set changes.
+  void AcceptClosure(const PoseGraphEdge& edge, const LoopClosure& closure);
+  void AddClosureEdge(const PoseGraphEdge& edge, const LoopClosure& closure);
   void Optimize();
 
   GraphSlamOptions options_;
@@ -91,6 +99,10 @@ class GraphSlam {
   std::vector<std::size_t> closure_edges_;  // graph edge of each closure
   std::vector<double> switches_;            // of each graph edge, from the last optimisation
   GraphSlamCounts counts_;
+  OdometryChain chain_;  // the odometry edges alone, for pairwise consistency
+  PairwiseConsistency consistency_;
+  std::vector<PoseGraphEdge> hypothesis_edges_;  // every closure given to consistency_
+  std::vector<LoopClosure> hypothesis_closures_;
   bool pending_closure_ = false;
   int nodes_at_last_optimization_ = 0;
 };

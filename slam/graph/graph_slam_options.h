@@ -11,6 +11,12 @@
 
 namespace slamrig::slam {
 
+/// How accepted loop closures are checked against each other.
+enum class LoopConsistency {
+  kNone,      ///< each closure on its own (its chi2 gate against the graph)
+  kPairwise,  ///< and the largest pairwise-consistent set (pairwise_consistency.h)
+};
+
 /// The field table of PoseGraphOptimizerOptions (slam/config/fields.h).
 template <typename V>
 void VisitFields(V& v, PoseGraphOptimizerOptions& o) {
@@ -92,6 +98,11 @@ struct GraphSlamOptions {
   /// Geometric verification: the closure's Mahalanobis distance to the graph's own relative pose
   /// (with the accumulated and the match covariance) must be below this chi2 (3 dof; 99.9 %).
   double loop_chi2_gate = 16.27;
+  /// Pairwise consistency (Mangelson et al. 2018): with kPairwise the closures that pass the
+  /// checks above enter the graph only while they belong to the largest set whose every pair
+  /// closes its cycle through the odometry within loop_pairwise_chi2 (3 dof).
+  LoopConsistency loop_consistency = LoopConsistency::kNone;
+  double loop_pairwise_chi2 = 16.27;
   /// The loop edge's covariance: ICP's, raised to at least these standard deviations.
   double loop_sigma_xy_floor_m = 0.02;
   double loop_sigma_yaw_floor_rad = 0.005;
@@ -136,6 +147,9 @@ void VisitFields(V& v, GraphSlamOptions& o) {
   v("loop_max_search_stddev_m", o.loop_max_search_stddev_m);
   v("loop_max_covariance_ratio", o.loop_max_covariance_ratio);
   v("loop_chi2_gate", o.loop_chi2_gate);
+  v.Enum("loop_consistency", o.loop_consistency,
+         {{LoopConsistency::kNone, "none"}, {LoopConsistency::kPairwise, "pairwise"}});
+  v("loop_pairwise_chi2", o.loop_pairwise_chi2);
   v("loop_sigma_xy_floor_m", o.loop_sigma_xy_floor_m);
   v("loop_sigma_yaw_floor_rad", o.loop_sigma_yaw_floor_rad);
   v("optimize_every_keyframes", o.optimize_every_keyframes);

@@ -66,12 +66,17 @@ TEST(GraphSlamTest, ClosesTheOfficeLoopAndBeatsOdometry) {
   EXPECT_GE(score.recall, 0.8);
 }
 
+struct IdenticalRoomsRun {
+  GraphSlamCounts counts;
+  std::vector<LoopClosure> closures;
+  LoopClosureScore score;
+};
+
 // Two identical rooms 8 m apart. The robot circles room A twice, moves to room B (honest
 // odometry) and circles it twice. The loop search is made generous (a 10 m radius and window), so
 // room B's nodes are matched against room A's submaps and the correlative search finds the
-// aliased pose 8 m away; the chi2 gate must reject it, as it disagrees with the graph by far
-// more than the graph's uncertainty.
-TEST(GraphSlamTest, IdenticalRoomsYieldNoFalseClosure) {
+// aliased pose 8 m away.
+IdenticalRoomsRun RunIdenticalRooms(GraphSlamOptions options) {
   testing::SegmentWorld world({});
   for (const double x0 : {0.0, 8.0}) {
     world.AddBox(x0, 0.0, x0 + 4.0, 4.0);
@@ -93,7 +98,6 @@ TEST(GraphSlamTest, IdenticalRoomsYieldNoFalseClosure) {
       }
     }
   }
-  GraphSlamOptions options;
   options.loop_skip_keyframes = 10;
   options.loop_search_radius_m = 10.0;
   options.loop_max_search_radius_m = 10.0;
@@ -110,11 +114,36 @@ TEST(GraphSlamTest, IdenticalRoomsYieldNoFalseClosure) {
   slam.Finish();
   std::vector<Pose2> reference;
   for (const Pose2& t : truth) reference.push_back(truth[0].Between(t));
-  const LoopClosureScore score = ScoreLoopClosures(slam.loop_closures(), reference);
-  EXPECT_GT(slam.counts().loop_closures, 0);  // within each room
-  EXPECT_GT(slam.counts().rejected, 0);       // room B was searched against room A
-  EXPECT_EQ(score.false_closures, 0);
-  for (const LoopClosure& c : slam.loop_closures()) {
+  return {slam.counts(), slam.loop_closures(), ScoreLoopClosures(slam.loop_closures(), reference)};
+}
+
+// The chi2 gate must reject the aliased closures, as they disagree with the graph by far more
+// than the graph's uncertainty.
+TEST(GraphSlamTest, IdenticalRoomsYieldNoFalseClosure) {
+  const IdenticalRoomsRun run = RunIdenticalRooms(GraphSlamOptions{});
+  EXPECT_GT(run.counts.loop_closures, 0);  // within each room
+  EXPECT_GT(run.counts.rejected, 0);       // room B was searched against room A
+  EXPECT_EQ(run.score.false_closures, 0);
+  for (const LoopClosure& c : run.closures) {
+    EXPECT_EQ(c.from_scan < 80, c.to_scan < 80) << c.from_scan << " -> " << c.to_scan;
+  }
+}
+
+// With the chi2 gate against the graph opened wide, the aliased closures get through on their
+// own; pairwise consistency rejects them (room B's closures to room A contradict room B's own
+// closures through the odometry) and keeps the true ones.
+TEST(GraphSlamTest, PairwiseConsistencyRejectsAliasedClosuresWithoutTheGate) {
+  GraphSlamOptions options;
+  options.loop_chi2_gate = 1e9;
+  const IdenticalRoomsRun open = RunIdenticalRooms(options);
+  ASSERT_GT(open.score.false_closures, 0);  // the gate was what kept them out
+
+  options.loop_consistency = LoopConsistency::kPairwise;
+  const IdenticalRoomsRun pairwise = RunIdenticalRooms(options);
+  EXPECT_EQ(pairwise.score.false_closures, 0);
+  EXPECT_GT(pairwise.counts.inconsistent, 0);
+  EXPECT_GE(pairwise.score.recall, 0.8);
+  for (const LoopClosure& c : pairwise.closures) {
     EXPECT_EQ(c.from_scan < 80, c.to_scan < 80) << c.from_scan << " -> " << c.to_scan;
   }
 }
