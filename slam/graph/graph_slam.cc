@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <queue>
 #include <set>
 #include <utility>
@@ -114,6 +115,9 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
   positive("odometry_check_window_m", odometry_check_window_m);
   positive("odometry_check_window_rad", odometry_check_window_rad);
   non_negative("odometry_check_min_gain", odometry_check_min_gain);
+  non_negative("odometry_check_wide_below", odometry_check_wide_below);
+  non_negative("node_below_match_score", node_below_match_score);
+  positive("odometry_check_wide_window_m", odometry_check_wide_window_m);
   if (loop_skip_keyframes < 1) {
     errors.push_back(RuleViolation("loop_skip_keyframes", loop_skip_keyframes, "must be >= 1"));
   }
@@ -166,11 +170,18 @@ Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment) {
   const IcpOdometryStep step = odometry_.Add(scan, odometry_increment);
   const int index = static_cast<int>(scan_node_.size());
   const Pose2 since = nodes_.empty() ? Pose2() : nodes_.back().odom_pose.Between(step.pose);
+  // A doubtful match becomes a node too, so that the odometry check judges it. (A failed match
+  // is not: its prior is the wheels', which the next match corrects against the local map.)
+  const bool matched = step.outcome == IcpOdometryOutcome::kMatched ||
+                       step.outcome == IcpOdometryOutcome::kDegenerate;
+  const bool doubtful = matched && step.score < options_.node_below_match_score;
+  failed_since_node_ = failed_since_node_ || step.outcome == IcpOdometryOutcome::kMatchFailed;
   if (nodes_.empty() || since.translation().norm() >= options_.keyframe_distance_m ||
-      std::abs(since.theta()) >= options_.keyframe_angle_rad) {
+      std::abs(since.theta()) >= options_.keyframe_angle_rad || doubtful) {
     std::vector<Eigen::Vector2d> points = ScanToBasePoints(scan, options_.odometry.points);
     if (nodes_.empty() || !points.empty()) {
-      AddNode(index, step.pose, std::move(points));
+      AddNode(index, step.pose, doubtful || failed_since_node_, std::move(points));
+      failed_since_node_ = false;
       SearchLoops();
       const int added = static_cast<int>(nodes_.size()) - nodes_at_last_optimization_;
       if (pending_closure_ && added >= options_.optimize_every_keyframes) Optimize();
@@ -204,13 +215,15 @@ std::vector<LoopClosure> GraphSlam::loop_closures() const {
   return kept;
 }
 
-void GraphSlam::AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vector2d> points) {
+void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
+                        std::vector<Eigen::Vector2d> points) {
   const int id = static_cast<int>(nodes_.size());
   Node node{scan, odom_pose, std::move(points), Eigen::Vector2d::Zero()};
   if (nodes_.empty()) {
     graph_.AddVertex(id, Pose2(), /*fixed=*/true);
   } else {
-    const Pose2 relative = CheckedRelative(nodes_.back().odom_pose.Between(odom_pose), node.points);
+    const Pose2 relative =
+        CheckedRelative(nodes_.back().odom_pose.Between(odom_pose), doubtful, node.points);
     const double d = relative.translation().norm();
     const double sxy = options_.edge_sigma_xy_per_m * d + options_.edge_sigma_xy_floor_m;
     const double syaw = options_.edge_sigma_yaw_per_rad * std::abs(relative.theta()) +
@@ -229,7 +242,7 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vec
   ++counts_.keyframes;
 }
 
-Pose2 GraphSlam::CheckedRelative(const Pose2& relative,
+Pose2 GraphSlam::CheckedRelative(const Pose2& relative, bool doubtful,
                                  const std::vector<Eigen::Vector2d>& points) {
   const int newest = static_cast<int>(nodes_.size()) - 1;
   if (options_.odometry_check_nodes == 0 || points.size() < 10) return relative;
@@ -241,22 +254,49 @@ Pose2 GraphSlam::CheckedRelative(const Pose2& relative,
   if (reference.size() < 10) return relative;
   const PointRaster raster =
       RasterOf(reference, options_.submap_resolution_m, options_.submap_blur_m);
-  CorrelativeMatcherOptions search = options_.correlative;
-  search.linear_window_m = options_.odometry_check_window_m;
-  search.angular_window_rad = options_.odometry_check_window_rad;
   const std::vector<Eigen::Vector2d> query = Thinned(points, options_.submap_resolution_m);
-  const std::optional<MatchResult> coarse =
-      CorrelativeMatcher(search, raster.view).Match(query, relative);
-  if (!coarse) return relative;
-  const std::optional<MatchResult> fine =
-      IcpMatcher(options_.loop_icp, reference).Match(points, coarse->pose);
-  if (!fine || fine->score < options_.loop_min_icp_score) return relative;
-  if (!(RasterScore(raster, query, fine->pose) >
-        RasterScore(raster, query, relative) + options_.odometry_check_min_gain)) {
-    return relative;
+  // A correlative search around `guess` within the windows, refined by ICP against the points.
+  auto rematch = [&](const Pose2& guess, double window_m, double window_rad,
+                     bool coarse_fallback) -> std::optional<Pose2> {
+    CorrelativeMatcherOptions search = options_.correlative;
+    search.linear_window_m = window_m;
+    search.angular_window_rad = window_rad;
+    const std::optional<MatchResult> coarse =
+        CorrelativeMatcher(search, raster.view).Match(query, guess);
+    if (!coarse) return std::nullopt;
+    const std::optional<MatchResult> fine =
+        IcpMatcher(options_.loop_icp, reference).Match(points, coarse->pose);
+    // ICP's refinement where it holds; else, for the wide search, the correlative pose itself (a
+    // scan after a lost turn overlaps the last nodes only in part).
+    if (!fine || fine->score < options_.loop_min_icp_score) {
+      return coarse_fallback ? std::optional<Pose2>(coarse->pose) : std::nullopt;
+    }
+    return fine->pose;
+  };
+  const double icp_score = RasterScore(raster, query, relative);
+  Pose2 best = relative;
+  double best_score = icp_score;
+  if (const std::optional<Pose2> local = rematch(relative, options_.odometry_check_window_m,
+                                                 options_.odometry_check_window_rad, false)) {
+    const double score = RasterScore(raster, query, *local);
+    if (score > best_score + options_.odometry_check_min_gain) {
+      best = *local;
+      best_score = score;
+    }
   }
+  if (doubtful && best_score < options_.odometry_check_wide_below) {
+    if (const std::optional<Pose2> wide =
+            rematch(relative, options_.odometry_check_wide_window_m, std::numbers::pi, true)) {
+      const double score = RasterScore(raster, query, *wide);
+      if (score > best_score + options_.odometry_check_min_gain) {
+        best = *wide;
+        best_score = score;
+      }
+    }
+  }
+  if (best == relative) return relative;
   ++counts_.odometry_rematched;
-  return fine->pose;
+  return best;
 }
 
 std::vector<Eigen::Vector2d> GraphSlam::PathVariances() const {

@@ -75,10 +75,13 @@ class GraphSlam {
   };
   // Variances (xy, yaw) along the least uncertain graph path from the newest node to every node.
   std::vector<Eigen::Vector2d> PathVariances() const;
-  void AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vector2d> points);
+  void AddNode(int scan, const Pose2& odom_pose, bool doubtful,
+               std::vector<Eigen::Vector2d> points);
   // The pose of `points` in the newest node's frame: `relative` (ICP odometry's), or the
-  // odometry check's re-match when it fits the last nodes clearly better.
-  Pose2 CheckedRelative(const Pose2& relative, const std::vector<Eigen::Vector2d>& points);
+  // odometry check's re-match when it fits the last nodes clearly better (a local search, and
+  // over every heading when ICP odometry's match was `doubtful` and the best so far fits poorly).
+  Pose2 CheckedRelative(const Pose2& relative, bool doubtful,
+                        const std::vector<Eigen::Vector2d>& points);
   void SearchLoops();
   std::optional<PoseGraphEdge> TryClosure(int candidate, const Eigen::Vector2d& variance);
   // Adds an accepted closure to the graph, or with pairwise consistency to the hypotheses,
@@ -103,6 +106,7 @@ class GraphSlam {
   PairwiseConsistency consistency_;
   std::vector<PoseGraphEdge> hypothesis_edges_;  // every closure given to consistency_
   std::vector<LoopClosure> hypothesis_closures_;
+  bool failed_since_node_ = false;  // an ICP odometry match failed since the newest node
   bool pending_closure_ = false;
   int nodes_at_last_optimization_ = 0;
 };

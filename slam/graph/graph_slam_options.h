@@ -64,6 +64,16 @@ struct GraphSlamOptions {
   double odometry_check_window_m = 0.3;
   double odometry_check_window_rad = 0.35;
   double odometry_check_min_gain = 0.1;
+  /// When ICP odometry's match was doubtful (see node_below_match_score) or failed since the last
+  /// node, and the best of those
+  /// scores below odometry_check_wide_below (0: never), the search is
+  /// widened to +-odometry_check_wide_window_m and every heading: a prior lost altogether (a gap
+  /// in the wheel odometry while the robot turned) is beyond any local search.
+  double odometry_check_wide_below = 0.3;
+  double odometry_check_wide_window_m = 1.0;
+  /// A scan whose ICP odometry match (full or degenerate) scored below this becomes a
+  /// node however little it moved, so that the odometry check judges it (0: only by motion).
+  double node_below_match_score = 0.75;
 
   /// Loop closures are searched among nodes older than the last loop_skip_keyframes ...
   int loop_skip_keyframes = 30;
@@ -131,6 +141,9 @@ void VisitFields(V& v, GraphSlamOptions& o) {
   v("odometry_check_window_m", o.odometry_check_window_m);
   v("odometry_check_window_rad", o.odometry_check_window_rad);
   v("odometry_check_min_gain", o.odometry_check_min_gain);
+  v("odometry_check_wide_below", o.odometry_check_wide_below);
+  v("odometry_check_wide_window_m", o.odometry_check_wide_window_m);
+  v("node_below_match_score", o.node_below_match_score);
   v("loop_skip_keyframes", o.loop_skip_keyframes);
   v("loop_search_radius_m", o.loop_search_radius_m);
   v("loop_radius_sigmas", o.loop_radius_sigmas);

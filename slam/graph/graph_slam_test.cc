@@ -191,5 +191,50 @@ TEST(GraphSlamTest, OdometryCheckRepairsAWrongOdometryEdge) {
   EXPECT_LT(error_on.translation().norm(), 0.05);
 }
 
+// The wheel odometry misses a turn altogether (a gap in its messages while the robot turned
+// 1.2 rad in place), far beyond ICP's convergence basin and the odometry check's local window:
+// ICP odometry's match fails there, and the widened check (every heading) at the next node finds
+// the turn; without it the heading error stays.
+TEST(GraphSlamTest, WideOdometryCheckRecoversAMissedTurn) {
+  testing::SegmentWorld world({});
+  world.AddBox(0.0, 0.0, 6.0, 4.0);
+  world.AddBox(1.0, 2.5, 1.6, 3.1);
+  world.AddBox(4.2, 0.8, 4.6, 1.4);
+  testing::RangeFinderSpec lidar;
+  lidar.num_beams = 181;
+  lidar.angle_increment_rad = 1.5 * M_PI / 180.0;
+  lidar.angle_min_rad = -M_PI / 2.0 * 1.5;
+  constexpr int kTurn = 12;
+  constexpr double kTurnRad = 1.2;
+  std::vector<Pose2> truth;
+  Pose2 pose(1.0, 1.2, 0.0);
+  for (int k = 0; k < 30; ++k) {
+    if (k == kTurn) pose = pose * Pose2(0.0, 0.0, kTurnRad);
+    truth.push_back(pose);
+    pose = pose * Pose2(0.1, 0.0, 0.0);
+  }
+  auto run = [&](double wide_below) {
+    GraphSlamOptions options;
+    options.keyframe_distance_m = 0.3;
+    options.loop_max_candidates = 0;
+    options.odometry_check_wide_below = wide_below;
+    GraphSlam slam{options};
+    RandomEngine rng(5);
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      Pose2 increment = i == 0 ? Pose2() : truth[i - 1].Between(truth[i]);
+      if (static_cast<int>(i) == kTurn) increment = increment * Pose2(0.0, 0.0, -kTurnRad);
+      slam.Add(world.Scan(truth[i], Time(static_cast<std::int64_t>(i) * 100'000'000), lidar, &rng),
+               increment);
+    }
+    slam.Finish();
+    return truth[0].Between(truth.back()).Between(slam.Poses().back());
+  };
+  const Pose2 error_off = run(0.0);
+  const Pose2 error_on = run(GraphSlamOptions{}.odometry_check_wide_below);
+  EXPECT_GT(std::abs(error_off.theta()), 0.5);
+  EXPECT_LT(std::abs(error_on.theta()), 0.03);
+  EXPECT_LT(error_on.translation().norm(), 0.05);
+}
+
 }  // namespace
 }  // namespace slamrig::slam
