@@ -118,6 +118,7 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
   non_negative("odometry_check_wide_below", odometry_check_wide_below);
   non_negative("node_below_match_score", node_below_match_score);
   positive("odometry_check_wide_window_m", odometry_check_wide_window_m);
+  non_negative("odometry_check_wide_min_score", odometry_check_wide_min_score);
   if (loop_skip_keyframes < 1) {
     errors.push_back(RuleViolation("loop_skip_keyframes", loop_skip_keyframes, "must be >= 1"));
   }
@@ -218,12 +219,17 @@ std::vector<LoopClosure> GraphSlam::loop_closures() const {
 void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
                         std::vector<Eigen::Vector2d> points) {
   const int id = static_cast<int>(nodes_.size());
-  Node node{scan, odom_pose, std::move(points), Eigen::Vector2d::Zero()};
+  Node node{scan, odom_pose, std::move(points), Eigen::Vector2d::Zero(), Pose2()};
   if (nodes_.empty()) {
     graph_.AddVertex(id, Pose2(), /*fixed=*/true);
   } else {
-    const Pose2 relative =
-        CheckedRelative(nodes_.back().odom_pose.Between(odom_pose), doubtful, node.points);
+    // When the previous node was re-placed, ICP odometry may have kept its wrong frame (the next
+    // relative pose is right as it is) or found its way back (the next one is right from the node
+    // before): both are tried.
+    const Pose2 icp_relative = nodes_.back().odom_pose.Between(odom_pose);
+    const Pose2 relative = CheckedRelative(
+        icp_relative, nodes_.back().rematch_offset * icp_relative, doubtful, node.points);
+    node.rematch_offset = relative.Inverse() * icp_relative;
     const double d = relative.translation().norm();
     const double sxy = options_.edge_sigma_xy_per_m * d + options_.edge_sigma_xy_floor_m;
     const double syaw = options_.edge_sigma_yaw_per_rad * std::abs(relative.theta()) +
@@ -242,16 +248,16 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
   ++counts_.keyframes;
 }
 
-Pose2 GraphSlam::CheckedRelative(const Pose2& relative, bool doubtful,
+Pose2 GraphSlam::CheckedRelative(const Pose2& icp_relative, const Pose2& alternative, bool doubtful,
                                  const std::vector<Eigen::Vector2d>& points) {
   const int newest = static_cast<int>(nodes_.size()) - 1;
-  if (options_.odometry_check_nodes == 0 || points.size() < 10) return relative;
+  if (options_.odometry_check_nodes == 0 || points.size() < 10) return icp_relative;
   std::vector<Eigen::Vector2d> reference;
   for (int k = std::max(0, newest - options_.odometry_check_nodes + 1); k <= newest; ++k) {
     const Pose2 newest_from_k = graph_.pose(newest).Between(graph_.pose(k));
     for (const Eigen::Vector2d& p : nodes_[k].points) reference.push_back(newest_from_k * p);
   }
-  if (reference.size() < 10) return relative;
+  if (reference.size() < 10) return icp_relative;
   const PointRaster raster =
       RasterOf(reference, options_.submap_resolution_m, options_.submap_blur_m);
   const std::vector<Eigen::Vector2d> query = Thinned(points, options_.submap_resolution_m);
@@ -273,9 +279,16 @@ Pose2 GraphSlam::CheckedRelative(const Pose2& relative, bool doubtful,
     }
     return fine->pose;
   };
-  const double icp_score = RasterScore(raster, query, relative);
+  Pose2 relative = icp_relative;
+  double best_score = RasterScore(raster, query, relative);
+  if (!(alternative == icp_relative)) {
+    const double score = RasterScore(raster, query, alternative);
+    if (score > best_score) {
+      relative = alternative;
+      best_score = score;
+    }
+  }
   Pose2 best = relative;
-  double best_score = icp_score;
   if (const std::optional<Pose2> local = rematch(relative, options_.odometry_check_window_m,
                                                  options_.odometry_check_window_rad, false)) {
     const double score = RasterScore(raster, query, *local);
@@ -288,14 +301,14 @@ Pose2 GraphSlam::CheckedRelative(const Pose2& relative, bool doubtful,
     if (const std::optional<Pose2> wide =
             rematch(relative, options_.odometry_check_wide_window_m, std::numbers::pi, true)) {
       const double score = RasterScore(raster, query, *wide);
-      if (score > best_score + options_.odometry_check_min_gain) {
+      if (score >= options_.odometry_check_wide_min_score &&
+          score > best_score + options_.odometry_check_min_gain) {
         best = *wide;
         best_score = score;
       }
     }
   }
-  if (best == relative) return relative;
-  ++counts_.odometry_rematched;
+  if (!(best == icp_relative)) ++counts_.odometry_rematched;
   return best;
 }
 

@@ -72,15 +72,19 @@ class GraphSlam {
     Pose2 odom_pose;                      // IcpOdometry's pose
     std::vector<Eigen::Vector2d> points;  // base frame
     Eigen::Vector2d edge_variance{0, 0};  // (xy, yaw) variance of the edge from the previous
+    // checked^-1 * ICP relative of the edge from the previous node: the identity unless the
+    // odometry check re-placed it, when it carries the next edge over from the previous node.
+    Pose2 rematch_offset;
   };
   // Variances (xy, yaw) along the least uncertain graph path from the newest node to every node.
   std::vector<Eigen::Vector2d> PathVariances() const;
   void AddNode(int scan, const Pose2& odom_pose, bool doubtful,
                std::vector<Eigen::Vector2d> points);
   // The pose of `points` in the newest node's frame: `relative` (ICP odometry's), or the
-  // odometry check's re-match when it fits the last nodes clearly better (a local search, and
+  // odometry check's re-match when it fits the last nodes clearly better (from the better fitting
+  // of `relative` and `alternative`, a local search, and
   // over every heading when ICP odometry's match was `doubtful` and the best so far fits poorly).
-  Pose2 CheckedRelative(const Pose2& relative, bool doubtful,
+  Pose2 CheckedRelative(const Pose2& relative, const Pose2& alternative, bool doubtful,
                         const std::vector<Eigen::Vector2d>& points);
   void SearchLoops();
   std::optional<PoseGraphEdge> TryClosure(int candidate, const Eigen::Vector2d& variance);

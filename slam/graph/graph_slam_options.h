@@ -71,6 +71,9 @@ struct GraphSlamOptions {
   /// in the wheel odometry while the robot turned) is beyond any local search.
   double odometry_check_wide_below = 0.3;
   double odometry_check_wide_window_m = 1.0;
+  /// The widened search's pose must score at least this itself (a scan that fits nothing well
+  /// anywhere is not re-placed on the strength of a small gain).
+  double odometry_check_wide_min_score = 0.5;
   /// A scan whose ICP odometry match (full or degenerate) scored below this becomes a
   /// node however little it moved, so that the odometry check judges it (0: only by motion).
   double node_below_match_score = 0.75;
@@ -143,6 +146,7 @@ void VisitFields(V& v, GraphSlamOptions& o) {
   v("odometry_check_min_gain", o.odometry_check_min_gain);
   v("odometry_check_wide_below", o.odometry_check_wide_below);
   v("odometry_check_wide_window_m", o.odometry_check_wide_window_m);
+  v("odometry_check_wide_min_score", o.odometry_check_wide_min_score);
   v("node_below_match_score", o.node_below_match_score);
   v("loop_skip_keyframes", o.loop_skip_keyframes);
   v("loop_search_radius_m", o.loop_search_radius_m);
