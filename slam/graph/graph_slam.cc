@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <queue>
 #include <set>
 #include <utility>
@@ -114,6 +115,10 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
   positive("odometry_check_window_m", odometry_check_window_m);
   positive("odometry_check_window_rad", odometry_check_window_rad);
   non_negative("odometry_check_min_gain", odometry_check_min_gain);
+  non_negative("odometry_check_wide_below", odometry_check_wide_below);
+  non_negative("node_below_match_score", node_below_match_score);
+  positive("odometry_check_wide_window_m", odometry_check_wide_window_m);
+  non_negative("odometry_check_wide_min_score", odometry_check_wide_min_score);
   if (loop_skip_keyframes < 1) {
     errors.push_back(RuleViolation("loop_skip_keyframes", loop_skip_keyframes, "must be >= 1"));
   }
@@ -143,6 +148,7 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
         RuleViolation("loop_max_covariance_ratio", loop_max_covariance_ratio, "must be > 1"));
   }
   positive("loop_chi2_gate", loop_chi2_gate);
+  positive("loop_pairwise_chi2", loop_pairwise_chi2);
   positive("loop_sigma_xy_floor_m", loop_sigma_xy_floor_m);
   positive("loop_sigma_yaw_floor_rad", loop_sigma_yaw_floor_rad);
   if (optimize_every_keyframes < 1) {
@@ -154,7 +160,10 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
 }
 
 GraphSlam::GraphSlam(const GraphSlamOptions& options)
-    : options_(options), odometry_(options.odometry), optimizer_(options.optimizer) {
+    : options_(options),
+      odometry_(options.odometry),
+      optimizer_(options.optimizer),
+      consistency_(options.loop_pairwise_chi2) {
   SLAMRIG_CHECK(options_.Validate().empty(), "invalid GraphSlamOptions");
 }
 
@@ -162,11 +171,18 @@ Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment) {
   const IcpOdometryStep step = odometry_.Add(scan, odometry_increment);
   const int index = static_cast<int>(scan_node_.size());
   const Pose2 since = nodes_.empty() ? Pose2() : nodes_.back().odom_pose.Between(step.pose);
+  // A doubtful match becomes a node too, so that the odometry check judges it. (A failed match
+  // is not: its prior is the wheels', which the next match corrects against the local map.)
+  const bool matched = step.outcome == IcpOdometryOutcome::kMatched ||
+                       step.outcome == IcpOdometryOutcome::kDegenerate;
+  const bool doubtful = matched && step.score < options_.node_below_match_score;
+  failed_since_node_ = failed_since_node_ || step.outcome == IcpOdometryOutcome::kMatchFailed;
   if (nodes_.empty() || since.translation().norm() >= options_.keyframe_distance_m ||
-      std::abs(since.theta()) >= options_.keyframe_angle_rad) {
+      std::abs(since.theta()) >= options_.keyframe_angle_rad || doubtful) {
     std::vector<Eigen::Vector2d> points = ScanToBasePoints(scan, options_.odometry.points);
     if (nodes_.empty() || !points.empty()) {
-      AddNode(index, step.pose, std::move(points));
+      AddNode(index, step.pose, doubtful || failed_since_node_, std::move(points));
+      failed_since_node_ = false;
       SearchLoops();
       const int added = static_cast<int>(nodes_.size()) - nodes_at_last_optimization_;
       if (pending_closure_ && added >= options_.optimize_every_keyframes) Optimize();
@@ -200,13 +216,20 @@ std::vector<LoopClosure> GraphSlam::loop_closures() const {
   return kept;
 }
 
-void GraphSlam::AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vector2d> points) {
+void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
+                        std::vector<Eigen::Vector2d> points) {
   const int id = static_cast<int>(nodes_.size());
-  Node node{scan, odom_pose, std::move(points), Eigen::Vector2d::Zero()};
+  Node node{scan, odom_pose, std::move(points), Eigen::Vector2d::Zero(), Pose2()};
   if (nodes_.empty()) {
     graph_.AddVertex(id, Pose2(), /*fixed=*/true);
   } else {
-    const Pose2 relative = CheckedRelative(nodes_.back().odom_pose.Between(odom_pose), node.points);
+    // When the previous node was re-placed, ICP odometry may have kept its wrong frame (the next
+    // relative pose is right as it is) or found its way back (the next one is right from the node
+    // before): both are tried.
+    const Pose2 icp_relative = nodes_.back().odom_pose.Between(odom_pose);
+    const Pose2 relative = CheckedRelative(
+        icp_relative, nodes_.back().rematch_offset * icp_relative, doubtful, node.points);
+    node.rematch_offset = relative.Inverse() * icp_relative;
     const double d = relative.translation().norm();
     const double sxy = options_.edge_sigma_xy_per_m * d + options_.edge_sigma_xy_floor_m;
     const double syaw = options_.edge_sigma_yaw_per_rad * std::abs(relative.theta()) +
@@ -219,39 +242,74 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vec
         EdgeKind::kOdometry};
     graph_.AddEdge(edge);
     edge_variances_.push_back(node.edge_variance);
+    chain_.Append(relative, sxy * sxy, syaw * syaw);
   }
   nodes_.push_back(std::move(node));
   ++counts_.keyframes;
 }
 
-Pose2 GraphSlam::CheckedRelative(const Pose2& relative,
+Pose2 GraphSlam::CheckedRelative(const Pose2& icp_relative, const Pose2& alternative, bool doubtful,
                                  const std::vector<Eigen::Vector2d>& points) {
   const int newest = static_cast<int>(nodes_.size()) - 1;
-  if (options_.odometry_check_nodes == 0 || points.size() < 10) return relative;
+  if (options_.odometry_check_nodes == 0 || points.size() < 10) return icp_relative;
   std::vector<Eigen::Vector2d> reference;
   for (int k = std::max(0, newest - options_.odometry_check_nodes + 1); k <= newest; ++k) {
     const Pose2 newest_from_k = graph_.pose(newest).Between(graph_.pose(k));
     for (const Eigen::Vector2d& p : nodes_[k].points) reference.push_back(newest_from_k * p);
   }
-  if (reference.size() < 10) return relative;
+  if (reference.size() < 10) return icp_relative;
   const PointRaster raster =
       RasterOf(reference, options_.submap_resolution_m, options_.submap_blur_m);
-  CorrelativeMatcherOptions search = options_.correlative;
-  search.linear_window_m = options_.odometry_check_window_m;
-  search.angular_window_rad = options_.odometry_check_window_rad;
   const std::vector<Eigen::Vector2d> query = Thinned(points, options_.submap_resolution_m);
-  const std::optional<MatchResult> coarse =
-      CorrelativeMatcher(search, raster.view).Match(query, relative);
-  if (!coarse) return relative;
-  const std::optional<MatchResult> fine =
-      IcpMatcher(options_.loop_icp, reference).Match(points, coarse->pose);
-  if (!fine || fine->score < options_.loop_min_icp_score) return relative;
-  if (!(RasterScore(raster, query, fine->pose) >
-        RasterScore(raster, query, relative) + options_.odometry_check_min_gain)) {
-    return relative;
+  // A correlative search around `guess` within the windows, refined by ICP against the points.
+  auto rematch = [&](const Pose2& guess, double window_m, double window_rad,
+                     bool coarse_fallback) -> std::optional<Pose2> {
+    CorrelativeMatcherOptions search = options_.correlative;
+    search.linear_window_m = window_m;
+    search.angular_window_rad = window_rad;
+    const std::optional<MatchResult> coarse =
+        CorrelativeMatcher(search, raster.view).Match(query, guess);
+    if (!coarse) return std::nullopt;
+    const std::optional<MatchResult> fine =
+        IcpMatcher(options_.loop_icp, reference).Match(points, coarse->pose);
+    // ICP's refinement where it holds; else, for the wide search, the correlative pose itself (a
+    // scan after a lost turn overlaps the last nodes only in part).
+    if (!fine || fine->score < options_.loop_min_icp_score) {
+      return coarse_fallback ? std::optional<Pose2>(coarse->pose) : std::nullopt;
+    }
+    return fine->pose;
+  };
+  Pose2 relative = icp_relative;
+  double best_score = RasterScore(raster, query, relative);
+  if (!(alternative == icp_relative)) {
+    const double score = RasterScore(raster, query, alternative);
+    if (score > best_score) {
+      relative = alternative;
+      best_score = score;
+    }
   }
-  ++counts_.odometry_rematched;
-  return fine->pose;
+  Pose2 best = relative;
+  if (const std::optional<Pose2> local = rematch(relative, options_.odometry_check_window_m,
+                                                 options_.odometry_check_window_rad, false)) {
+    const double score = RasterScore(raster, query, *local);
+    if (score > best_score + options_.odometry_check_min_gain) {
+      best = *local;
+      best_score = score;
+    }
+  }
+  if (doubtful && best_score < options_.odometry_check_wide_below) {
+    if (const std::optional<Pose2> wide =
+            rematch(relative, options_.odometry_check_wide_window_m, std::numbers::pi, true)) {
+      const double score = RasterScore(raster, query, *wide);
+      if (score >= options_.odometry_check_wide_min_score &&
+          score > best_score + options_.odometry_check_min_gain) {
+        best = *wide;
+        best_score = score;
+      }
+    }
+  }
+  if (!(best == icp_relative)) ++counts_.odometry_rematched;
+  return best;
 }
 
 std::vector<Eigen::Vector2d> GraphSlam::PathVariances() const {
@@ -323,14 +381,54 @@ void GraphSlam::SearchLoops() {
       ++counts_.rejected;
       continue;
     }
-    closure_edges_.push_back(graph_.edges().size());
-    graph_.AddEdge(*edge);
-    const Eigen::Matrix3d covariance = edge->information.inverse();
-    edge_variances_.emplace_back(covariance(0, 0) + covariance(1, 1), covariance(2, 2));
-    closures_.push_back({nodes_[j].scan, nodes_[current].scan, edge->measurement});
-    ++counts_.loop_closures;
-    pending_closure_ = true;
+    AcceptClosure(*edge, {nodes_[j].scan, nodes_[current].scan, edge->measurement});
   }
+}
+
+void GraphSlam::AddClosureEdge(const PoseGraphEdge& edge, const LoopClosure& closure) {
+  closure_edges_.push_back(graph_.edges().size());
+  graph_.AddEdge(edge);
+  const Eigen::Matrix3d covariance = edge.information.inverse();
+  edge_variances_.emplace_back(covariance(0, 0) + covariance(1, 1), covariance(2, 2));
+  closures_.push_back(closure);
+  ++counts_.loop_closures;
+  pending_closure_ = true;
+}
+
+void GraphSlam::AcceptClosure(const PoseGraphEdge& edge, const LoopClosure& closure) {
+  if (options_.loop_consistency == LoopConsistency::kNone) {
+    AddClosureEdge(edge, closure);
+    return;
+  }
+  hypothesis_edges_.push_back(edge);
+  hypothesis_closures_.push_back(closure);
+  const bool changed =
+      consistency_.Add({edge.from, edge.to, edge.measurement, edge.information.inverse()}, chain_);
+  const std::vector<int>& kept = consistency_.kept();
+  counts_.inconsistent = consistency_.size() - static_cast<int>(kept.size());
+  if (!changed) {
+    if (!kept.empty() && kept.back() == consistency_.size() - 1) AddClosureEdge(edge, closure);
+    return;
+  }
+  // The consistent set changed: the graph keeps its vertices (at their current estimates) and
+  // odometry edges, and takes the kept closures in place of the ones it had.
+  PoseGraph rebuilt;
+  for (const PoseGraphVertex& v : graph_.vertices()) rebuilt.AddVertex(v.id, v.pose, v.fixed);
+  std::vector<Eigen::Vector2d> variances;
+  for (std::size_t e = 0; e < graph_.edges().size(); ++e) {
+    if (graph_.edges()[e].kind == EdgeKind::kLoopClosure) continue;
+    rebuilt.AddEdge(graph_.edges()[e]);
+    variances.push_back(edge_variances_[e]);
+  }
+  graph_ = std::move(rebuilt);
+  edge_variances_ = std::move(variances);
+  closure_edges_.clear();
+  closures_.clear();
+  switches_.clear();
+  counts_.loop_closures = 0;
+  for (const int k : kept) AddClosureEdge(hypothesis_edges_[k], hypothesis_closures_[k]);
+  // At once: the estimate still bends to the closures just dropped, and the loop search reads it.
+  Optimize();
 }
 
 std::optional<PoseGraphEdge> GraphSlam::TryClosure(int candidate, const Eigen::Vector2d& variance) {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "slam/graph/graph_slam_options.h"
+#include "slam/graph/pairwise_consistency.h"
 #include "slam/graph/pose_graph.h"
 #include "slam/graph/pose_graph_optimizer.h"
 #include "slam/matching/icp_odometry.h"
@@ -38,6 +39,9 @@ struct GraphSlamCounts {
   /// switchable robust loss; they no longer count as loop closures.
   int switched_off = 0;
   int odometry_rematched = 0;  ///< odometry edges the odometry check replaced
+  /// With pairwise consistency: closures that passed their own checks but are outside the
+  /// largest pairwise-consistent set (so not in the graph).
+  int inconsistent = 0;
 };
 
 /// Online graph SLAM over laser scans with an odometry increment each. Deterministic; not
@@ -68,15 +72,26 @@ class GraphSlam {
     Pose2 odom_pose;                      // IcpOdometry's pose
     std::vector<Eigen::Vector2d> points;  // base frame
     Eigen::Vector2d edge_variance{0, 0};  // (xy, yaw) variance of the edge from the previous
+    // checked^-1 * ICP relative of the edge from the previous node: the identity unless the
+    // odometry check re-placed it, when it carries the next edge over from the previous node.
+    Pose2 rematch_offset;
   };
   // Variances (xy, yaw) along the least uncertain graph path from the newest node to every node.
   std::vector<Eigen::Vector2d> PathVariances() const;
-  void AddNode(int scan, const Pose2& odom_pose, std::vector<Eigen::Vector2d> points);
+  void AddNode(int scan, const Pose2& odom_pose, bool doubtful,
+               std::vector<Eigen::Vector2d> points);
   // The pose of `points` in the newest node's frame: `relative` (ICP odometry's), or the
-  // odometry check's re-match when it fits the last nodes clearly better.
-  Pose2 CheckedRelative(const Pose2& relative, const std::vector<Eigen::Vector2d>& points);
+  // odometry check's re-match when it fits the last nodes clearly better (from the better fitting
+  // of `relative` and `alternative`, a local search, and
+  // over every heading when ICP odometry's match was `doubtful` and the best so far fits poorly).
+  Pose2 CheckedRelative(const Pose2& relative, const Pose2& alternative, bool doubtful,
+                        const std::vector<Eigen::Vector2d>& points);
   void SearchLoops();
   std::optional<PoseGraphEdge> TryClosure(int candidate, const Eigen::Vector2d& variance);
+  // Adds an accepted closure to the graph, or with pairwise consistency to the hypotheses,
+  // rebuilding the graph's closures when the consistent set changes.
+  void AcceptClosure(const PoseGraphEdge& edge, const LoopClosure& closure);
+  void AddClosureEdge(const PoseGraphEdge& edge, const LoopClosure& closure);
   void Optimize();
 
   GraphSlamOptions options_;
@@ -91,6 +106,11 @@ class GraphSlam {
   std::vector<std::size_t> closure_edges_;  // graph edge of each closure
   std::vector<double> switches_;            // of each graph edge, from the last optimisation
   GraphSlamCounts counts_;
+  OdometryChain chain_;  // the odometry edges alone, for pairwise consistency
+  PairwiseConsistency consistency_;
+  std::vector<PoseGraphEdge> hypothesis_edges_;  // every closure given to consistency_
+  std::vector<LoopClosure> hypothesis_closures_;
+  bool failed_since_node_ = false;  // an ICP odometry match failed since the newest node
   bool pending_closure_ = false;
   int nodes_at_last_optimization_ = 0;
 };

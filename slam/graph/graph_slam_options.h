@@ -11,6 +11,12 @@
 
 namespace slamrig::slam {
 
+/// How accepted loop closures are checked against each other.
+enum class LoopConsistency {
+  kNone,      ///< each closure on its own (its chi2 gate against the graph)
+  kPairwise,  ///< and the largest pairwise-consistent set (pairwise_consistency.h)
+};
+
 /// The field table of PoseGraphOptimizerOptions (slam/config/fields.h).
 template <typename V>
 void VisitFields(V& v, PoseGraphOptimizerOptions& o) {
@@ -58,6 +64,19 @@ struct GraphSlamOptions {
   double odometry_check_window_m = 0.3;
   double odometry_check_window_rad = 0.35;
   double odometry_check_min_gain = 0.1;
+  /// When ICP odometry's match was doubtful (see node_below_match_score) or failed since the last
+  /// node, and the best of those
+  /// scores below odometry_check_wide_below (0: never), the search is
+  /// widened to +-odometry_check_wide_window_m and every heading: a prior lost altogether (a gap
+  /// in the wheel odometry while the robot turned) is beyond any local search.
+  double odometry_check_wide_below = 0.3;
+  double odometry_check_wide_window_m = 1.0;
+  /// The widened search's pose must score at least this itself (a scan that fits nothing well
+  /// anywhere is not re-placed on the strength of a small gain).
+  double odometry_check_wide_min_score = 0.5;
+  /// A scan whose ICP odometry match (full or degenerate) scored below this becomes a
+  /// node however little it moved, so that the odometry check judges it (0: only by motion).
+  double node_below_match_score = 0.75;
 
   /// Loop closures are searched among nodes older than the last loop_skip_keyframes ...
   int loop_skip_keyframes = 30;
@@ -92,6 +111,11 @@ struct GraphSlamOptions {
   /// Geometric verification: the closure's Mahalanobis distance to the graph's own relative pose
   /// (with the accumulated and the match covariance) must be below this chi2 (3 dof; 99.9 %).
   double loop_chi2_gate = 16.27;
+  /// Pairwise consistency (Mangelson et al. 2018): with kPairwise the closures that pass the
+  /// checks above enter the graph only while they belong to the largest set whose every pair
+  /// closes its cycle through the odometry within loop_pairwise_chi2 (3 dof).
+  LoopConsistency loop_consistency = LoopConsistency::kNone;
+  double loop_pairwise_chi2 = 16.27;
   /// The loop edge's covariance: ICP's, raised to at least these standard deviations.
   double loop_sigma_xy_floor_m = 0.02;
   double loop_sigma_yaw_floor_rad = 0.005;
@@ -120,6 +144,10 @@ void VisitFields(V& v, GraphSlamOptions& o) {
   v("odometry_check_window_m", o.odometry_check_window_m);
   v("odometry_check_window_rad", o.odometry_check_window_rad);
   v("odometry_check_min_gain", o.odometry_check_min_gain);
+  v("odometry_check_wide_below", o.odometry_check_wide_below);
+  v("odometry_check_wide_window_m", o.odometry_check_wide_window_m);
+  v("odometry_check_wide_min_score", o.odometry_check_wide_min_score);
+  v("node_below_match_score", o.node_below_match_score);
   v("loop_skip_keyframes", o.loop_skip_keyframes);
   v("loop_search_radius_m", o.loop_search_radius_m);
   v("loop_radius_sigmas", o.loop_radius_sigmas);
@@ -136,6 +164,9 @@ void VisitFields(V& v, GraphSlamOptions& o) {
   v("loop_max_search_stddev_m", o.loop_max_search_stddev_m);
   v("loop_max_covariance_ratio", o.loop_max_covariance_ratio);
   v("loop_chi2_gate", o.loop_chi2_gate);
+  v.Enum("loop_consistency", o.loop_consistency,
+         {{LoopConsistency::kNone, "none"}, {LoopConsistency::kPairwise, "pairwise"}});
+  v("loop_pairwise_chi2", o.loop_pairwise_chi2);
   v("loop_sigma_xy_floor_m", o.loop_sigma_xy_floor_m);
   v("loop_sigma_yaw_floor_rad", o.loop_sigma_yaw_floor_rad);
   v("optimize_every_keyframes", o.optimize_every_keyframes);

@@ -66,12 +66,17 @@ TEST(GraphSlamTest, ClosesTheOfficeLoopAndBeatsOdometry) {
   EXPECT_GE(score.recall, 0.8);
 }
 
+struct IdenticalRoomsRun {
+  GraphSlamCounts counts;
+  std::vector<LoopClosure> closures;
+  LoopClosureScore score;
+};
+
 // Two identical rooms 8 m apart. The robot circles room A twice, moves to room B (honest
 // odometry) and circles it twice. The loop search is made generous (a 10 m radius and window), so
 // room B's nodes are matched against room A's submaps and the correlative search finds the
-// aliased pose 8 m away; the chi2 gate must reject it, as it disagrees with the graph by far
-// more than the graph's uncertainty.
-TEST(GraphSlamTest, IdenticalRoomsYieldNoFalseClosure) {
+// aliased pose 8 m away.
+IdenticalRoomsRun RunIdenticalRooms(GraphSlamOptions options) {
   testing::SegmentWorld world({});
   for (const double x0 : {0.0, 8.0}) {
     world.AddBox(x0, 0.0, x0 + 4.0, 4.0);
@@ -93,7 +98,6 @@ TEST(GraphSlamTest, IdenticalRoomsYieldNoFalseClosure) {
       }
     }
   }
-  GraphSlamOptions options;
   options.loop_skip_keyframes = 10;
   options.loop_search_radius_m = 10.0;
   options.loop_max_search_radius_m = 10.0;
@@ -110,11 +114,36 @@ TEST(GraphSlamTest, IdenticalRoomsYieldNoFalseClosure) {
   slam.Finish();
   std::vector<Pose2> reference;
   for (const Pose2& t : truth) reference.push_back(truth[0].Between(t));
-  const LoopClosureScore score = ScoreLoopClosures(slam.loop_closures(), reference);
-  EXPECT_GT(slam.counts().loop_closures, 0);  // within each room
-  EXPECT_GT(slam.counts().rejected, 0);       // room B was searched against room A
-  EXPECT_EQ(score.false_closures, 0);
-  for (const LoopClosure& c : slam.loop_closures()) {
+  return {slam.counts(), slam.loop_closures(), ScoreLoopClosures(slam.loop_closures(), reference)};
+}
+
+// The chi2 gate must reject the aliased closures, as they disagree with the graph by far more
+// than the graph's uncertainty.
+TEST(GraphSlamTest, IdenticalRoomsYieldNoFalseClosure) {
+  const IdenticalRoomsRun run = RunIdenticalRooms(GraphSlamOptions{});
+  EXPECT_GT(run.counts.loop_closures, 0);  // within each room
+  EXPECT_GT(run.counts.rejected, 0);       // room B was searched against room A
+  EXPECT_EQ(run.score.false_closures, 0);
+  for (const LoopClosure& c : run.closures) {
+    EXPECT_EQ(c.from_scan < 80, c.to_scan < 80) << c.from_scan << " -> " << c.to_scan;
+  }
+}
+
+// With the chi2 gate against the graph opened wide, the aliased closures get through on their
+// own; pairwise consistency rejects them (room B's closures to room A contradict room B's own
+// closures through the odometry) and keeps the true ones.
+TEST(GraphSlamTest, PairwiseConsistencyRejectsAliasedClosuresWithoutTheGate) {
+  GraphSlamOptions options;
+  options.loop_chi2_gate = 1e9;
+  const IdenticalRoomsRun open = RunIdenticalRooms(options);
+  ASSERT_GT(open.score.false_closures, 0);  // the gate was what kept them out
+
+  options.loop_consistency = LoopConsistency::kPairwise;
+  const IdenticalRoomsRun pairwise = RunIdenticalRooms(options);
+  EXPECT_EQ(pairwise.score.false_closures, 0);
+  EXPECT_GT(pairwise.counts.inconsistent, 0);
+  EXPECT_GE(pairwise.score.recall, 0.8);
+  for (const LoopClosure& c : pairwise.closures) {
     EXPECT_EQ(c.from_scan < 80, c.to_scan < 80) << c.from_scan << " -> " << c.to_scan;
   }
 }
@@ -158,6 +187,51 @@ TEST(GraphSlamTest, OdometryCheckRepairsAWrongOdometryEdge) {
   EXPECT_EQ(rematched_off, 0);
   EXPECT_GT(std::abs(error_off.theta()), 0.2);
   EXPECT_GE(rematched_on, 1);
+  EXPECT_LT(std::abs(error_on.theta()), 0.03);
+  EXPECT_LT(error_on.translation().norm(), 0.05);
+}
+
+// The wheel odometry misses a turn altogether (a gap in its messages while the robot turned
+// 1.2 rad in place), far beyond ICP's convergence basin and the odometry check's local window:
+// ICP odometry's match fails there, and the widened check (every heading) at the next node finds
+// the turn; without it the heading error stays.
+TEST(GraphSlamTest, WideOdometryCheckRecoversAMissedTurn) {
+  testing::SegmentWorld world({});
+  world.AddBox(0.0, 0.0, 6.0, 4.0);
+  world.AddBox(1.0, 2.5, 1.6, 3.1);
+  world.AddBox(4.2, 0.8, 4.6, 1.4);
+  testing::RangeFinderSpec lidar;
+  lidar.num_beams = 181;
+  lidar.angle_increment_rad = 1.5 * M_PI / 180.0;
+  lidar.angle_min_rad = -M_PI / 2.0 * 1.5;
+  constexpr int kTurn = 12;
+  constexpr double kTurnRad = 1.2;
+  std::vector<Pose2> truth;
+  Pose2 pose(1.0, 1.2, 0.0);
+  for (int k = 0; k < 30; ++k) {
+    if (k == kTurn) pose = pose * Pose2(0.0, 0.0, kTurnRad);
+    truth.push_back(pose);
+    pose = pose * Pose2(0.1, 0.0, 0.0);
+  }
+  auto run = [&](double wide_below) {
+    GraphSlamOptions options;
+    options.keyframe_distance_m = 0.3;
+    options.loop_max_candidates = 0;
+    options.odometry_check_wide_below = wide_below;
+    GraphSlam slam{options};
+    RandomEngine rng(5);
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      Pose2 increment = i == 0 ? Pose2() : truth[i - 1].Between(truth[i]);
+      if (static_cast<int>(i) == kTurn) increment = increment * Pose2(0.0, 0.0, -kTurnRad);
+      slam.Add(world.Scan(truth[i], Time(static_cast<std::int64_t>(i) * 100'000'000), lidar, &rng),
+               increment);
+    }
+    slam.Finish();
+    return truth[0].Between(truth.back()).Between(slam.Poses().back());
+  };
+  const Pose2 error_off = run(0.0);
+  const Pose2 error_on = run(GraphSlamOptions{}.odometry_check_wide_below);
+  EXPECT_GT(std::abs(error_off.theta()), 0.5);
   EXPECT_LT(std::abs(error_on.theta()), 0.03);
   EXPECT_LT(error_on.translation().norm(), 0.05);
 }

@@ -157,6 +157,7 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_in
     }
     step.pose = Pose2(prior.x() + correction.x(), prior.y() + correction.y(), yaw);
     step.covariance = match->covariance;
+    step.score = match->score;
     step.outcome = degenerate ? IcpOdometryOutcome::kDegenerate : IcpOdometryOutcome::kMatched;
   }
   switch (step.outcome) {

@@ -65,6 +65,7 @@ struct IcpOdometryStep {
   /// estimate; huge along a degenerate direction), or the increment's noise model on a fallback.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   IcpOdometryOutcome outcome = IcpOdometryOutcome::kFirstScan;
+  double score = 0.0;     ///< the match's score (IcpMatcher's inlier share) when it was used
   bool keyframe = false;  ///< the scan joined the local map
 };
 

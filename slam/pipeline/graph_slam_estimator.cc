@@ -56,7 +56,8 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"optimizations", c.optimizations},
           {"final_chi2", c.final_chi2},
           {"switched_off", c.switched_off},
-          {"odometry_rematched", c.odometry_rematched}};
+          {"odometry_rematched", c.odometry_rematched},
+          {"inconsistent", c.inconsistent}};
 }
 
 }  // namespace slamrig::slam

@@ -41,7 +41,7 @@ class GraphSlamEstimator final : public Estimator {
   std::optional<std::vector<Pose2>> RevisedPoses() const override { return slam_.Poses(); }
   const OccupancyGrid& map() const override { return map_; }
   /// keyframes, loop_closures, loop_candidates, rejected, optimizations, final_chi2,
-  /// switched_off.
+  /// switched_off, odometry_rematched, inconsistent.
   std::map<std::string, double> Statistics() const override;
   std::vector<LoopClosure> LoopClosures() const override { return slam_.loop_closures(); }
   /// The graph's odometry and loop-closure edges at the current estimate.
