@@ -151,6 +151,10 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
       options_.odometry_window_per_m * motion.translation().norm() + options_.odometry_window_min_m;
   const double step = options_.odometry_window_step_m;
   const int n = static_cast<int>(std::ceil(half / step));
+  const double log_far_density = std::log(eps) - 2.0 * std::log(2.0 * n * step);
+  // A point's log-likelihood is at most 0: where even a perfect match in the window could not
+  // beat the match near the prediction, the window need not be searched.
+  if (!(log_far_density + log_yaw_density(predicted) > log_near)) return motion;
   // The grid only picks where to climb from: a spread subset of the points ranks its poses at a
   // fraction of the cost (the window holds thousands of poses on a log with 1 m increments).
   constexpr std::size_t kGridPoints = 48;
@@ -173,9 +177,8 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
   constexpr double kNoPrior = 1e6;
   const ClimbResult far =
       matcher_.Climb(best.map, points, start, PosePrior{predicted, kNoPrior, sigma_yaw});
-  const double width = 2.0 * n * step;
   const double log_far = scale * matcher_.Evaluate(best.map, points, far.pose).log_likelihood +
-                         std::log(eps) - 2.0 * std::log(width) + log_yaw_density(far.pose);
+                         log_far_density + log_yaw_density(far.pose);
   if (!(log_far > log_near)) return motion;
   *rejected = true;
   return best.pose.Between(far.pose);
