@@ -177,42 +177,16 @@ ClimbResult RbpfMatcher::Climb(const TiledGrid& map, std::span<const MatchPoint>
   double best_value = objective(best.pose, best.fit);
   int evaluations = 1;
   if (options_.yaw_search_rad > 0.0) {
-    // The search only picks the yaw to climb from: a spread subset of the points ranks the yaws
-    // (its score scaled to the whole scan, so that the prior keeps its weight), the climb then
-    // works on every point.
-    constexpr std::size_t kSearchPoints = 64;
-    const std::size_t stride = std::max<std::size_t>(1, points.size() / kSearchPoints);
-    std::vector<MatchPoint> sparse;
-    sparse.reserve(points.size() / stride + 1);
-    for (std::size_t i = 0; i < points.size(); i += stride) sparse.push_back(points[i]);
-    const double to_full =
-        sparse.empty() ? 1.0
-                       : static_cast<double>(points.size()) / static_cast<double>(sparse.size());
-    auto sparse_value = [&](const Pose2& pose) {
-      MatchFit fit = Fit<false>(map, sparse, pose);
-      fit.score *= to_full;
-      return objective(pose, fit);
-    };
-    double best_sparse = sparse_value(initial);
-    Pose2 best_yaw = initial;
     const int steps = static_cast<int>(options_.yaw_search_rad / options_.yaw_search_step_rad);
     for (int i = -steps; i <= steps; ++i) {
       if (i == 0) continue;
       const Pose2 pose(initial.x(), initial.y(),
                        initial.theta() + i * options_.yaw_search_step_rad);
-      const double value = sparse_value(pose);
+      const MatchFit fit = Fit<false>(map, points, pose);
       ++evaluations;
-      if (value > best_sparse) {
-        best_sparse = value;
-        best_yaw = pose;
-      }
-    }
-    if (!(best_yaw == initial)) {
-      const MatchFit fit = Fit<false>(map, points, best_yaw);
-      ++evaluations;
-      const double value = objective(best_yaw, fit);
+      const double value = objective(pose, fit);
       if (value > best_value) {
-        best = {best_yaw, fit, 0};
+        best = {pose, fit, 0};
         best_value = value;
       }
     }

@@ -108,8 +108,7 @@ class RbpfMatcher {
   MatchFit Evaluate(const TiledGrid& map, std::span<const MatchPoint> points,
                     const Pose2& world_from_base) const;
 
-  /// The yaw search (yaw_search_rad; ranked on a spread subset of up to 64 points), then GMapping's
-  /// `optimize`: from the best yaw, step +-x, +-y,
+  /// The yaw search (yaw_search_rad), then GMapping's `optimize`: from the best yaw, step +-x, +-y,
   /// +-yaw to the best neighbour while the objective rises; halve the steps when it does not,
   /// `refinements` times. The objective is the score minus prior_weight times half the squared
   /// Mahalanobis distance to `prior`.
