@@ -36,11 +36,7 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
                           std::uint64_t seed, bool* failed) const {
   RandomEngine rng(seed);
   const Pose2 predicted = particle.pose * motion;
-  const RbpfMotionNoise& noise = options_.motion;
-  const double trans = motion.translation().norm();
-  const double rot = std::abs(motion.theta());
-  const double sigma_xy = noise.xy_per_m * trans + noise.xy_per_rad * rot + noise.min_xy_m;
-  const double sigma_yaw = noise.yaw_per_m * trans + noise.yaw_per_rad * rot + noise.min_yaw_rad;
+  const auto [sigma_xy, sigma_yaw] = MotionSigmas(motion);
   const double scale = options_.observation_scale;
 
   // The climb starts from a draw of the motion model, not from the prediction itself (as the
@@ -112,6 +108,82 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
   particle.history = std::make_shared<RbpfPoseNode>(drawn, std::move(particle.history));
 }
 
+std::pair<double, double> Rbpf::MotionSigmas(const Pose2& motion) const {
+  const RbpfMotionNoise& noise = options_.motion;
+  const double trans = motion.translation().norm();
+  const double rot = std::abs(motion.theta());
+  return {noise.xy_per_m * trans + noise.xy_per_rad * rot + noise.min_xy_m,
+          noise.yaw_per_m * trans + noise.yaw_per_rad * rot + noise.min_yaw_rad};
+}
+
+Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& points,
+                          bool* rejected) const {
+  // Two hypotheses for the increment, compared on the best particle's map (the increment is in
+  // the robot frame, so it carries over to every particle):
+  //  - the odometry holds: the match near the prediction, climbed with the motion prior, whose
+  //    density is (1 - eps) times the Gaussian motion model;
+  //  - the odometry failed: the best match anywhere in the window, whose translation density is
+  //    eps / window area (yaw still from the Gaussian: the failures this guards against, slip
+  //    and a reversal counted as forward motion, are of the translation).
+  // Each is scored by its observation likelihood (observation_scale, as the weights) times that
+  // density. Without a failure the window's best match is the prediction's or one the density
+  // ratio outweighs (a corridor's axis gives equal likelihoods: the odometry wins there).
+  const RbpfParticle& best = particles_[best_];
+  const Pose2 predicted = best.pose * motion;
+  const auto [sigma_xy, sigma_yaw] = MotionSigmas(motion);
+  const double scale = options_.observation_scale;
+  const double eps = options_.odometry_failure_probability;
+  constexpr double kLog2Pi = 1.8378770664093453;
+  auto log_yaw_density = [&](const Pose2& pose) {
+    const double dt = NormalizeAngle(pose.theta() - predicted.theta());
+    return -0.5 * dt * dt / (sigma_yaw * sigma_yaw) - 0.5 * kLog2Pi - std::log(sigma_yaw);
+  };
+
+  const ClimbResult near =
+      matcher_.Climb(best.map, points, predicted, PosePrior{predicted, sigma_xy, sigma_yaw});
+  const double ex = near.pose.x() - predicted.x();
+  const double ey = near.pose.y() - predicted.y();
+  const double log_near = scale * matcher_.Evaluate(best.map, points, near.pose).log_likelihood +
+                          std::log1p(-eps) - 0.5 * (ex * ex + ey * ey) / (sigma_xy * sigma_xy) -
+                          kLog2Pi - 2.0 * std::log(sigma_xy) + log_yaw_density(near.pose);
+
+  const double half =
+      options_.odometry_window_per_m * motion.translation().norm() + options_.odometry_window_min_m;
+  const double step = options_.odometry_window_step_m;
+  const int n = static_cast<int>(std::ceil(half / step));
+  const double log_far_density = std::log(eps) - 2.0 * std::log(2.0 * n * step);
+  // A point's log-likelihood is at most 0: where even a perfect match in the window could not
+  // beat the match near the prediction, the window need not be searched.
+  if (!(log_far_density + log_yaw_density(predicted) > log_near)) return motion;
+  // The grid only picks where to climb from: a spread subset of the points ranks its poses at a
+  // fraction of the cost (the window holds thousands of poses on a log with 1 m increments).
+  constexpr std::size_t kGridPoints = 48;
+  std::vector<MatchPoint> sparse;
+  const std::size_t stride = std::max<std::size_t>(1, points.size() / kGridPoints);
+  for (std::size_t i = 0; i < points.size(); i += stride) sparse.push_back(points[i]);
+  Pose2 start = predicted;
+  double start_ll = -std::numeric_limits<double>::infinity();
+  for (int iy = -n; iy <= n; ++iy) {
+    for (int ix = -n; ix <= n; ++ix) {
+      const Pose2 pose(predicted.x() + ix * step, predicted.y() + iy * step, predicted.theta());
+      const double ll = matcher_.Evaluate(best.map, sparse, pose).log_likelihood;
+      if (ll > start_ll) {
+        start_ll = ll;
+        start = pose;
+      }
+    }
+  }
+  // No prior in the climb: under this hypothesis the odometry says nothing about the position.
+  constexpr double kNoPrior = 1e6;
+  const ClimbResult far =
+      matcher_.Climb(best.map, points, start, PosePrior{predicted, kNoPrior, sigma_yaw});
+  const double log_far = scale * matcher_.Evaluate(best.map, points, far.pose).log_likelihood +
+                         log_far_density + log_yaw_density(far.pose);
+  if (!(log_far > log_near)) return motion;
+  *rejected = true;
+  return best.pose.Between(far.pose);
+}
+
 void Rbpf::Resample(const std::vector<double>& weights) {
   const std::vector<int> keep = slam::Resample(weights, options_.resampling, rng_);
   std::vector<RbpfParticle> resampled;
@@ -149,7 +221,7 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
     step.failed_matches = 0;
     return step;
   }
-  const Pose2 motion = pending_motion_;
+  const Pose2 pending = pending_motion_;
   pending_motion_ = Pose2();
   step.updated = true;
   ++update_count_;
@@ -160,6 +232,11 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
   for (std::uint64_t& s : seeds) s = rng_();
   const std::vector<MatchPoint> points =
       MakeMatchPoints(scan, options_.points, options_.map.resolution_m);
+  Pose2 motion = pending;
+  if (options_.odometry_failure_probability > 0.0 && !points.empty()) {
+    motion = CheckOdometry(pending, points, &step.odometry_rejected);
+    odometry_rejections_ += step.odometry_rejected;
+  }
   std::vector<char> failed(static_cast<std::size_t>(n), 0);
   auto update_block = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {

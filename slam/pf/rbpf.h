@@ -1,6 +1,7 @@
 #pragma once
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "slam/grid/tiled_grid.h"
@@ -47,6 +48,8 @@ struct RbpfStep {
   bool updated = false;           ///< false: the robot moved too little, poses follow the odometry
   int failed_matches = 0;         ///< particles whose scan match failed (odometry proposal)
   double matched_fraction = 0.0;  ///< of the best particle's scan points, at its new pose
+  /// The odometry check replaced the increment by the best particle's wide match.
+  bool odometry_rejected = false;
 };
 
 /// A Rao-Blackwellised particle filter with per-particle maps, GMapping's method (Grisetti,
@@ -74,6 +77,9 @@ class Rbpf {
   int DistinctTiles() const;
   int resample_count() const { return resample_count_; }
   int update_count() const { return update_count_; }
+  /// Updates whose odometry increment the check replaced
+  /// (RbpfOptions::odometry_failure_probability).
+  int odometry_rejections() const { return odometry_rejections_; }
   const RbpfOptions& options() const { return options_; }
 
  private:
@@ -82,6 +88,12 @@ class Rbpf {
                       const std::vector<MatchPoint>& points, const LaserScan& scan,
                       std::uint64_t seed, bool* failed) const;
   void Resample(const std::vector<double>& weights);
+  /// The odometry check: `motion`, or the increment the best particle's wide match gives where
+  /// the mixture model finds that more likely (then `*rejected` is set).
+  Pose2 CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& points,
+                      bool* rejected) const;
+  /// The motion model's standard deviations (x, y each; yaw) for an increment.
+  std::pair<double, double> MotionSigmas(const Pose2& motion) const;
 
   RbpfOptions options_;
   RbpfMatcher matcher_;
@@ -94,6 +106,7 @@ class Rbpf {
   RbpfStep last_step_;
   int resample_count_ = 0;
   int update_count_ = 0;
+  int odometry_rejections_ = 0;
 };
 
 }  // namespace slamrig::slam

@@ -53,6 +53,19 @@ struct RbpfOptions {
   /// correlated (GMapping flattens its weights in the same way).
   double observation_scale = 0.2;
 
+  /// The odometry check: the odometry model is a mixture, with this probability of a failed
+  /// increment (wheel slip, a reversal reported as forward motion, a collision) whose translation
+  /// is anywhere in a square window around the prediction. Each update the best particle's scan
+  /// is matched over that window; where the match there, weighed by this mixture, is more likely
+  /// than the one near the prediction, the increment becomes the matched one for every particle.
+  /// 0 = off (the odometry is always trusted as a Gaussian).
+  double odometry_failure_probability = 0.01;
+  /// Half-width of the window: odometry_window_per_m per m of odometry translation (2: a
+  /// reversal reported as forward motion is inside) plus odometry_window_min_m.
+  double odometry_window_per_m = 2.0;
+  double odometry_window_min_m = 0.1;
+  double odometry_window_step_m = 0.1;  ///< spacing of the window's grid of starting poses
+
   ResamplingScheme resampling = ResamplingScheme::kSystematic;
   /// Resample when Neff < resample_neff_ratio * num_particles (selective resampling).
   double resample_neff_ratio = 0.5;
@@ -81,6 +94,10 @@ void VisitFields(V& v, RbpfOptions& o) {
   v("proposal_xy_step_m", o.proposal_xy_step_m);
   v("proposal_yaw_step_rad", o.proposal_yaw_step_rad);
   v("observation_scale", o.observation_scale);
+  v("odometry_failure_probability", o.odometry_failure_probability);
+  v("odometry_window_per_m", o.odometry_window_per_m);
+  v("odometry_window_min_m", o.odometry_window_min_m);
+  v("odometry_window_step_m", o.odometry_window_step_m);
   v.Enum("resampling", o.resampling,
          {{ResamplingScheme::kSystematic, "systematic"},
           {ResamplingScheme::kStratified, "stratified"}});

@@ -29,6 +29,7 @@ struct RbpfRun {
   std::vector<Pose2> online;
   std::vector<Pose2> updates;  // the best particle's path at the end
   int resamples = 0;
+  int odometry_rejections = 0;
 };
 
 RbpfRun RunFilter(const std::vector<SyncedScan>& scans, const RbpfOptions& options) {
@@ -38,6 +39,7 @@ RbpfRun RunFilter(const std::vector<SyncedScan>& scans, const RbpfOptions& optio
     run.online.push_back(filter.AddScan(s.scan, s.increment).best_pose);
   run.updates = filter.BestUpdatePoses();
   run.resamples = filter.resample_count();
+  run.odometry_rejections = filter.odometry_rejections();
   return run;
 }
 
@@ -52,6 +54,31 @@ TEST(RbpfTest, BeatsDeadReckoningOnASyntheticOfficeRun) {
   EXPECT_LT(rmse, 0.1) << "dead reckoning " << dr;
   EXPECT_LT(rmse, 0.3 * dr);
   EXPECT_GT(rbpf.resamples, 0);
+  // Good odometry: the check never replaces it.
+  EXPECT_EQ(rbpf.odometry_rejections, 0);
+}
+
+// Odometry that reports 3 s of driving round the corner as reversing (freiburg-079's odometry does
+// the opposite: it counts reversals as forward motion): the odometry check follows the scans,
+// while a filter that trusts the odometry as a Gaussian is dragged off by twice the distance.
+TEST(RbpfTest, OdometryCheckFollowsTheScansWhenTheOdometryReversesItsSign) {
+  const ShortRun& run = GetShortRun();
+  std::vector<SyncedScan> scans = run.scans;
+  for (std::size_t i = 320; i < 350 && i < scans.size(); ++i) {
+    const Pose2& u = scans[i].increment;
+    scans[i].increment = Pose2(-u.x(), -u.y(), u.theta());
+  }
+  RbpfOptions options = FastOptions();
+  const RbpfRun with_check = RunFilter(scans, options);
+  options.odometry_failure_probability = 0.0;
+  const RbpfRun without_check = RunFilter(scans, options);
+  const double rmse = PositionRmse(with_check.online, run.run.truth);
+  const double rmse_without = PositionRmse(without_check.online, run.run.truth);
+  RecordProperty("rmse_with_check_m", std::to_string(rmse));
+  RecordProperty("rmse_without_check_m", std::to_string(rmse_without));
+  EXPECT_LT(rmse, 0.1) << "without the check " << rmse_without;
+  EXPECT_GT(rmse_without, 3.0 * rmse);
+  EXPECT_GT(with_check.odometry_rejections, 0);
 }
 
 TEST(RbpfTest, SameSeedSameTrajectoryWhateverTheThreadCount) {

@@ -55,6 +55,7 @@ std::map<std::string, double> RbpfEstimator::Statistics() const {
           {"resamples", filter_.resample_count()},
           {"updates", updates_},
           {"failed_matches", failed_matches_},
+          {"odometry_rejections", filter_.odometry_rejections()},
           {"map_tiles", tiles},
           {"map_tiles_per_particle",
            filter_.particles().empty()

@@ -23,8 +23,8 @@ class RbpfEstimator final : public Estimator {
   /// The best particle's map, converted when asked for after it changed.
   const OccupancyGrid& map() const override;
   /// mean_neff, resamples, updates, failed_matches (particle matches that fell back on the
-  /// odometry), map_tiles (distinct tiles over all particles at the end) and
-  /// map_tiles_per_particle.
+  /// odometry), odometry_rejections (updates whose increment the odometry check replaced),
+  /// map_tiles (distinct tiles over all particles at the end) and map_tiles_per_particle.
   std::map<std::string, double> Statistics() const override;
   EstimatorView View() const override;
 
