@@ -54,7 +54,8 @@ const std::vector<Algorithm>& Algorithms() {
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<AlgorithmOptionsFor<EkfSlamEstimatorOptions, EkfSlamEstimator>>(
              EkfSlamEstimatorOptions{});
-       }},
+       },
+       /*maps_landmarks=*/true},
       {"icp-odometry",
        "scan-to-local-map point-to-line ICP with the wheel odometry as prior, the map along it",
        {"default"},
