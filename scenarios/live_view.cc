@@ -1,5 +1,6 @@
 #include "scenarios/live_view.h"
 
+#include <Eigen/Eigenvalues>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -54,11 +55,15 @@ LiveFrame DrawLiveFrame(double sim_time_s, const slam::OccupancyGrid& map,
                         const Pose2& world_from_map, const std::vector<Pose2>& truth_path,
                         const std::vector<LiveEstimate>& estimates,
                         const std::vector<std::vector<Pose2>>& estimate_paths) {
-  // Frame the robot's whereabouts with 5 m around them (the map may reach much further).
+  // Frame the robot's whereabouts and the landmarks with 5 m around them (the map may reach much
+  // further).
   Eigen::AlignedBox2d box;
   for (const Pose2& p : truth_path) box.extend(p.translation());
   for (const auto& path : estimate_paths) {
     for (const Pose2& p : path) box.extend(p.translation());
+  }
+  for (const LiveEstimate& e : estimates) {
+    for (const LiveLandmark& l : e.landmarks) box.extend(l.position_m);
   }
   if (box.isEmpty()) box.extend(Eigen::Vector2d::Zero());
   box.min() -= Eigen::Vector2d::Constant(5.0);
@@ -98,6 +103,19 @@ LiveFrame DrawLiveFrame(double sim_time_s, const slam::OccupancyGrid& map,
     cv::circle(image, c, 5, colour, 2, cv::LINE_AA);
     cv::line(image, c, tip, colour, 2, cv::LINE_AA);
   };
+  // A 3-sigma ellipse, at least 2 px across so that a confident one stays visible.
+  auto draw_ellipse = [&](const Eigen::Vector2d& c, const Eigen::Matrix2d& covariance,
+                          const cv::Scalar& colour) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(covariance);
+    const Eigen::Vector2d axes = 3.0 * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt() * scale;
+    const Eigen::Vector2d major = eigen.eigenvectors().col(1);
+    // Rows grow downwards: the angle in the image is the negated world angle.
+    const double angle_deg = -std::atan2(major.y(), major.x()) * 180.0 / M_PI;
+    cv::ellipse(
+        image, px(c),
+        cv::Size(std::max(2, static_cast<int>(axes(1))), std::max(2, static_cast<int>(axes(0)))),
+        angle_deg, 0.0, 360.0, colour, 1, cv::LINE_8);
+  };
   const cv::Scalar truth_colour(40, 160, 40);
   draw_path(truth_path, truth_colour);
   if (!truth_path.empty()) draw_pose(truth_path.back(), truth_colour);
@@ -116,7 +134,13 @@ LiveFrame DrawLiveFrame(double sim_time_s, const slam::OccupancyGrid& map,
       cv::circle(image, px(p.translation()), 1, colour, cv::FILLED);
     if (i < estimate_paths.size() && estimates[i].edges.empty())
       draw_path(estimate_paths[i], colour);
+    for (const LiveLandmark& l : estimates[i].landmarks) {
+      cv::drawMarker(image, px(l.position_m), colour, cv::MARKER_CROSS, 7, 1);
+      draw_ellipse(l.position_m, l.covariance, colour);
+    }
     if (estimates[i].has_pose) draw_pose(estimates[i].pose, colour);
+    if (estimates[i].has_pose && estimates[i].position_covariance)
+      draw_ellipse(estimates[i].pose.translation(), *estimates[i].position_covariance, colour);
     cv::putText(image, estimates[i].name, {10, 44 + 20 * static_cast<int>(i)},
                 cv::FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv::LINE_AA);
   }

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,14 +19,23 @@ struct LiveEdge {
   bool loop_closure = false;  ///< drawn in kLoopClosureBgr, else thin in the estimate's colour
 };
 
+/// A mapped landmark to draw, world frame: a cross and its 3-sigma ellipse.
+struct LiveLandmark {
+  Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+};
+
 /// One estimate to draw: its pose, its recent path and, for a particle filter, its particles,
-/// for a graph estimator its edges.
+/// for a graph estimator its edges, for a landmark estimator its landmarks; the pose's 3-sigma
+/// position ellipse where it has a covariance.
 struct LiveEstimate {
   std::string name;
   bool has_pose = false;  ///< false until the estimator has processed its first scan
   Pose2 pose;
   std::vector<Pose2> particles;
   std::vector<LiveEdge> edges;
+  std::vector<LiveLandmark> landmarks;
+  std::optional<Eigen::Matrix2d> position_covariance;  ///< of pose's x, y (world frame)
 };
 
 /// The colour of loop-closure edges in the live view (orange), blue-green-red.

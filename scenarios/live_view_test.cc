@@ -79,3 +79,41 @@ TEST(LiveViewTest, AnEstimateWithoutEdgesDrawsNoLoopClosure) {
 
 }  // namespace
 }  // namespace slamrig::scenario
+
+namespace slamrig::scenario {
+namespace {
+
+// A landmark estimate: each landmark's 3-sigma ellipse (here 0.5 m sigma along x, 0.1 m along y)
+// is drawn in the estimate's colour at 1.5 m beside the landmark on the x axis, not 1.5 m
+// beside it on the y axis.
+TEST(LiveViewTest, DrawsLandmarksWithTheirCovarianceEllipses) {
+  const slam::OccupancyGrid map{slam::OccupancyGridOptions{}};
+  LiveEstimate e;
+  e.name = "ekf-slam";
+  e.has_pose = true;
+  e.pose = Pose2(0.0, 0.0, 0.0);
+  e.landmarks.push_back({{4.0, 4.0}, Eigen::Vector2d(0.25, 0.01).asDiagonal()});
+  const LiveFrame frame = DrawLiveFrame(1.0, map, Pose2(), {Pose2()}, {e}, {{Pose2()}});
+  const Colour c = PaletteColour(0);
+  const auto is_estimate = [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector2i px = frame.PixelOf(p);
+    bool found = false;
+    // The ellipse is a 1 px line: look in a 3 x 3 neighbourhood.
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const std::size_t i =
+            3 * (static_cast<std::size_t>(px.y() + dy) * frame.width_px + px.x() + dx);
+        found =
+            found || (frame.bgr[i] == c.b && frame.bgr[i + 1] == c.g && frame.bgr[i + 2] == c.r);
+      }
+    }
+    return found;
+  };
+  EXPECT_TRUE(is_estimate({5.5, 4.0}));
+  EXPECT_TRUE(is_estimate({2.5, 4.0}));
+  EXPECT_FALSE(is_estimate({4.0, 5.5}));
+  EXPECT_TRUE(is_estimate({4.0, 4.3}));
+}
+
+}  // namespace
+}  // namespace slamrig::scenario

@@ -1,3 +1,4 @@
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -114,6 +115,54 @@ std::string MetricsJson(const ScenarioResult& r) {
   return j.Finish();
 }
 
+// The 3-sigma ellipse of a 2D covariance, as a closed polyline of segments.
+void AddEllipse(const Eigen::Vector2d& center, const Eigen::Matrix2d& covariance, Colour colour,
+                std::vector<slam::SegmentOverlay>* out) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(covariance);
+  const Eigen::Vector2d radii = 3.0 * eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  const Eigen::Matrix2d axes = eigen.eigenvectors();
+  constexpr int kSides = 24;
+  const auto point = [&](int k) {
+    const double a = 2.0 * M_PI * k / kSides;
+    return Eigen::Vector2d(center +
+                           axes * Eigen::Vector2d(radii(0) * std::cos(a), radii(1) * std::sin(a)));
+  };
+  for (int k = 0; k < kSides; ++k)
+    out->push_back({point(k), point(k + 1), colour.b, colour.g, colour.r});
+}
+
+// A small cross marking a point (a landmark, a true pillar), `size_m` across.
+void AddCross(const Eigen::Vector2d& c, double size_m, Colour colour,
+              std::vector<slam::SegmentOverlay>* out) {
+  const double h = 0.5 * size_m;
+  out->push_back(
+      {c - Eigen::Vector2d(h, h), c + Eigen::Vector2d(h, h), colour.b, colour.g, colour.r});
+  out->push_back(
+      {c - Eigen::Vector2d(h, -h), c + Eigen::Vector2d(h, -h), colour.b, colour.g, colour.r});
+}
+
+// A landmark estimator's map in the map frame: one line per landmark, its covariance and its
+// sightings.
+std::string LandmarksCsv(const ConfigResult& c) {
+  const double yaw = c.map_from_estimator.theta();
+  Eigen::Matrix2d rotation;
+  rotation << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);
+  std::vector<int> sightings(c.run.landmarks.landmarks.size(), 0);
+  for (const slam::LandmarkSighting& s : c.run.landmarks.sightings)
+    if (s.landmark >= 0 && s.landmark < static_cast<int>(sightings.size())) ++sightings[s.landmark];
+  std::ostringstream out;
+  out.precision(9);
+  out << "# index,x_m,y_m,xx,xy,yy,sightings (map frame, m and m^2)\n";
+  for (std::size_t i = 0; i < c.run.landmarks.landmarks.size(); ++i) {
+    const slam::LandmarkEstimate& l = c.run.landmarks.landmarks[i];
+    const Eigen::Vector2d p = c.map_from_estimator * l.position_m;
+    const Eigen::Matrix2d q = rotation * l.covariance * rotation.transpose();
+    out << i << ',' << p.x() << ',' << p.y() << ',' << q(0, 0) << ',' << q(0, 1) << ',' << q(1, 1)
+        << ',' << sightings[i] << '\n';
+  }
+  return out.str();
+}
+
 }  // namespace
 
 std::string ExpectationOutcome::Describe() const {
@@ -207,6 +256,9 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
       slam::WriteFileAtomically(file(c.name + "_covariance.csv"),
                                 slam::CovarianceCsv(c.online, in_map));
     }
+    if (!c.run.landmarks.landmarks.empty()) {
+      slam::WriteFileAtomically(file(c.name + "_landmarks.csv"), LandmarksCsv(c));
+    }
     const Colour colour = PaletteColour(i == 2 ? 4 : i);  // skip palette green (the truth's)
     overlays.push_back({&c.estimate, c.name, colour.b, colour.g, colour.r});
     slam::WriteMapServerMap(c.run.map, file(c.name + "_map"));
@@ -250,10 +302,35 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
                                 static_cast<std::uint8_t>(ok ? 170 : 0),
                                 static_cast<std::uint8_t>(ok ? 0 : 220)});
       }
+      // A landmark estimator's landmarks (crosses) with their 3-sigma ellipses, the true
+      // pillars (green crosses, in its frame) and the last pose's 3-sigma position ellipse.
+      const bool has_landmarks = !c.run.landmarks.landmarks.empty();
+      if (has_landmarks) {
+        const Colour mark = PaletteColour(3);
+        for (const slam::LandmarkEstimate& l : c.run.landmarks.landmarks) {
+          AddCross(l.position_m, 0.4, mark, &own.segments);
+          AddEllipse(l.position_m, l.covariance, mark, &own.segments);
+        }
+        if (r.spec->simulated) {
+          for (const sim::ShapeSpec& shape : r.spec->simulated->options.world.walls) {
+            if (shape.type == sim::ShapeType::kCircle)
+              AddCross(estimator_from_map * shape.center_m, 0.6, {40, 160, 40}, &own.segments);
+          }
+        }
+        if (!c.run.covariances.empty() && !c.run.online.empty()) {
+          AddEllipse(c.run.online.poses().back().pose.translation(),
+                     c.run.covariances.back().topLeftCorner<2, 2>(), mark, &own.segments);
+        }
+      }
       slam::WriteMapPng(file(c.name + "_map.png"), c.run.map, {truth_overlay, estimate_overlay},
                         own);
       html_maps += "<figure><img src=\"" + c.name + "_map.png\"><figcaption>" + Html(c.name) +
-                   "'s map with its trajectory (and the truth, in green).</figcaption></figure>";
+                   "'s map with its trajectory (and the truth, in green)" +
+                   (has_landmarks ? "; its landmarks (crosses) with 3-sigma ellipses, the true "
+                                    "pillars (green crosses) and the last pose's 3-sigma "
+                                    "ellipse"
+                                  : "") +
+                   ".</figcaption></figure>";
     }
   }
 

@@ -1,5 +1,6 @@
 #include "scenarios/scenario_runner.h"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -67,6 +68,17 @@ void ShowLive(LiveView& view, double now_s, const Runners& runners, const Pose2&
     for (const slam::ViewEdge& edge : extras.edges) {
       e.edges.push_back({map_from_start * edge.from, map_from_start * edge.to, edge.loop_closure});
     }
+    const double c = std::cos(map_from_start.theta()), s = std::sin(map_from_start.theta());
+    Eigen::Matrix2d rotation;
+    rotation << c, -s, s, c;
+    for (const slam::LandmarkEstimate& l : extras.landmarks) {
+      e.landmarks.push_back(
+          {map_from_start * l.position_m, rotation * l.covariance * rotation.transpose()});
+    }
+    if (extras.pose_covariance) {
+      e.position_covariance =
+          rotation * extras.pose_covariance->topLeftCorner<2, 2>() * rotation.transpose();
+    }
     if (!extras.particles.empty() && !shown_has_particles) {
       shown = r.get();
       shown_has_particles = true;
@@ -105,6 +117,103 @@ void ScoreNees(const ScenarioResult& run, ConfigResult* c) {
   m["nees_upper_95"] = bounds.upper;
 }
 
+// A landmark estimator's map against the world's round pillars (its circles): each pillar
+// paired with its nearest estimated landmark when each is the other's nearest and they lie within
+// kPillarMatchRadius; the errors, the landmark NEES (2 dof) of the pairs, and the wrong
+// associations. The pillar of a sighting is the one nearest the observed centre placed at the
+// true pose (none beyond kPillarMatchRadius: clutter), a landmark's the one most of its sightings
+// are of; a sighting is wrong when its pillar is not its landmark's, or, for a clutter landmark,
+// when it lies further than kPillarMatchRadius from where that landmark ended up.
+constexpr double kPillarMatchRadius = 0.5;
+
+void ScoreLandmarks(const ScenarioResult& run, ConfigResult* c) {
+  const slam::LandmarkMap& map = c->run.landmarks;
+  if (!run.spec->simulated || (map.landmarks.empty() && map.sightings.empty())) return;
+  std::vector<Eigen::Vector2d> pillars;
+  for (const sim::ShapeSpec& shape : run.spec->simulated->options.world.walls)
+    if (shape.type == sim::ShapeType::kCircle) pillars.push_back(shape.center_m);
+  const double yaw = c->map_from_estimator.theta();
+  Eigen::Matrix2d rotation;
+  rotation << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);
+  std::vector<Eigen::Vector2d> estimated;
+  for (const slam::LandmarkEstimate& l : map.landmarks)
+    estimated.push_back(c->map_from_estimator * l.position_m);
+  const auto nearest = [](const std::vector<Eigen::Vector2d>& set, const Eigen::Vector2d& p) {
+    int best = -1;
+    for (int i = 0; i < static_cast<int>(set.size()); ++i)
+      if (best < 0 || (set[i] - p).norm() < (set[best] - p).norm()) best = i;
+    return best;
+  };
+  auto& m = c->metrics;
+  int mapped = 0;
+  double error_sum = 0.0, error_max = 0.0, nees_sum = 0.0;
+  std::vector<bool> landmark_matched(estimated.size(), false);
+  for (int i = 0; i < static_cast<int>(pillars.size()); ++i) {
+    const int j = nearest(estimated, pillars[i]);
+    if (j < 0 || nearest(pillars, estimated[j]) != i) continue;
+    const Eigen::Vector2d e = pillars[i] - estimated[j];
+    if (e.norm() > kPillarMatchRadius) continue;
+    ++mapped;
+    landmark_matched[j] = true;
+    error_sum += e.norm();
+    error_max = std::max(error_max, e.norm());
+    const Eigen::Matrix2d covariance =
+        rotation * map.landmarks[j].covariance * rotation.transpose();
+    nees_sum += e.dot(covariance.ldlt().solve(e));
+  }
+  m["pillars"] = static_cast<double>(pillars.size());
+  m["pillars_mapped"] = mapped;
+  m["spurious_landmarks"] =
+      static_cast<double>(std::count(landmark_matched.begin(), landmark_matched.end(), false));
+  m["landmark_error_max_m"] = mapped > 0 ? error_max : NAN;
+  m["landmark_error_mean_m"] = mapped > 0 ? error_sum / mapped : NAN;
+  m["landmark_anees"] = mapped > 0 ? nees_sum / mapped : NAN;
+  if (mapped > 0) {
+    const slam::NeesBounds bounds = slam::AneesBounds(2, mapped);
+    m["landmark_anees_lower_95"] = bounds.lower;
+    m["landmark_anees_upper_95"] = bounds.upper;
+  }
+  // The true pillar of every sighting, then each landmark's by majority.
+  std::vector<int> pillar_of_sighting;
+  std::vector<std::optional<Eigen::Vector2d>> true_point;
+  std::vector<std::map<int, int>> votes(map.landmarks.size());
+  for (const slam::LandmarkSighting& s : map.sightings) {
+    const std::optional<Pose2> truth = run.truth.Interpolate(s.time);
+    int pillar = -1;
+    true_point.emplace_back();
+    if (truth) {
+      const Eigen::Vector2d p = *truth * s.center_base_m;
+      true_point.back() = p;
+      pillar = nearest(pillars, p);
+      if (pillar >= 0 && (pillars[pillar] - p).norm() > kPillarMatchRadius) pillar = -1;
+    }
+    pillar_of_sighting.push_back(pillar);
+    if (s.landmark >= 0 && s.landmark < static_cast<int>(votes.size())) ++votes[s.landmark][pillar];
+  }
+  std::vector<int> pillar_of_landmark(votes.size(), -1);
+  for (std::size_t j = 0; j < votes.size(); ++j) {
+    int most = 0;
+    for (const auto& [pillar, count] : votes[j]) {
+      if (count > most) {
+        most = count;
+        pillar_of_landmark[j] = pillar;
+      }
+    }
+  }
+  int wrong = 0;
+  for (std::size_t k = 0; k < map.sightings.size(); ++k) {
+    const int j = map.sightings[k].landmark;
+    if (j < 0 || j >= static_cast<int>(votes.size())) continue;
+    if (pillar_of_landmark[j] >= 0 || pillar_of_sighting[k] >= 0) {
+      wrong += pillar_of_sighting[k] != pillar_of_landmark[j];
+    } else {
+      wrong += !true_point[k] || (*true_point[k] - estimated[j]).norm() > kPillarMatchRadius;
+    }
+  }
+  m["landmark_sightings"] = static_cast<double>(map.sightings.size());
+  m["wrong_associations"] = wrong;
+}
+
 // Scores of one configuration against the reference (NaN where there is none).
 void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
   auto& m = c->metrics;
@@ -123,6 +232,7 @@ void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
   m["ate_rot_rmse_rad"] = t.ate.rotation_rad.rmse;
   m["online_ate_rmse_m"] = slam::ComputeAte(c->online, run.truth).translation_m.rmse;
   ScoreNees(run, c);
+  ScoreLandmarks(run, c);
   // Means of the pairs' translation errors; NaN when the run is too short for a spacing.
   const auto mean = [](const slam::ErrorStats& s) { return s.count ? s.mean : NAN; };
   m["rpe_m_per_scan"] = mean(t.rpe_per_scan.translation_m);

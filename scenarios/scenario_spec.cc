@@ -172,10 +172,26 @@ const std::vector<std::string>& TruthMetrics() {
   return metrics;
 }
 
+const std::vector<std::string>& LandmarkMetrics() {
+  static const std::vector<std::string> metrics = {"pillars",
+                                                   "pillars_mapped",
+                                                   "spurious_landmarks",
+                                                   "landmark_error_max_m",
+                                                   "landmark_error_mean_m",
+                                                   "landmark_anees",
+                                                   "landmark_anees_lower_95",
+                                                   "landmark_anees_upper_95",
+                                                   "landmark_sightings",
+                                                   "wrong_associations"};
+  return metrics;
+}
+
 std::vector<std::string> MetricsOf(const slam::EstimatorConfig& config) {
   std::vector<std::string> metrics = KnownMetrics();
   if (const slam::Algorithm* a = slam::FindAlgorithm(config.algorithm)) {
     metrics.insert(metrics.end(), a->statistics.begin(), a->statistics.end());
+    if (a->maps_landmarks)
+      metrics.insert(metrics.end(), LandmarkMetrics().begin(), LandmarkMetrics().end());
   }
   return metrics;
 }

@@ -109,7 +109,12 @@ const std::vector<std::string>& KnownMetrics();
 /// true poses (`expect: {truth: {texture_psnr_db_min: 20}}`).
 const std::vector<std::string>& TruthMetrics();
 
-/// The metrics of `config`: KnownMetrics() and its algorithm's statistics.
+/// The scores of a landmark map against the world's pillars (simulated runs of algorithms that
+/// map landmarks).
+const std::vector<std::string>& LandmarkMetrics();
+
+/// The metrics of `config`: KnownMetrics(), its algorithm's statistics and, for an algorithm that
+/// maps landmarks, LandmarkMetrics().
 std::vector<std::string> MetricsOf(const slam::EstimatorConfig& config);
 
 /// Reads a scenario file strictly. `overrides` are `key=value` texts: keys starting with

@@ -65,6 +65,14 @@ class PoseEkf {
   Eigen::Matrix3d PoseCovariance() const { return p_.block<3, 3>(3, 3); }
   /// The whole 8 x 8 covariance.
   const Eigen::Matrix<double, 8, 8>& covariance() const { return p_; }
+  /// The whole state: clone (x, y, yaw), pose (x, y, yaw), gyro bias, gyro scale error.
+  const Eigen::Matrix<double, 8, 1>& state() const { return x_; }
+  /// Replaces the state and its covariance: for a filter that carries this state inside a larger
+  /// one (EKF-SLAM) and predicts through this one's motion model.
+  void SetState(const Eigen::Matrix<double, 8, 1>& x, const Eigen::Matrix<double, 8, 8>& p) {
+    x_ = x;
+    p_ = p;
+  }
 
  private:
   EkfUpdate Update(const Eigen::VectorXd& innovation, const Eigen::MatrixXd& h,

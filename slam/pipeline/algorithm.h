@@ -68,6 +68,9 @@ struct Algorithm {
   std::vector<std::string> statistics;  ///< the names Estimator::Statistics() reports
   /// The options of `preset` (one of `presets`).
   std::function<std::unique_ptr<AlgorithmOptions>(const std::string& preset)> make_options;
+  /// It reports a landmark map (Estimator::Landmarks()), which simulated runs score against the
+  /// world's pillars (the landmark metrics of metrics.json).
+  bool maps_landmarks = false;
 };
 
 /// Every algorithm, in the order --help lists them.

@@ -4,6 +4,7 @@
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/dead_reckoning_estimator.h"
 #include "slam/pipeline/ekf_estimator.h"
+#include "slam/pipeline/ekf_slam_estimator.h"
 #include "slam/pipeline/graph_slam_estimator.h"
 #include "slam/pipeline/icp_odometry_estimator.h"
 #include "slam/pipeline/particle_filter_estimator.h"
@@ -43,6 +44,18 @@ const std::vector<Algorithm>& Algorithms() {
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<AlgorithmOptionsFor<EkfOptions, EkfEstimator>>(EkfOptions{});
        }},
+      {"ekf-slam",
+       "landmark EKF-SLAM: encoders and gyro predict, round landmarks (pillars) from each scan "
+       "update pose and map, association by nearest neighbour or JCBB",
+       {"default"},
+       {"landmarks", "tentative_landmarks", "landmark_observations", "landmark_pairings",
+        "ambiguous_observations", "landmark_updates", "zero_rate_updates", "gyro_bias_rad_s",
+        "mean_nis_per_dof"},
+       [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
+         return std::make_unique<AlgorithmOptionsFor<EkfSlamEstimatorOptions, EkfSlamEstimator>>(
+             EkfSlamEstimatorOptions{});
+       },
+       /*maps_landmarks=*/true},
       {"icp-odometry",
        "scan-to-local-map point-to-line ICP with the wheel odometry as prior, the map along it",
        {"default"},

@@ -44,11 +44,36 @@ struct ViewEdge {
   bool loop_closure = false;  ///< a loop closure, else an odometry edge
 };
 
+/// A mapped point landmark (a pillar), in the estimator's frame.
+struct LandmarkEstimate {
+  Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();  ///< of position_m, m^2
+};
+
+/// One observation an estimator paired with a landmark (or started one from), so that its
+/// associations can be scored against the truth.
+struct LandmarkSighting {
+  Time time;                                                ///< the scan's
+  int landmark = -1;                                        ///< index into LandmarkMap::landmarks
+  Eigen::Vector2d center_base_m = Eigen::Vector2d::Zero();  ///< the observed centre, base_link
+};
+
+/// A landmark estimator's map: the final landmarks and every sighting it used.
+struct LandmarkMap {
+  std::vector<LandmarkEstimate> landmarks;
+  std::vector<LandmarkSighting> sightings;
+};
+
 /// What the live view (and `slamrig slam --clouds`) may show besides the pose and the map, in
 /// the estimator's frame.
 struct EstimatorView {
   std::vector<WeightedPose> particles;
   std::vector<ViewEdge> edges;  ///< a graph estimator's edges at its current estimate
+
+  /// A landmark estimator's current map.
+  std::vector<LandmarkEstimate> landmarks;
+  /// The current pose's covariance (x, y, yaw), where the estimator has one.
+  std::optional<Eigen::Matrix3d> pose_covariance;
 };
 
 /// The one interface every SLAM algorithm implements (dead reckoning, the particle filter, and
@@ -81,6 +106,8 @@ class Estimator {
   virtual std::map<std::string, double> Statistics() const { return {}; }
   /// The loop closures it accepted (scan indices in AddScan order), for scoring; default none.
   virtual std::vector<LoopClosure> LoopClosures() const { return {}; }
+  /// The landmark map and the sightings behind it (landmark estimators); default none.
+  virtual LandmarkMap Landmarks() const { return {}; }
   /// Extras for the live view.
   virtual EstimatorView View() const { return {}; }
 };

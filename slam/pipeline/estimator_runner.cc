@@ -78,6 +78,7 @@ EstimatorRun EstimatorRunner::TakeResult() {
     run_.record_rate_covariances.clear();
   run_.statistics = estimator_->Statistics();
   run_.loop_closures = estimator_->LoopClosures();
+  run_.landmarks = estimator_->Landmarks();
   run_.map = estimator_->map();
   run_.gyro_fallbacks = sync_.gyro_fallbacks();
   run_.scans_without_odometry = sync_.scans_without_odometry();

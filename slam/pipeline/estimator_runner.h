@@ -33,6 +33,7 @@ struct EstimatorRun {
   std::map<std::string, std::vector<double>> traces;       ///< per-scan values by name
   std::map<std::string, double> statistics;                ///< Estimator::Statistics() at the end
   std::vector<LoopClosure> loop_closures;                  ///< Estimator::LoopClosures() at the end
+  LandmarkMap landmarks;                                   ///< Estimator::Landmarks() at the end
   OccupancyGrid map{OccupancyGridOptions{}};               ///< the final map
   OdometrySource odometry_source = OdometrySource::kNone;  ///< the odometry used
   int gyro_fallbacks = 0;          ///< intervals without IMU samples (ScanSynchronizer)

@@ -1,0 +1,79 @@
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "slam/fusion/ekf_slam.h"
+#include "slam/grid/occupancy_grid.h"
+#include "slam/pipeline/algorithm.h"
+#include "slam/pipeline/estimator.h"
+
+namespace slamrig::slam {
+
+/// Options of the `ekf-slam` estimator: the filter's, and the map drawn along its poses.
+struct EkfSlamEstimatorOptions {
+  EkfSlamOptions filter;  ///< its keys sit at this level
+  OccupancyGridOptions map;
+  /// Every this many scans one is drawn into the occupancy map (the landmarks are the SLAM map;
+  /// the grid is for the picture and the map scores, and tracing every beam of every scan costs
+  /// more than the filter).
+  int map_every_scans = 4;
+
+  /// One message per broken rule, named by the YAML keys.
+  std::vector<std::string> Validate() const;
+};
+
+/// The field table of EkfSlamEstimatorOptions (slam/config/fields.h).
+template <typename V>
+void VisitFields(V& v, EkfSlamEstimatorOptions& o) {
+  VisitFields(v, o.filter);
+  v.Struct("map", o.map);
+  v("map_every_scans", o.map_every_scans);
+}
+
+/// Landmark EKF-SLAM (EkfSlam): wheel encoders and the gyro predict as their records arrive
+/// (odometry-pose increments at the scans when the source has no encoders), gyro samples at
+/// standstill measure the bias, and each scan's round landmarks (ExtractLandmarks) update the
+/// pose and the landmark map. The occupancy map is the scans drawn at the online poses. Reports
+/// the pose covariance with every pose, and the landmarks with their covariances.
+class EkfSlamEstimator final : public Estimator {
+ public:
+  EkfSlamEstimator(const EkfSlamEstimatorOptions& options, const EstimatorContext& context);
+
+  void AddRecord(const Record& record) override;
+  ScanEstimate AddScan(const SyncedScan& scan) override;
+  const OccupancyGrid& map() const override { return map_; }
+  std::map<std::string, double> Statistics() const override;
+  LandmarkMap Landmarks() const override;
+  EstimatorView View() const override;
+
+ private:
+  void AddImu(const ImuSample& imu);
+  void AddTicks(const WheelTicks& ticks);
+  std::vector<LandmarkEstimate> CurrentLandmarks() const;
+
+  EkfSlamEstimatorOptions options_;
+  DiffDriveParams robot_;
+  bool use_gyro_ = true;
+  EkfSlam slam_;
+  OccupancyGrid map_;
+  std::vector<LandmarkSighting> sightings_;
+  int scans_ = 0;
+  bool saw_ticks_ = false;
+  int still_intervals_ = 0;  // consecutive encoder intervals without a tick
+  std::optional<Time> last_imu_time_;
+  std::optional<Time> previous_scan_time_;
+  bool gyro_since_ticks_ = false;
+  double gyro_yaw_since_ticks_ = 0.0;
+  int observations_ = 0;
+  int pairings_ = 0;
+  int ambiguous_ = 0;
+  int updates_ = 0;
+  int zero_rate_updates_ = 0;
+  double nis_sum_ = 0.0;
+  double nis_dof_sum_ = 0.0;
+};
+
+}  // namespace slamrig::slam
