@@ -39,7 +39,7 @@ const std::vector<Algorithm>& Algorithms() {
        "the gyro bias estimated; a covariance with every pose",
        {"default"},
        {"gyro_bias_rad_s", "gyro_scale_error", "scan_updates", "zero_rate_updates", "mean_nis",
-        "slip_inflations", "matched", "keyframes"},
+        "slip_inflations", "matched", "keyframes", "anchors", "match_covariance_factor"},
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<AlgorithmOptionsFor<EkfOptions, EkfEstimator>>(EkfOptions{});
        }},
