@@ -15,6 +15,10 @@ constexpr double kZeroRateGate = 10.83;
 // enough that one update moves it little (the NIS of one update is chi-square, its spread as
 // large as its mean), large enough to settle within a few dozen keyframes.
 constexpr double kMatchScaleGain = 0.05;
+// Bounds of the factor: a run of near-zero innovations (a robot at rest before a wall) must not
+// shrink the match covariance to nothing.
+constexpr double kMinMatchScale = 0.1;
+constexpr double kMaxMatchScale = 1e3;
 
 double MeanTicks(const std::vector<std::int32_t>& ticks) {
   if (ticks.empty()) return 0.0;
@@ -145,9 +149,9 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
             options_.slip_gate > 0.0 ? std::optional<double>(options_.slip_gate) : std::nullopt);
         if (update.inflation > 1.0) ++slip_inflations_;
         if (options_.adaptive_match_covariance && update.inflation == 1.0) {
-          match_scale_ =
-              std::max(1.0, match_scale_ *
-                                std::exp(kMatchScaleGain * (update.nis / update.dimension - 1.0)));
+          match_scale_ = std::clamp(
+              match_scale_ * std::exp(kMatchScaleGain * (update.nis / update.dimension - 1.0)),
+              kMinMatchScale, kMaxMatchScale);
         }
         nis_sum_ += update.nis;
         ++scan_updates_;
