@@ -15,8 +15,8 @@ constexpr double kZeroRateGate = 10.83;
 // enough that one update moves it little (the NIS of one update is chi-square, its spread as
 // large as its mean), large enough to settle within a few dozen keyframes.
 constexpr double kMatchScaleGain = 0.05;
-// Bounds of the factor: a run of near-zero innovations (a robot at rest before a wall) must not
-// shrink the match covariance to nothing.
+// Bounds of the estimate: a run of near-zero innovations (a robot at rest before a wall) must not
+// drive it to where a change of the lidar takes hundreds of updates to undo.
 constexpr double kMinMatchScale = 0.1;
 constexpr double kMaxMatchScale = 1e3;
 
@@ -121,6 +121,13 @@ ScanEstimate EkfEstimator::AddScan(const SyncedScan& scan) {
   return Correct(scan.scan);
 }
 
+double EkfEstimator::MatchScale() const {
+  // The estimate moves both ways (held at >= 1 it would drift upward, the NIS's spread reflected
+  // there); the factor applied only ever inflates the Hessian's covariance, a lower bound on the
+  // match's spread.
+  return std::max(1.0, std::exp(log_match_scale_));
+}
+
 ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
   const bool first = scans_ == 0;
   ++scans_;
@@ -137,7 +144,7 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
     r(0, 0) += options_.match_sigma_floor_xy_m * options_.match_sigma_floor_xy_m;
     r(1, 1) += options_.match_sigma_floor_xy_m * options_.match_sigma_floor_xy_m;
     r(2, 2) += options_.match_sigma_floor_yaw_rad * options_.match_sigma_floor_yaw_rad;
-    r *= match_scale_;
+    r *= MatchScale();
     if (first) {
       // Both frames start at the first scan's pose.
       ekf_.AnchorMatcherFrame(step.pose, Eigen::Matrix3d::Zero());
@@ -149,9 +156,9 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
             options_.slip_gate > 0.0 ? std::optional<double>(options_.slip_gate) : std::nullopt);
         if (update.inflation > 1.0) ++slip_inflations_;
         if (options_.adaptive_match_covariance && update.inflation == 1.0) {
-          match_scale_ = std::clamp(
-              match_scale_ * std::exp(kMatchScaleGain * (update.nis / update.dimension - 1.0)),
-              kMinMatchScale, kMaxMatchScale);
+          log_match_scale_ =
+              std::clamp(log_match_scale_ + kMatchScaleGain * (update.nis / update.dimension - 1.0),
+                         std::log(kMinMatchScale), std::log(kMaxMatchScale));
         }
         nis_sum_ += update.nis;
         ++scan_updates_;
@@ -195,7 +202,7 @@ std::map<std::string, double> EkfEstimator::Statistics() const {
           {"matched", icp_.counts().matched},
           {"keyframes", keyframes_},
           {"anchors", anchors_},
-          {"match_covariance_factor", match_scale_},
+          {"match_covariance_factor", MatchScale()},
           {"mean_nis", scan_updates_ > 0 ? nis_sum_ / scan_updates_ : 0.0}};
 }
 

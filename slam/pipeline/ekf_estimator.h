@@ -25,15 +25,14 @@ struct EkfOptions {
   double match_sigma_floor_xy_m = 0.0011;
   double match_sigma_floor_yaw_rad = 0.00035;
   /// The Hessian's covariance ignores the local map's own noise and the correlation of
-  /// neighbouring residuals, so it understates the spread more the noisier the lidar (and the
-  /// floors may overstate it on a clean one): scale the match covariance by a factor (0.1 to
-  /// 1000) adapted so that the updates' NIS averages its
+  /// neighbouring residuals, so it understates the spread more the noisier the lidar: scale the
+  /// match covariance by a factor (at least 1) adapted so that the updates' NIS averages its
   /// dimension (Mehra 1972's covariance matching, a stochastic-approximation step on the log of
   /// the factor per update; updates whose motion was inflated for a slip are left out).
   bool adaptive_match_covariance = true;
   /// The local map's frame drifts as keyframes join it, each placed with its match's error: the
   /// map's pose moves by this share of that error (standard deviations) per keyframe.
-  double map_drift_share = 0.5;
+  double map_drift_share = 0.45;
   /// Also update on matches IcpOdometry calls degenerate (the prior fills their weak direction).
   bool update_on_degenerate = false;
   /// Update once per ICP keyframe; false: at every matched scan (consecutive scans meet the same
@@ -95,6 +94,8 @@ class EkfEstimator final : public Estimator {
   void AddTicks(const WheelTicks& ticks);
   /// Matches `scan` at the filter's current pose, updates, clones; the estimate at the scan.
   ScanEstimate Correct(const LaserScan& scan);
+  /// The factor applied to the match covariance (the adapted one, at least 1).
+  double MatchScale() const;
 
   EkfOptions options_;
   DiffDriveParams robot_;
@@ -116,7 +117,7 @@ class EkfEstimator final : public Estimator {
   int keyframes_ = 0;
   bool anchored_ = false;  // the matcher's frame is tied to the filter's
   int anchors_ = 0;
-  double match_scale_ = 1.0;  // the adapted factor on the match covariance
+  double log_match_scale_ = 0.0;  // the estimate of log(factor on the match covariance)
   double nis_sum_ = 0.0;
   double last_nis_ = 0.0;
 };

@@ -57,7 +57,7 @@ TEST(EkfEstimatorTest, BeatsDeadReckoningOnASyntheticRun) {
 
 // Over many seeds the NEES of the final pose averages inside the two-sided 95 % region of
 // chi-square with 3 * runs degrees of freedom (Bar-Shalom et al., Sec. 5.4.2): the filter is
-// neither optimistic nor pessimistic (ANEES 2.0; the lower end is 1.92). It was pessimistic (1.3)
+// neither optimistic nor pessimistic (ANEES 2.2; the lower end is 1.92). It was pessimistic (1.3)
 // while the keyframe-to-keyframe increments were taken as independent: they are differences of
 // poses matched against one persistent local map, so their errors cancel along the path while the
 // filter's covariance grew as a random walk. The match covariance is not inflated beyond what the
