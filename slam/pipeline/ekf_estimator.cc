@@ -41,6 +41,14 @@ std::vector<std::string> EkfOptions::Validate() const {
     errors.push_back(
         RuleViolation("match_sigma_floor_yaw_rad", match_sigma_floor_yaw_rad, "must be >= 0"));
   }
+  if (!(increment_sigma_floor_xy_m >= 0.0)) {
+    errors.push_back(
+        RuleViolation("increment_sigma_floor_xy_m", increment_sigma_floor_xy_m, "must be >= 0"));
+  }
+  if (!(increment_sigma_floor_yaw_rad >= 0.0)) {
+    errors.push_back(RuleViolation("increment_sigma_floor_yaw_rad", increment_sigma_floor_yaw_rad,
+                                   "must be >= 0"));
+  }
   if (!(map_drift_share >= 0.0)) {
     errors.push_back(RuleViolation("map_drift_share", map_drift_share, "must be >= 0"));
   }
@@ -145,10 +153,46 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
     r(1, 1) += options_.match_sigma_floor_xy_m * options_.match_sigma_floor_xy_m;
     r(2, 2) += options_.match_sigma_floor_yaw_rad * options_.match_sigma_floor_yaw_rad;
     r *= MatchScale();
-    if (first) {
+    if (!first && !saw_ticks_) {
+      // Odometry-pose increments (no encoders): keyframe-to-keyframe increments through the
+      // clone, as before the matcher's frame. On the corrected CARMEN logs the frame model made
+      // intel (1.9 -> 10.9 m), belgioioso (2.6 -> 6.3 m) and edmonton (0.72 -> 1.5 m) worse,
+      // which is not understood yet.
+      if (usable && (step.keyframe || !options_.keyframe_updates)) {
+        // The increment's covariance (the previous keyframe's pose held fixed) in that
+        // keyframe's frame, floored.
+        Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+        const double c = std::cos(icp_keyframe_.theta()), s = std::sin(icp_keyframe_.theta());
+        rotation.topLeftCorner<2, 2>() << c, s, -s, c;
+        Eigen::Matrix3d increment =
+            options_.match_covariance_scale * rotation * step.covariance * rotation.transpose();
+        const double xy = options_.increment_sigma_floor_xy_m;
+        const double yaw = options_.increment_sigma_floor_yaw_rad;
+        increment(0, 0) += xy * xy;
+        increment(1, 1) += xy * xy;
+        increment(2, 2) += yaw * yaw;
+        const EkfUpdate update = ekf_.UpdateRelativePose(
+            icp_keyframe_.Between(step.pose), increment,
+            options_.slip_gate > 0.0 ? std::optional<double>(options_.slip_gate) : std::nullopt);
+        if (update.inflation > 1.0) ++slip_inflations_;
+        nis_sum_ += update.nis;
+        ++scan_updates_;
+        last_nis_ = update.nis;
+      }
+      if (step.keyframe) {
+        ++keyframes_;
+        icp_keyframe_ = step.pose;
+        ekf_.Clone();
+      }
+    } else if (first) {
       // Both frames start at the first scan's pose.
       ekf_.AnchorMatcherFrame(step.pose, Eigen::Matrix3d::Zero());
       anchored_ = true;
+      icp_keyframe_ = step.pose;
+      if (!saw_ticks_) {
+        ++keyframes_;
+        ekf_.Clone();
+      }
     } else if (usable && (step.keyframe || !options_.keyframe_updates)) {
       if (anchored_) {
         const EkfUpdate update = ekf_.UpdateMatcherPose(
@@ -169,7 +213,7 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
         ++anchors_;
       }
     }
-    if (first || step.keyframe) {
+    if (saw_ticks_ && (first || step.keyframe)) {
       ++keyframes_;
       if (!first && !usable) {
         // The keyframe joins the map where the prior put it, along its weak direction at least.

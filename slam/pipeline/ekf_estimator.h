@@ -24,6 +24,10 @@ struct EkfOptions {
   /// office loop is near its expected 3, a check that needs no truth).
   double match_sigma_floor_xy_m = 0.0011;
   double match_sigma_floor_yaw_rad = 0.00035;
+  /// Without encoders (odometry-pose increments) the keyframe-to-keyframe increments correct
+  /// through the clone instead, with these floors (standard deviations of the increment).
+  double increment_sigma_floor_xy_m = 0.0015;
+  double increment_sigma_floor_yaw_rad = 0.0005;
   /// The Hessian's covariance ignores the local map's own noise and the correlation of
   /// neighbouring residuals, so it understates the spread more the noisier the lidar: scale the
   /// match covariance by a factor (at least 1) adapted so that the updates' NIS averages its
@@ -56,6 +60,8 @@ void VisitFields(V& v, EkfOptions& o) {
   v("match_covariance_scale", o.match_covariance_scale);
   v("match_sigma_floor_xy_m", o.match_sigma_floor_xy_m);
   v("match_sigma_floor_yaw_rad", o.match_sigma_floor_yaw_rad);
+  v("increment_sigma_floor_xy_m", o.increment_sigma_floor_xy_m);
+  v("increment_sigma_floor_yaw_rad", o.increment_sigma_floor_yaw_rad);
   v("adaptive_match_covariance", o.adaptive_match_covariance);
   v("map_drift_share", o.map_drift_share);
   v("update_on_degenerate", o.update_on_degenerate);
@@ -115,6 +121,7 @@ class EkfEstimator final : public Estimator {
   int zero_rate_updates_ = 0;
   int slip_inflations_ = 0;
   int keyframes_ = 0;
+  Pose2 icp_keyframe_;     // the last keyframe's match (the increments' start, no encoders)
   bool anchored_ = false;  // the matcher's frame is tied to the filter's
   int anchors_ = 0;
   double log_match_scale_ = 0.0;  // the estimate of log(factor on the match covariance)
