@@ -14,8 +14,11 @@ namespace {
 constexpr int kP = EkfSlam::kPoseDim;
 constexpr int kBias = 3;
 
-using Matrix8d = Eigen::Matrix<double, 8, 8>;
-using Vector8d = Eigen::Matrix<double, 8, 1>;
+// PoseEkf's state: clone (0-2), pose (3-5), gyro bias (6), gyro scale error (7), matcher frame
+// (8-10); EKF-SLAM uses the pose and gyro block (3-7) and leaves the others at zero.
+constexpr int kN = PoseEkf::kStateSize;
+using MatrixNd = Eigen::Matrix<double, kN, kN>;
+using VectorNd = Eigen::Matrix<double, kN, 1>;
 
 int LandmarkRow(int j) { return kP + 2 * j; }
 
@@ -87,21 +90,21 @@ void EkfSlam::ResetPose(const Pose2& pose) {
 
 template <typename Step>
 void EkfSlam::Predict(const Step& step) {
-  Vector8d x;
-  x << x_.head<3>(), x_.head<3>(), x_(kBias), x_(kBias + 1);
+  VectorNd x = VectorNd::Zero();
+  x.head<8>() << x_.head<3>(), x_.head<3>(), x_(kBias), x_(kBias + 1);
   // The filter proper: no clone, the pose and gyro states' covariance.
-  Matrix8d p = Matrix8d::Zero();
-  p.bottomRightCorner<5, 5>() = p_.topLeftCorner<5, 5>();
+  MatrixNd p = MatrixNd::Zero();
+  p.block<5, 5>(3, 3) = p_.topLeftCorner<5, 5>();
   motion_.SetState(x, p);
   // Probe 1: clone == pose with unit covariance, so cov(pose', clone) = F[:, pose].
-  Matrix8d a = Matrix8d::Zero();
+  MatrixNd a = MatrixNd::Zero();
   a.topLeftCorner<3, 3>().setIdentity();
   a.block<3, 3>(0, 3).setIdentity();
   a.block<3, 3>(3, 0).setIdentity();
   a.block<3, 3>(3, 3).setIdentity();
   probe_pose_.SetState(x, a);
   // Probe 2: clone x == bias, clone y == scale, so cov(state', clone xy) = F[:, bias, scale].
-  Matrix8d b = Matrix8d::Zero();
+  MatrixNd b = MatrixNd::Zero();
   b(0, 0) = b(0, 6) = b(6, 0) = b(6, 6) = 1.0;
   b(1, 1) = b(1, 7) = b(7, 1) = b(7, 7) = 1.0;
   probe_gyro_.SetState(x, b);
@@ -111,8 +114,8 @@ void EkfSlam::Predict(const Step& step) {
   Eigen::Matrix<double, 5, 5> f;
   f.leftCols<3>() = probe_pose_.covariance().block<5, 3>(3, 0);
   f.rightCols<2>() = probe_gyro_.covariance().block<5, 2>(3, 0);
-  x_.head<kP>() = motion_.state().tail<5>();
-  p_.topLeftCorner<kP, kP>() = motion_.covariance().bottomRightCorner<5, 5>();
+  x_.head<kP>() = motion_.state().segment<5>(3);
+  p_.topLeftCorner<kP, kP>() = motion_.covariance().block<5, 5>(3, 3);
   const int m = static_cast<int>(x_.size()) - kP;
   if (m > 0) {
     const Eigen::MatrixXd cross = f * p_.topRightCorner(kP, m);

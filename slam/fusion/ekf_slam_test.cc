@@ -126,11 +126,12 @@ TEST(EkfSlamTest, PredictionCarriesCrossCovariancesWithTheMotionJacobian) {
   };
   const auto moved = [&](const Eigen::Matrix<double, 5, 1>& s) {
     PoseEkf f(options.motion);
-    Eigen::Matrix<double, 8, 1> full;
-    full << s.head<3>(), s;
-    f.SetState(full, Eigen::Matrix<double, 8, 8>::Zero());
+    constexpr int kN = PoseEkf::kStateSize;
+    Eigen::Matrix<double, kN, 1> full = Eigen::Matrix<double, kN, 1>::Zero();
+    full.head<8>() << s.head<3>(), s;
+    f.SetState(full, Eigen::Matrix<double, kN, kN>::Zero());
     step(f);
-    return Eigen::Matrix<double, 5, 1>(f.state().tail<5>());
+    return Eigen::Matrix<double, 5, 1>(f.state().segment<5>(3));
   };
   Eigen::Matrix<double, 5, 5> f_numeric;
   const Eigen::Matrix<double, 5, 1> s0 = x.head<5>();

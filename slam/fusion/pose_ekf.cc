@@ -9,12 +9,19 @@
 namespace slamrig::slam {
 namespace {
 
-constexpr int kN = 8;
+constexpr int kN = PoseEkf::kStateSize;
 constexpr int kYaw = 5;
 constexpr int kBias = 6;
 constexpr int kScale = 7;
+constexpr int kFrame = 8;  // the matcher's frame: x, y, yaw at 8, 9, 10
 
 double Squared(double v) { return v * v; }
+
+// d(R(yaw) p)/d(yaw) = R(yaw + pi/2) p.
+Eigen::Vector2d RotatedDerivative(double yaw, const Eigen::Vector2d& p) {
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  return {-s * p.x() - c * p.y(), c * p.x() - s * p.y()};
+}
 
 }  // namespace
 
@@ -32,11 +39,12 @@ PoseEkf::PoseEkf(const PoseEkfOptions& options) : options_(options) {
 }
 
 void PoseEkf::ResetPose(const Pose2& pose) {
-  const Eigen::Matrix2d gyro = p_.bottomRightCorner<2, 2>();
+  const Eigen::Matrix2d gyro = p_.block<2, 2>(kBias, kBias);
   p_.setZero();
-  p_.bottomRightCorner<2, 2>() = gyro;
+  p_.block<2, 2>(kBias, kBias) = gyro;
   x_.head<3>() << pose.x(), pose.y(), pose.theta();
   x_.segment<3>(3) = x_.head<3>();
+  x_.segment<3>(kFrame).setZero();
 }
 
 void PoseEkf::PredictGyro(double rate_rad_s, double dt_s) {
@@ -126,32 +134,110 @@ EkfUpdate PoseEkf::UpdateRelativePose(const Pose2& z, const Eigen::Matrix3d& r,
   Eigen::VectorXd innovation(3);
   innovation << z.x() - predicted.x(), z.y() - predicted.y(),
       NormalizeAngle(z.theta() - predicted.theta());
-  const Eigen::Matrix3d motion = h * p_ * h.transpose();  // the motion's covariance since the clone
-  const auto nis = [&](double scale) {
-    return innovation.dot((scale * motion + r).ldlt().solve(innovation));
-  };
-  double inflation = 1.0;
-  if (inflation_gate && nis(1.0) > *inflation_gate) {
-    // The motion model failed (a wheel slipped): the smallest scale of the motion's covariance
-    // that brings the NIS down to the gate (it falls monotonically with the scale), by bisection
-    // on a log scale, added as process noise on the current pose alone (Mehra 1972's
-    // innovation-based adaptation, one step at a time).
-    double lo = 1.0, hi = 1e6;
-    if (nis(hi) <= *inflation_gate) {
-      for (int i = 0; i < 40; ++i) {
-        const double mid = std::sqrt(lo * hi);
-        (nis(mid) > *inflation_gate ? lo : hi) = mid;
-      }
-    }
-    inflation = hi;
-    // The clone-frame covariance rotated into the fixed frame: the pose's own noise.
-    Eigen::Matrix3d g = Eigen::Matrix3d::Identity();
-    g.topLeftCorner<2, 2>() << c, -s, s, c;
-    p_.block<3, 3>(3, 3) += (inflation - 1.0) * g * motion * g.transpose();
-  }
+  const double inflation = inflation_gate ? InflateMotion(innovation, h, r, *inflation_gate) : 1.0;
   EkfUpdate update = Update(innovation, h, r);
   update.inflation = inflation;
   return update;
+}
+
+double PoseEkf::InflateMotion(const Eigen::VectorXd& innovation, const Eigen::MatrixXd& h,
+                              const Eigen::MatrixXd& r, double gate) {
+  const Eigen::MatrixXd s0 = h * p_ * h.transpose() + r;
+  if (innovation.dot(s0.ldlt().solve(innovation)) <= gate) return 1.0;
+  // The motion's covariance since the clone, in the clone's frame, rotated into the fixed frame:
+  // the pose's own noise since the clone.
+  const double c = std::cos(x_(2)), s = std::sin(x_(2));
+  const Eigen::Vector2d d = x_.segment<2>(3) - x_.head<2>();
+  Eigen::Matrix<double, 3, kN> relative = Eigen::Matrix<double, 3, kN>::Zero();
+  relative.block<2, 2>(0, 0) << -c, -s, s, -c;
+  relative(0, 2) = -s * d.x() + c * d.y();
+  relative(1, 2) = -c * d.x() - s * d.y();
+  relative.block<2, 2>(0, 3) << c, s, -s, c;
+  relative(2, 2) = -1.0;
+  relative(2, kYaw) = 1.0;
+  const Eigen::Matrix3d motion = relative * p_ * relative.transpose();
+  Eigen::Matrix3d g = Eigen::Matrix3d::Identity();
+  g.topLeftCorner<2, 2>() << c, -s, s, c;
+  const Eigen::Matrix3d added = g * motion * g.transpose();
+  // What a unit of extra motion noise adds to the innovation's covariance.
+  const Eigen::MatrixXd h_pose = h.middleCols<3>(3);
+  const Eigen::MatrixXd a = h_pose * added * h_pose.transpose();
+  const auto nis = [&](double scale) {
+    return innovation.dot((s0 + (scale - 1.0) * a).ldlt().solve(innovation));
+  };
+  // The motion model failed (a wheel slipped): the smallest scale of the motion's covariance
+  // that brings the NIS down to the gate (it falls monotonically with the scale), by bisection
+  // on a log scale, added as process noise on the current pose alone (Mehra 1972's
+  // innovation-based adaptation, one step at a time).
+  double lo = 1.0, hi = 1e6;
+  if (nis(hi) <= gate) {
+    for (int i = 0; i < 40; ++i) {
+      const double mid = std::sqrt(lo * hi);
+      (nis(mid) > gate ? lo : hi) = mid;
+    }
+  }
+  p_.block<3, 3>(3, 3) += (hi - 1.0) * added;
+  return hi;
+}
+
+Eigen::Matrix3d PoseEkf::MatcherPoseJacobianFrame() const {
+  // m * pose = (m_xy + R(m_yaw) pose_xy, m_yaw + pose_yaw).
+  Eigen::Matrix3d j = Eigen::Matrix3d::Identity();
+  j.block<2, 1>(0, 2) = RotatedDerivative(x_(kFrame + 2), x_.segment<2>(3));
+  return j;
+}
+
+Eigen::Matrix3d PoseEkf::MatcherPoseJacobianPose() const {
+  const double c = std::cos(x_(kFrame + 2)), s = std::sin(x_(kFrame + 2));
+  Eigen::Matrix3d j = Eigen::Matrix3d::Identity();
+  j.topLeftCorner<2, 2>() << c, -s, s, c;
+  return j;
+}
+
+void PoseEkf::AnchorMatcherFrame(const Pose2& z, const Eigen::Matrix3d& r) {
+  const Pose2 frame = z * pose().Inverse();
+  x_.segment<3>(kFrame) << frame.x(), frame.y(), frame.theta();
+  // m = z * pose^-1: m_yaw = z_yaw - pose_yaw, m_xy = z_xy - R(m_yaw) pose_xy. Its Jacobians with
+  // respect to the pose and to z; m's rows become that function of the pose's (its old
+  // correlations are dropped) plus the match's own noise.
+  const Eigen::Vector2d lever = RotatedDerivative(frame.theta(), x_.segment<2>(3));
+  Eigen::Matrix3d j_pose = -Eigen::Matrix3d::Identity();
+  const double c = std::cos(frame.theta()), s = std::sin(frame.theta());
+  j_pose.topLeftCorner<2, 2>() << -c, s, -s, -c;
+  j_pose.block<2, 1>(0, 2) = lever;
+  Eigen::Matrix3d j_z = Eigen::Matrix3d::Identity();
+  j_z.block<2, 1>(0, 2) = -lever;
+  Eigen::Matrix<double, 3, kN> j = Eigen::Matrix<double, 3, kN>::Zero();
+  j.middleCols<3>(3) = j_pose;
+  const Eigen::Matrix<double, 3, kN> cross = j * p_;
+  p_.middleRows<3>(kFrame) = cross;
+  p_.middleCols<3>(kFrame) = cross.transpose();
+  p_.block<3, 3>(kFrame, kFrame) =
+      j_pose * p_.block<3, 3>(3, 3) * j_pose.transpose() + j_z * r * j_z.transpose();
+  p_ = 0.5 * (p_ + p_.transpose()).eval();
+}
+
+EkfUpdate PoseEkf::UpdateMatcherPose(const Pose2& z, const Eigen::Matrix3d& r,
+                                     std::optional<double> inflation_gate) {
+  const Pose2 predicted = matcher_frame() * pose();
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(3, kN);
+  h.middleCols<3>(3) = MatcherPoseJacobianPose();
+  h.middleCols<3>(kFrame) = MatcherPoseJacobianFrame();
+  Eigen::VectorXd innovation(3);
+  innovation << z.x() - predicted.x(), z.y() - predicted.y(),
+      NormalizeAngle(z.theta() - predicted.theta());
+  const double inflation = inflation_gate ? InflateMotion(innovation, h, r, *inflation_gate) : 1.0;
+  EkfUpdate update = Update(innovation, h, r);
+  update.inflation = inflation;
+  return update;
+}
+
+void PoseEkf::DriftMatcherFrame(const Eigen::Matrix3d& q) {
+  // The matcher's pose of the robot z = m * pose moves by dz: m moves by dm/dz dz, with dm/dz as
+  // in AnchorMatcherFrame.
+  Eigen::Matrix3d j_z = Eigen::Matrix3d::Identity();
+  j_z.block<2, 1>(0, 2) = -RotatedDerivative(x_(kFrame + 2), x_.segment<2>(3));
+  p_.block<3, 3>(kFrame, kFrame) += j_z * q * j_z.transpose();
 }
 
 EkfUpdate PoseEkf::UpdateZeroRate(double rate_rad_s) {
@@ -175,6 +261,7 @@ EkfUpdate PoseEkf::Update(const Eigen::VectorXd& innovation, const Eigen::Matrix
   x_ += dx;
   x_(2) = NormalizeAngle(x_(2));
   x_(kYaw) = NormalizeAngle(x_(kYaw));
+  x_(kFrame + 2) = NormalizeAngle(x_(kFrame + 2));
   p_ = JosephUpdate(p, k, h, r);
   return {innovation.dot(s_ldlt.solve(innovation)), static_cast<int>(innovation.size())};
 }

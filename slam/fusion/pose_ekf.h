@@ -28,9 +28,11 @@ struct EkfUpdate {
 };
 
 /// The filter. State: the clone c = (x, y, yaw) of the pose at the last clone, the current pose
-/// (x, y, yaw), the gyro bias b (rad/s) and the gyro's scale error s (the gyro reads
-/// (1 + s) times the rate, plus b); 8 x 8 covariance. Poses in one fixed frame.
-/// Deterministic; not thread-safe.
+/// (x, y, yaw), the gyro bias b (rad/s), the gyro's scale error s (the gyro reads (1 + s) times
+/// the rate, plus b) and the matcher's frame m = matcher_from_filter (x, y, yaw): where a scan
+/// matcher's own frame (its local map) sits, so that its absolute poses m * pose can be fused
+/// with errors independent from match to match while m drifts slowly; 11 x 11 covariance. Poses
+/// in one fixed frame. Deterministic; not thread-safe.
 class PoseEkf {
  public:
   explicit PoseEkf(const PoseEkfOptions& options);
@@ -52,6 +54,17 @@ class PoseEkf {
   /// slip): the motion's covariance is scaled up until the NIS meets the gate, then the update.
   EkfUpdate UpdateRelativePose(const Pose2& z, const Eigen::Matrix3d& r,
                                std::optional<double> inflation_gate = std::nullopt);
+  /// Anchors the matcher's frame: m = z * pose^-1 for a match `z` with covariance `r` (matcher
+  /// frame), correlated with the pose through that relation. The match carries no information
+  /// about the pose then; the next UpdateMatcherPose measures the motion since this one.
+  void AnchorMatcherFrame(const Pose2& z, const Eigen::Matrix3d& r);
+  /// Measures the pose in the matcher's frame, m * pose = `z`, with covariance `r` (matcher
+  /// frame); `inflation_gate` as in UpdateRelativePose (the motion since the clone is inflated).
+  EkfUpdate UpdateMatcherPose(const Pose2& z, const Eigen::Matrix3d& r,
+                              std::optional<double> inflation_gate = std::nullopt);
+  /// The matcher's frame drifts: its pose of the robot moves by a perturbation of covariance `q`
+  /// (matcher frame, at the robot), as when a keyframe joins its map with an error.
+  void DriftMatcherFrame(const Eigen::Matrix3d& q);
   /// A gyro sample taken at standstill measures the bias: b = rate.
   EkfUpdate UpdateZeroRate(double rate_rad_s);
   /// The clone becomes the current pose (the next relative measurement starts here).
@@ -61,15 +74,19 @@ class PoseEkf {
   Pose2 clone() const { return {x_(0), x_(1), x_(2)}; }
   double gyro_bias() const { return x_(6); }
   double gyro_scale_error() const { return x_(7); }
+  Pose2 matcher_frame() const { return {x_(8), x_(9), x_(10)}; }
   /// Covariance of (x, y, yaw) of pose().
   Eigen::Matrix3d PoseCovariance() const { return p_.block<3, 3>(3, 3); }
-  /// The whole 8 x 8 covariance.
-  const Eigen::Matrix<double, 8, 8>& covariance() const { return p_; }
-  /// The whole state: clone (x, y, yaw), pose (x, y, yaw), gyro bias, gyro scale error.
-  const Eigen::Matrix<double, 8, 1>& state() const { return x_; }
+  static constexpr int kStateSize = 11;
+  /// The whole covariance.
+  const Eigen::Matrix<double, kStateSize, kStateSize>& covariance() const { return p_; }
+  /// The whole state: clone (x, y, yaw), pose (x, y, yaw), gyro bias, gyro scale error, matcher
+  /// frame (x, y, yaw).
+  const Eigen::Matrix<double, kStateSize, 1>& state() const { return x_; }
   /// Replaces the state and its covariance: for a filter that carries this state inside a larger
   /// one (EKF-SLAM) and predicts through this one's motion model.
-  void SetState(const Eigen::Matrix<double, 8, 1>& x, const Eigen::Matrix<double, 8, 8>& p) {
+  void SetState(const Eigen::Matrix<double, kStateSize, 1>& x,
+                const Eigen::Matrix<double, kStateSize, kStateSize>& p) {
     x_ = x;
     p_ = p;
   }
@@ -77,10 +94,19 @@ class PoseEkf {
  private:
   EkfUpdate Update(const Eigen::VectorXd& innovation, const Eigen::MatrixXd& h,
                    const Eigen::MatrixXd& r);
+  /// Scales the covariance of the motion since the clone (as process noise on the pose) by the
+  /// smallest factor that brings the NIS of `innovation` with measurement Jacobian `h` and noise
+  /// `r` down to `gate`; the factor (1: none needed).
+  double InflateMotion(const Eigen::VectorXd& innovation, const Eigen::MatrixXd& h,
+                       const Eigen::MatrixXd& r, double gate);
+  /// d(m * pose)/d(m) and d(m * pose)/d(pose) at the current state, 3 x 3 each.
+  Eigen::Matrix3d MatcherPoseJacobianFrame() const;
+  Eigen::Matrix3d MatcherPoseJacobianPose() const;
 
   PoseEkfOptions options_;
-  Eigen::Matrix<double, 8, 1> x_ = Eigen::Matrix<double, 8, 1>::Zero();
-  Eigen::Matrix<double, 8, 8> p_ = Eigen::Matrix<double, 8, 8>::Zero();
+  Eigen::Matrix<double, kStateSize, 1> x_ = Eigen::Matrix<double, kStateSize, 1>::Zero();
+  Eigen::Matrix<double, kStateSize, kStateSize> p_ =
+      Eigen::Matrix<double, kStateSize, kStateSize>::Zero();
 };
 
 }  // namespace slamrig::slam

@@ -5,6 +5,8 @@
 #include <Eigen/Eigenvalues>
 #include <random>
 
+#include "slam/fusion/consistency.h"
+
 namespace slamrig::slam {
 namespace {
 
@@ -87,7 +89,10 @@ TEST(PoseEkfTest, CovarianceStaysSymmetricPositiveDefiniteThroughAManyStepRun) {
     }
     const Eigen::MatrixXd p = ekf.covariance();
     ASSERT_EQ((p - p.transpose()).norm(), 0.0) << step;
-    ASSERT_GT(MinEigenvalue(p + 1e-15 * Eigen::MatrixXd::Identity(8, 8)), 0.0) << step;
+    ASSERT_GT(MinEigenvalue(
+                  p + 1e-15 * Eigen::MatrixXd::Identity(PoseEkf::kStateSize, PoseEkf::kStateSize)),
+              0.0)
+        << step;
   }
 }
 
@@ -119,6 +124,101 @@ TEST(PoseEkfTest, EstimatesGyroBiasFromRelativeYawAndFromStandstill) {
   PoseEkf still{PoseEkfOptions{}};
   for (int k = 0; k < 400; ++k) still.UpdateZeroRate(bias + (k % 2 == 0 ? 0.01 : -0.01));
   EXPECT_NEAR(still.gyro_bias(), bias, 1e-3);
+}
+
+// Anchored with an exact first match, the matcher's frame ties its poses to the filter's, so a
+// second match m * pose = z2 measures the motion since the first: the same update as the relative
+// one of z1^-1 z2 with z2's covariance turned into z1's frame.
+TEST(PoseEkfTest, AnchoredMatcherPoseUpdateEqualsTheRelativeUpdate) {
+  const Pose2 start(1.0, -2.0, 0.7);
+  PoseEkf anchored{PoseEkfOptions{}};
+  anchored.ResetPose(start);
+  for (int i = 0; i < 5; ++i) anchored.PredictWheels(0.1, 0.09, 0.4, 0.02);
+  anchored.Clone();
+  const Pose2 z1(4.0, 3.0, -0.4);
+  anchored.AnchorMatcherFrame(z1, Eigen::Matrix3d::Zero());
+  PoseEkf relative = anchored;
+  for (PoseEkf* ekf : {&anchored, &relative}) {
+    for (int i = 0; i < 8; ++i) ekf->PredictWheels(0.1, 0.08, 0.4, std::nullopt);
+  }
+  const Pose2 motion = relative.clone().Between(relative.pose()) * Pose2(0.01, -0.02, 0.003);
+  const Pose2 z2 = z1 * motion;
+  Eigen::Matrix3d r;
+  r << 4e-4, 1e-4, 2e-5, 1e-4, 2e-4, -1e-5, 2e-5, -1e-5, 1e-5;
+  anchored.UpdateMatcherPose(z2, r);
+  relative.UpdateRelativePose(motion, RotateCovariance(r, -z1.theta()));
+  EXPECT_NEAR(anchored.pose().x(), relative.pose().x(), 1e-9);
+  EXPECT_NEAR(anchored.pose().y(), relative.pose().y(), 1e-9);
+  EXPECT_NEAR(anchored.pose().theta(), relative.pose().theta(), 1e-9);
+  EXPECT_LT((anchored.PoseCovariance() - relative.PoseCovariance()).norm(),
+            1e-9 * relative.PoseCovariance().norm());
+}
+
+// Monte Carlo against the filter's own model: a robot drives a circle with encoder and gyro noise
+// drawn as PoseEkfOptions states them, a matcher reports m * pose with white noise while its
+// frame m drifts per keyframe; the filter's ANEES of the final pose over the runs lies in the
+// two-sided 95 % chi-square region, and the NIS averages its dimension.
+TEST(PoseEkfTest, MatcherPoseUpdatesAreConsistentOverMonteCarloRuns) {
+  const PoseEkfOptions options;
+  const double dt = 0.01;
+  const Eigen::Matrix3d r = Eigen::Vector3d(4e-6, 2e-6, 1e-7).asDiagonal();
+  const Eigen::Matrix3d q = 0.09 * r;  // the frame's drift per keyframe
+  const int runs = 200;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> normal;
+  const auto draw = [&](const Eigen::Matrix3d& cov) {
+    const Eigen::Matrix3d l = cov.llt().matrixL();
+    return Eigen::Vector3d(l * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)));
+  };
+  // `pose` moved by an additive (x, y, yaw) perturbation: the measurement model's noise.
+  const auto plus = [](const Pose2& pose, const Eigen::Vector3d& d) {
+    return Pose2(pose.x() + d.x(), pose.y() + d.y(), pose.theta() + d.z());
+  };
+  double nees_sum = 0.0, nis_sum = 0.0;
+  int updates = 0;
+  for (int run = 0; run < runs; ++run) {
+    PoseEkf ekf(options);
+    ekf.ResetPose(Pose2());
+    ekf.AnchorMatcherFrame(Pose2(), Eigen::Matrix3d::Zero());
+    Pose2 truth;
+    Pose2 frame;  // the matcher's true frame
+    const double bias = options.gyro_bias_sigma_rad_s * normal(rng);
+    const double scale = options.gyro_scale_sigma * normal(rng);
+    for (int step = 0; step < 400; ++step) {
+      // 0.4 m/s on a circle of 2 m radius; four gyro samples per encoder interval.
+      const double rate = 0.2, speed = 0.4;
+      double turned = 0.0, gyro_turned = 0.0;
+      for (int g = 0; g < 4; ++g) {
+        const double reading = (rate + bias + options.gyro_sigma_rad_s * normal(rng)) / (1 - scale);
+        // The filter integrates the reading with its bias and scale estimates; the truth turns at
+        // `rate`.
+        gyro_turned += (reading - ekf.gyro_bias()) * dt;
+        turned += rate * dt;
+        ekf.PredictGyro(reading, dt);
+      }
+      const double distance = speed * 4 * dt;
+      const Eigen::Vector2d move(distance * (1.0 + options.encoder_sigma_rel * normal(rng)),
+                                 distance * options.encoder_lateral_sigma_rel * normal(rng));
+      // The translation follows the mean heading of the interval, as the filter's model says.
+      const double heading = truth.theta() + 0.5 * turned;
+      const Eigen::Vector2d world = Eigen::Rotation2Dd(heading) * move;
+      truth = Pose2(truth.x() + world.x(), truth.y() + world.y(), truth.theta() + turned);
+      ekf.PredictWheels(distance, distance, 0.4, gyro_turned);
+      if (step % 10 == 9) {
+        const Pose2 z = plus(frame * truth, draw(r));
+        nis_sum += ekf.UpdateMatcherPose(z, r).nis;
+        ++updates;
+        frame = plus(frame * truth, draw(q)) * truth.Inverse();
+        ekf.DriftMatcherFrame(q);
+        ekf.Clone();
+      }
+    }
+    nees_sum += PoseNees(truth, ekf.pose(), ekf.PoseCovariance());
+  }
+  const NeesBounds bounds = AneesBounds(3, runs);
+  EXPECT_GT(nees_sum / runs, bounds.lower);
+  EXPECT_LT(nees_sum / runs, bounds.upper);
+  EXPECT_NEAR(nis_sum / updates, 3.0, 0.3);
 }
 
 }  // namespace

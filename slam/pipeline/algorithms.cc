@@ -36,11 +36,11 @@ const std::vector<Algorithm>& Algorithms() {
                                  : ParticleFilterOptions{});
        }},
       {"ekf",
-       "EKF pose fusion: encoders and gyro predict, scan-to-local-map ICP increments correct, "
+       "EKF pose fusion: encoders and gyro predict, scan-to-local-map ICP matches correct, "
        "the gyro bias estimated; a covariance with every pose",
        {"default"},
        {"gyro_bias_rad_s", "gyro_scale_error", "scan_updates", "zero_rate_updates", "mean_nis",
-        "slip_inflations", "matched", "keyframes"},
+        "slip_inflations", "matched", "keyframes", "anchors", "match_covariance_factor"},
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<AlgorithmOptionsFor<EkfOptions, EkfEstimator>>(EkfOptions{});
        }},

@@ -19,16 +19,29 @@ struct EkfOptions {
   bool scan_matching = true;  ///< correct with scan-to-local-map ICP increments
   /// The ICP covariance is multiplied by this ...
   double match_covariance_scale = 1.0;
-  /// ... and a floor added: standard deviations of the increment's x, y and yaw (what a match
-  /// between keyframes errs by beyond its Hessian estimate; set so that the mean NIS on the
+  /// ... and a floor added: standard deviations of the match's x, y and yaw against its local
+  /// map (what a match errs by beyond its Hessian estimate; set so that the mean NIS on the
   /// office loop is near its expected 3, a check that needs no truth).
-  double match_sigma_floor_xy_m = 0.0015;
-  double match_sigma_floor_yaw_rad = 0.0005;
+  double match_sigma_floor_xy_m = 0.0011;
+  double match_sigma_floor_yaw_rad = 0.00035;
+  /// Without encoders (odometry-pose increments) the keyframe-to-keyframe increments correct
+  /// through the clone instead, with these floors (standard deviations of the increment).
+  double increment_sigma_floor_xy_m = 0.0015;
+  double increment_sigma_floor_yaw_rad = 0.0005;
+  /// The Hessian's covariance ignores the local map's own noise and the correlation of
+  /// neighbouring residuals, so it understates the spread more the noisier the lidar: scale the
+  /// match covariance by a factor (at least 1) adapted so that the updates' NIS averages its
+  /// dimension (Mehra 1972's covariance matching, a stochastic-approximation step on the log of
+  /// the factor per update; updates whose motion was inflated for a slip are left out).
+  bool adaptive_match_covariance = true;
+  /// The local map's frame drifts as keyframes join it, each placed with its match's error: the
+  /// map's pose moves by this share of that error (standard deviations) per keyframe.
+  double map_drift_share = 0.45;
   /// Also update on matches IcpOdometry calls degenerate (the prior fills their weak direction).
   bool update_on_degenerate = false;
-  /// Update once per ICP keyframe (the keyframe-to-keyframe increment); false: at every matched
-  /// scan, against the last keyframe's clone (the updates then share the map's error: the
-  /// covariance comes out optimistic).
+  /// Update once per ICP keyframe; false: at every matched scan (consecutive scans meet the same
+  /// map from nearly the same place, so their errors are not independent: the covariance comes
+  /// out optimistic).
   bool keyframe_updates = true;
   /// A match whose NIS exceeds this (chi2_3 at 0.999) says the motion model failed (a wheel
   /// slipped on ice): the motion's covariance is inflated until it does not. 0: never.
@@ -47,6 +60,10 @@ void VisitFields(V& v, EkfOptions& o) {
   v("match_covariance_scale", o.match_covariance_scale);
   v("match_sigma_floor_xy_m", o.match_sigma_floor_xy_m);
   v("match_sigma_floor_yaw_rad", o.match_sigma_floor_yaw_rad);
+  v("increment_sigma_floor_xy_m", o.increment_sigma_floor_xy_m);
+  v("increment_sigma_floor_yaw_rad", o.increment_sigma_floor_yaw_rad);
+  v("adaptive_match_covariance", o.adaptive_match_covariance);
+  v("map_drift_share", o.map_drift_share);
   v("update_on_degenerate", o.update_on_degenerate);
   v("keyframe_updates", o.keyframe_updates);
   v("slip_gate", o.slip_gate);
@@ -56,12 +73,17 @@ void VisitFields(V& v, EkfOptions& o) {
 /// EKF pose fusion (PoseEkf): wheel encoders and the gyro predict as their records arrive
 /// (odometry-pose increments at the scans when the source has no encoders), gyro samples at
 /// standstill measure the gyro bias (and turns its scale error), and IcpOdometry matches each
-/// scan against its local map. At each ICP keyframe the match's pose relative to the previous
-/// keyframe's corrects the filter's pose relative to its clone of that keyframe (stochastic
-/// cloning), with the match's covariance; a keyframe is cloned anew. Matching every scan but
-/// updating once per keyframe keeps the updates' errors nearly independent: the scans between two
-/// keyframes meet the same map, so their matches' errors are not. Reports the pose
-/// covariance with every pose, the NIS of the latest scan update as the trace `nis`.
+/// scan against its local map. At each ICP keyframe the match's pose in the matcher's frame
+/// corrects the filter through the matcher's frame, a state that drifts as keyframes join the
+/// local map (PoseEkf::UpdateMatcherPose): the matches' errors against the map are nearly
+/// independent, where the increments between keyframes are not (two consecutive increments share
+/// the keyframe between them with opposite signs, so their errors cancel along the path; treated
+/// as independent, they make the covariance grow as a random walk the error does not follow).
+/// A keyframe whose match was unusable joins the map where the odometry put it, so the frame is
+/// anchored anew at the next usable match, which then measures nothing but the frame.
+/// Updating once per keyframe keeps the updates' errors nearly independent: the scans between two
+/// keyframes meet the same map from nearly the same place. Reports the pose covariance with every
+/// pose, the NIS of the latest scan update as the trace `nis`.
 class EkfEstimator final : public Estimator {
  public:
   EkfEstimator(const EkfOptions& options, const EstimatorContext& context);
@@ -78,6 +100,8 @@ class EkfEstimator final : public Estimator {
   void AddTicks(const WheelTicks& ticks);
   /// Matches `scan` at the filter's current pose, updates, clones; the estimate at the scan.
   ScanEstimate Correct(const LaserScan& scan);
+  /// The factor applied to the match covariance (the adapted one, at least 1).
+  double MatchScale() const;
 
   EkfOptions options_;
   DiffDriveParams robot_;
@@ -85,7 +109,6 @@ class EkfEstimator final : public Estimator {
   PoseEkf ekf_;
   IcpOdometry icp_;
   OccupancyGrid map_;
-  Pose2 icp_keyframe_;
   Pose2 previous_pose_;
   int scans_ = 0;
   bool saw_ticks_ = false;
@@ -98,6 +121,10 @@ class EkfEstimator final : public Estimator {
   int zero_rate_updates_ = 0;
   int slip_inflations_ = 0;
   int keyframes_ = 0;
+  Pose2 icp_keyframe_;     // the last keyframe's match (the increments' start, no encoders)
+  bool anchored_ = false;  // the matcher's frame is tied to the filter's
+  int anchors_ = 0;
+  double log_match_scale_ = 0.0;  // the estimate of log(factor on the match covariance)
   double nis_sum_ = 0.0;
   double last_nis_ = 0.0;
 };
