@@ -73,6 +73,7 @@ class EkfSlam {
   Pose2 pose() const { return {x_(0), x_(1), x_(2)}; }
   Eigen::Matrix3d PoseCovariance() const { return p_.topLeftCorner<3, 3>(); }
   double gyro_bias() const { return x_(3); }
+  double gyro_bias_variance() const { return p_(3, 3); }
   double gyro_scale_error() const { return x_(4); }
   int landmarks() const { return static_cast<int>((x_.size() - kPoseDim) / 2); }
   Eigen::Vector2d landmark(int i) const { return x_.segment<2>(kPoseDim + 2 * i); }

@@ -73,6 +73,7 @@ class PoseEkf {
   Pose2 pose() const { return {x_(3), x_(4), x_(5)}; }
   Pose2 clone() const { return {x_(0), x_(1), x_(2)}; }
   double gyro_bias() const { return x_(6); }
+  double gyro_bias_variance() const { return p_(6, 6); }
   double gyro_scale_error() const { return x_(7); }
   Pose2 matcher_frame() const { return {x_(8), x_(9), x_(10)}; }
   /// Covariance of (x, y, yaw) of pose().

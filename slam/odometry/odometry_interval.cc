@@ -4,15 +4,12 @@
 #include "slam/types/check.h"
 
 namespace slamrig::slam {
-namespace {
-
 double MeanTicks(const std::vector<std::int32_t>& ticks) {
+  if (ticks.empty()) return 0.0;
   double sum = 0.0;
   for (const std::int32_t t : ticks) sum += t;
   return sum / static_cast<double>(ticks.size());
 }
-
-}  // namespace
 
 void OdometryInterval::AddTicks(const WheelTicks& ticks) {
   SLAMRIG_CHECK(!ticks.right_ticks.empty() && !ticks.left_ticks.empty(),

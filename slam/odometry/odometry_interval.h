@@ -1,12 +1,17 @@
 #pragma once
 
+#include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "slam/types/records.h"
 
 namespace slamrig::slam {
 
 struct DiffDriveParams;  // slam/odometry/wheel_odometry.h
+
+/// The mean of one side's wheel ticks (robots with several wheels per side); 0 for none.
+double MeanTicks(const std::vector<std::int32_t>& ticks);
 
 /// The encoder counts and gyro rates gathered over one interval (between two ticks records, or
 /// two scans), reduced to the motion over it in one place for every integrator (WheelOdometry,

@@ -2,15 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
 namespace {
 
-constexpr int kStillIntervals = 10;
-constexpr double kZeroRateGate = 10.83;
 // The step of the match covariance's adaptation: log(factor) += gain * (NIS / dim - 1). Small
 // enough that one update moves it little (the NIS of one update is chi-square, its spread as
 // large as its mean), large enough to settle within a few dozen keyframes.
@@ -19,11 +16,6 @@ constexpr double kMatchScaleGain = 0.05;
 // drive it to where a change of the lidar takes hundreds of updates to undo.
 constexpr double kMinMatchScale = 0.1;
 constexpr double kMaxMatchScale = 1e3;
-
-double MeanTicks(const std::vector<std::int32_t>& ticks) {
-  if (ticks.empty()) return 0.0;
-  return std::accumulate(ticks.begin(), ticks.end(), 0.0) / static_cast<double>(ticks.size());
-}
 
 }  // namespace
 
@@ -59,8 +51,7 @@ std::vector<std::string> EkfOptions::Validate() const {
 
 EkfEstimator::EkfEstimator(const EkfOptions& options, const EstimatorContext& context)
     : options_(options),
-      robot_(context.robot),
-      use_gyro_(context.use_gyro),
+      feed_(context.robot, context.use_gyro, options.filter),
       ekf_(options.filter),
       icp_(IcpOdometryOptions{}),
       map_(options.map) {}
@@ -68,8 +59,8 @@ EkfEstimator::EkfEstimator(const EkfOptions& options, const EstimatorContext& co
 void EkfEstimator::AddRecord(const Record& record) {
   const auto* ticks = std::get_if<WheelTicks>(&record);
   last_record_was_ticks_ = ticks != nullptr;
-  if (const auto* imu = std::get_if<ImuSample>(&record)) AddImu(*imu);
-  if (ticks) AddTicks(*ticks);
+  if (const auto* imu = std::get_if<ImuSample>(&record)) feed_.AddImu(*imu, ekf_);
+  if (ticks) feed_.AddTicks(*ticks, ekf_);
 }
 
 std::optional<ScanEstimate> EkfEstimator::RecordEstimate() const {
@@ -80,49 +71,8 @@ std::optional<ScanEstimate> EkfEstimator::RecordEstimate() const {
   return estimate;
 }
 
-void EkfEstimator::AddImu(const ImuSample& imu) {
-  // odometry.use_gyro: false leaves the heading to the encoders (and the scan matches).
-  if (!use_gyro_) return;
-  const double rate = imu.angular_velocity_rad_s.z();
-  if (!std::isfinite(rate)) return;
-  // Each sample is held from the previous one (zero-order hold).
-  if (last_imu_time_) {
-    const double dt = SecondsBetween(imu.time, *last_imu_time_);
-    if (dt > 0.0) {
-      gyro_yaw_since_ticks_ += (rate - ekf_.gyro_bias()) * dt;
-      ekf_.PredictGyro(rate, dt);
-      gyro_since_ticks_ = true;
-    }
-  }
-  last_imu_time_ = imu.time;
-  // Encoder ticks are coarse (a slow turn can leave an interval without a tick), so only a run
-  // of still intervals counts, and a sample far from the bias (chi2_1 at 0.999) is no standstill.
-  if (still_intervals_ >= kStillIntervals && options_.filter.zero_rate_updates) {
-    const double innovation = rate - ekf_.gyro_bias();
-    const double variance = ekf_.covariance()(6, 6) +
-                            options_.filter.gyro_sigma_rad_s * options_.filter.gyro_sigma_rad_s;
-    if (innovation * innovation < kZeroRateGate * variance) {
-      ekf_.UpdateZeroRate(rate);
-      ++zero_rate_updates_;
-    }
-  }
-}
-
-void EkfEstimator::AddTicks(const WheelTicks& ticks) {
-  const double metres_per_tick = robot_.MetresPerTick();
-  const double right_m = MeanTicks(ticks.right_ticks) * metres_per_tick;
-  const double left_m = MeanTicks(ticks.left_ticks) * metres_per_tick;
-  ekf_.PredictWheels(
-      right_m, left_m, robot_.track_width_m,
-      gyro_since_ticks_ ? std::optional<double>(gyro_yaw_since_ticks_) : std::nullopt);
-  still_intervals_ = right_m == 0.0 && left_m == 0.0 ? still_intervals_ + 1 : 0;
-  saw_ticks_ = true;
-  gyro_since_ticks_ = false;
-  gyro_yaw_since_ticks_ = 0.0;
-}
-
 ScanEstimate EkfEstimator::AddScan(const SyncedScan& scan) {
-  if (scans_ > 0 && !saw_ticks_) {
+  if (scans_ > 0 && !feed_.saw_ticks()) {
     const double distance = scan.increment.translation().norm();
     ekf_.PredictIncrement(scan.increment, distance, scan.increment.theta());
   }
@@ -153,7 +103,7 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
     r(1, 1) += options_.match_sigma_floor_xy_m * options_.match_sigma_floor_xy_m;
     r(2, 2) += options_.match_sigma_floor_yaw_rad * options_.match_sigma_floor_yaw_rad;
     r *= MatchScale();
-    if (!first && !saw_ticks_) {
+    if (!first && !feed_.saw_ticks()) {
       // Odometry-pose increments (no encoders): keyframe-to-keyframe increments through the
       // clone, as before the matcher's frame. On the corrected CARMEN logs the frame model made
       // intel (1.9 -> 10.9 m), belgioioso (2.6 -> 6.3 m) and edmonton (0.72 -> 1.5 m) worse,
@@ -189,7 +139,7 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
       ekf_.AnchorMatcherFrame(step.pose, Eigen::Matrix3d::Zero());
       anchored_ = true;
       icp_keyframe_ = step.pose;
-      if (!saw_ticks_) {
+      if (!feed_.saw_ticks()) {
         ++keyframes_;
         ekf_.Clone();
       }
@@ -213,7 +163,7 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
         ++anchors_;
       }
     }
-    if (saw_ticks_ && (first || step.keyframe)) {
+    if (feed_.saw_ticks() && (first || step.keyframe)) {
       ++keyframes_;
       if (!first && !usable) {
         // The keyframe joins the map where the prior put it, along its weak direction at least.
@@ -241,7 +191,7 @@ std::map<std::string, double> EkfEstimator::Statistics() const {
   return {{"gyro_bias_rad_s", ekf_.gyro_bias()},
           {"gyro_scale_error", ekf_.gyro_scale_error()},
           {"scan_updates", scan_updates_},
-          {"zero_rate_updates", zero_rate_updates_},
+          {"zero_rate_updates", feed_.zero_rate_updates()},
           {"slip_inflations", slip_inflations_},
           {"matched", icp_.counts().matched},
           {"keyframes", keyframes_},

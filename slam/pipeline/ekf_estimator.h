@@ -10,6 +10,7 @@
 #include "slam/matching/icp_odometry.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
+#include "slam/pipeline/wheel_gyro_feed.h"
 
 namespace slamrig::slam {
 
@@ -96,29 +97,20 @@ class EkfEstimator final : public Estimator {
   std::map<std::string, double> Statistics() const override;
 
  private:
-  void AddImu(const ImuSample& imu);
-  void AddTicks(const WheelTicks& ticks);
   /// Matches `scan` at the filter's current pose, updates, clones; the estimate at the scan.
   ScanEstimate Correct(const LaserScan& scan);
   /// The factor applied to the match covariance (the adapted one, at least 1).
   double MatchScale() const;
 
   EkfOptions options_;
-  DiffDriveParams robot_;
-  bool use_gyro_ = true;
+  WheelGyroFeed<PoseEkf> feed_;
   PoseEkf ekf_;
   IcpOdometry icp_;
   OccupancyGrid map_;
   Pose2 previous_pose_;
   int scans_ = 0;
-  bool saw_ticks_ = false;
   bool last_record_was_ticks_ = false;
-  int still_intervals_ = 0;  // consecutive encoder intervals without a tick
-  std::optional<Time> last_imu_time_;
-  bool gyro_since_ticks_ = false;
-  double gyro_yaw_since_ticks_ = 0.0;
   int scan_updates_ = 0;
-  int zero_rate_updates_ = 0;
   int slip_inflations_ = 0;
   int keyframes_ = 0;
   Pose2 icp_keyframe_;     // the last keyframe's match (the increments' start, no encoders)

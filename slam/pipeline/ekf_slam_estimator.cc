@@ -1,7 +1,6 @@
 #include "slam/pipeline/ekf_slam_estimator.h"
 
 #include <cmath>
-#include <numeric>
 
 #include "slam/types/validation.h"
 
@@ -10,13 +9,6 @@ namespace {
 
 // As the `ekf` estimator: a run of still encoder intervals is a standstill, and a gyro sample
 // beyond chi2_1 at 0.999 of the bias is none.
-constexpr int kStillIntervals = 10;
-constexpr double kZeroRateGate = 10.83;
-
-double MeanTicks(const std::vector<std::int32_t>& ticks) {
-  if (ticks.empty()) return 0.0;
-  return std::accumulate(ticks.begin(), ticks.end(), 0.0) / static_cast<double>(ticks.size());
-}
 
 }  // namespace
 
@@ -31,58 +23,19 @@ std::vector<std::string> EkfSlamEstimatorOptions::Validate() const {
 EkfSlamEstimator::EkfSlamEstimator(const EkfSlamEstimatorOptions& options,
                                    const EstimatorContext& context)
     : options_(options),
-      robot_(context.robot),
-      use_gyro_(context.use_gyro),
+      feed_(context.robot, context.use_gyro, options.filter.motion),
       slam_(options.filter),
       map_(options.map) {}
 
 void EkfSlamEstimator::AddRecord(const Record& record) {
-  if (const auto* imu = std::get_if<ImuSample>(&record)) AddImu(*imu);
-  if (const auto* ticks = std::get_if<WheelTicks>(&record)) AddTicks(*ticks);
-}
-
-void EkfSlamEstimator::AddImu(const ImuSample& imu) {
-  if (!use_gyro_) return;
-  const double rate = imu.angular_velocity_rad_s.z();
-  if (!std::isfinite(rate)) return;
-  // Each sample is held from the previous one (zero-order hold).
-  if (last_imu_time_) {
-    const double dt = SecondsBetween(imu.time, *last_imu_time_);
-    if (dt > 0.0) {
-      gyro_yaw_since_ticks_ += (rate - slam_.gyro_bias()) * dt;
-      slam_.PredictGyro(rate, dt);
-      gyro_since_ticks_ = true;
-    }
-  }
-  last_imu_time_ = imu.time;
-  if (still_intervals_ >= kStillIntervals && options_.filter.motion.zero_rate_updates) {
-    const double innovation = rate - slam_.gyro_bias();
-    const double sigma = options_.filter.motion.gyro_sigma_rad_s;
-    const double variance = slam_.covariance()(3, 3) + sigma * sigma;
-    if (innovation * innovation < kZeroRateGate * variance) {
-      slam_.UpdateZeroRate(rate);
-      ++zero_rate_updates_;
-    }
-  }
-}
-
-void EkfSlamEstimator::AddTicks(const WheelTicks& ticks) {
-  const double metres_per_tick = robot_.MetresPerTick();
-  const double right_m = MeanTicks(ticks.right_ticks) * metres_per_tick;
-  const double left_m = MeanTicks(ticks.left_ticks) * metres_per_tick;
-  slam_.PredictWheels(
-      right_m, left_m, robot_.track_width_m,
-      gyro_since_ticks_ ? std::optional<double>(gyro_yaw_since_ticks_) : std::nullopt);
-  still_intervals_ = right_m == 0.0 && left_m == 0.0 ? still_intervals_ + 1 : 0;
-  saw_ticks_ = true;
-  gyro_since_ticks_ = false;
-  gyro_yaw_since_ticks_ = 0.0;
+  if (const auto* imu = std::get_if<ImuSample>(&record)) feed_.AddImu(*imu, slam_);
+  if (const auto* ticks = std::get_if<WheelTicks>(&record)) feed_.AddTicks(*ticks, slam_);
 }
 
 ScanEstimate EkfSlamEstimator::AddScan(const SyncedScan& scan) {
   if (scans_ == 0) {
     slam_.ResetPose(Pose2());
-  } else if (!saw_ticks_) {
+  } else if (!feed_.saw_ticks()) {
     slam_.PredictIncrement(scan.increment, scan.increment.translation().norm(),
                            scan.increment.theta());
   }
@@ -149,7 +102,7 @@ std::map<std::string, double> EkfSlamEstimator::Statistics() const {
           {"landmark_pairings", pairings_},
           {"ambiguous_observations", ambiguous_},
           {"landmark_updates", updates_},
-          {"zero_rate_updates", zero_rate_updates_},
+          {"zero_rate_updates", feed_.zero_rate_updates()},
           {"gyro_bias_rad_s", slam_.gyro_bias()},
           {"mean_nis_per_dof", nis_dof_sum_ > 0.0 ? nis_sum_ / nis_dof_sum_ : 0.0}};
 }

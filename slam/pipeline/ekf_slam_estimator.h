@@ -9,6 +9,7 @@
 #include "slam/grid/occupancy_grid.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
+#include "slam/pipeline/wheel_gyro_feed.h"
 
 namespace slamrig::slam {
 
@@ -50,28 +51,19 @@ class EkfSlamEstimator final : public Estimator {
   EstimatorView View() const override;
 
  private:
-  void AddImu(const ImuSample& imu);
-  void AddTicks(const WheelTicks& ticks);
   std::vector<LandmarkEstimate> CurrentLandmarks() const;
 
   EkfSlamEstimatorOptions options_;
-  DiffDriveParams robot_;
-  bool use_gyro_ = true;
+  WheelGyroFeed<EkfSlam> feed_;
   EkfSlam slam_;
   OccupancyGrid map_;
   std::vector<LandmarkSighting> sightings_;
   int scans_ = 0;
-  bool saw_ticks_ = false;
-  int still_intervals_ = 0;  // consecutive encoder intervals without a tick
-  std::optional<Time> last_imu_time_;
   std::optional<Time> previous_scan_time_;
-  bool gyro_since_ticks_ = false;
-  double gyro_yaw_since_ticks_ = 0.0;
   int observations_ = 0;
   int pairings_ = 0;
   int ambiguous_ = 0;
   int updates_ = 0;
-  int zero_rate_updates_ = 0;
   double nis_sum_ = 0.0;
   double nis_dof_sum_ = 0.0;
 };
