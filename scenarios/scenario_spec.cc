@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 #include <system_error>
 
@@ -470,9 +471,16 @@ ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string
   if (!slam.IsMap()) slam.Fail("expected a map of SLAM configurations (name: {algorithm: ...})");
   const slam::DiffDriveParams robot =
       spec.simulated ? sim::NominalOdometry(spec.simulated->options.robot) : spec.log->robot;
+  // The simulated gyro's noise as the robot file states it; a log's gyro is not characterised.
+  std::optional<slam::GyroNoiseModel> gyro;
+  if (spec.simulated && spec.simulated->options.robot.imu.enabled) {
+    const sim::ImuOptions& imu = spec.simulated->options.robot.imu;
+    gyro = slam::GyroNoiseModel{imu.gyro.noise_density, imu.gyro.random_walk, imu.rate_hz};
+  }
   for (const std::string& name : slam.Keys()) {
     slam::EstimatorConfig config = slam::ParseEstimatorConfig(name, slam.Required(name));
     config.odometry.robot = robot;
+    config.gyro = gyro;
     spec.configs.push_back(std::move(config));
   }
   if (spec.configs.empty()) slam.Fail("needs at least one SLAM configuration");

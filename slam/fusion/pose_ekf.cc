@@ -85,6 +85,9 @@ void PoseEkf::PredictWheels(double right_m, double left_m, double track_width_m,
   p_(4, 4) += s * s * along + c * c * lateral;
   p_(3, 4) += c * s * (along - lateral);
   p_(4, 3) = p_(3, 4);
+  const double skid = Squared(options_.encoder_skid_sigma_m_per_sqrt_rad) * std::abs(turned);
+  p_(3, 3) += skid;
+  p_(4, 4) += skid;
   if (!gyro_yaw_rad) {
     p_(kYaw, kYaw) += Squared(options_.encoder_yaw_sigma_rel *
                               (std::abs(right_m) + std::abs(left_m)) / track_width_m);

@@ -11,6 +11,12 @@ struct PoseEkfOptions {
   double encoder_sigma_rel = 0.02;
   /// Sideways slip per encoder interval: sigma = encoder_lateral_sigma_rel * |distance|.
   double encoder_lateral_sigma_rel = 0.01;
+  /// Skid of a skid-steered base while it turns: a random walk of the position with the yaw
+  /// turned, variance encoder_skid_sigma_m_per_sqrt_rad^2 * |yaw turned| in x and in y (the
+  /// turn's instantaneous centre wanders along the wheelbase as the wheels' loads shift, so the
+  /// base moves by that offset times the angle even on a turn in place, where the distance terms
+  /// add nothing). Per radian, not per interval, so that it does not depend on the encoder rate.
+  double encoder_skid_sigma_m_per_sqrt_rad = 0.0;
   /// Yaw from the wheel difference (no gyro in the interval): sigma = rel * (|right| + |left|) /
   /// track width.
   double encoder_yaw_sigma_rel = 0.02;
@@ -44,6 +50,7 @@ void VisitFields(V& v, PoseEkfOptions& o) {
   v("encoder_sigma_rel", o.encoder_sigma_rel);
   v("encoder_lateral_sigma_rel", o.encoder_lateral_sigma_rel);
   v("encoder_yaw_sigma_rel", o.encoder_yaw_sigma_rel);
+  v("encoder_skid_sigma_m_per_sqrt_rad", o.encoder_skid_sigma_m_per_sqrt_rad);
   v("gyro_sigma_rad_s", o.gyro_sigma_rad_s);
   v("gyro_bias_sigma_rad_s", o.gyro_bias_sigma_rad_s);
   v("gyro_bias_walk_rad_s_sqrt_s", o.gyro_bias_walk_rad_s_sqrt_s);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <cmath>
 #include <random>
 
 #include "slam/fusion/consistency.h"
@@ -45,6 +46,36 @@ TEST(JosephUpdateTest, EqualsShortFormForOptimalGain) {
   const Eigen::MatrixXd k = p * h.transpose() * s.inverse();
   const Eigen::MatrixXd short_form = (Eigen::MatrixXd::Identity(2, 2) - k * h) * p;
   EXPECT_LT((JosephUpdate(p, k, h, r) - short_form).norm(), 1e-12);
+}
+
+// A turn in place adds nothing through the distance terms; the skid term adds position variance
+// k^2 |turned| per axis however the turn is split into encoder intervals (a random walk in the
+// yaw turned), and nothing at all with k = 0.
+TEST(PoseEkfTest, SkidNoiseGrowsWithTheYawTurnedNotWithTheIntervals) {
+  const double k = 0.05;
+  const double turn = 1.5 * M_PI;
+  for (const int intervals : {3, 40}) {
+    for (const double skid : {k, 0.0}) {
+      PoseEkfOptions options;
+      options.encoder_skid_sigma_m_per_sqrt_rad = skid;
+      PoseEkf ekf(options);
+      ekf.ResetPose(Pose2());
+      const double wheel = 0.5 * 0.4 * turn / intervals;  // right forward, left back
+      for (int i = 0; i < intervals; ++i) ekf.PredictWheels(wheel, -wheel, 0.4, turn / intervals);
+      const Eigen::Matrix3d p = ekf.PoseCovariance();
+      EXPECT_NEAR(p(0, 0), skid * skid * turn, 1e-15) << intervals;
+      EXPECT_NEAR(p(1, 1), skid * skid * turn, 1e-15) << intervals;
+      EXPECT_NEAR(p(0, 1), 0.0, 1e-15);
+    }
+  }
+}
+
+TEST(PoseEkfOptionsTest, RejectsANegativeSkidNoiseByItsKey) {
+  PoseEkfOptions options;
+  options.encoder_skid_sigma_m_per_sqrt_rad = -0.1;
+  const std::vector<std::string> errors = options.Validate();
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("encoder_skid_sigma_m_per_sqrt_rad"), std::string::npos) << errors[0];
 }
 
 // A slip the motion model cannot explain (0.3 m on a 1 m drive whose model allows 2 %): the

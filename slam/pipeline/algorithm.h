@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,11 +14,22 @@
 
 namespace slamrig::slam {
 
+/// A gyro's white noise in the continuous-time parameters of the robot file (Kalibr's), for an
+/// estimator to model the gyro it reads instead of guessing.
+struct GyroNoiseModel {
+  double noise_density_rad_s_sqrt_hz = 0.0;  ///< white rate noise
+  double random_walk_rad_s2_sqrt_hz = 0.0;   ///< bias random walk
+  double rate_hz = 0.0;                      ///< samples per second
+};
+
 /// What every estimator is built with besides its own options.
 struct EstimatorContext {
   std::uint64_t seed = 1;  ///< the estimator's own random seed (a named stream of the run's)
   DiffDriveParams robot;   ///< the wheel geometry of the source (for estimators that read ticks)
   bool use_gyro = true;    ///< odometry.use_gyro: estimators that read the IMU themselves honour it
+  /// The source's gyro noise as its robot file states it, where there is one (a simulated
+  /// robot); nullopt for logs, whose gyro is not characterised.
+  std::optional<GyroNoiseModel> gyro;
 };
 
 /// One algorithm's options behind one interface: a plain options struct with a VisitFields

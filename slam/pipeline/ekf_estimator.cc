@@ -17,6 +17,16 @@ constexpr double kMatchScaleGain = 0.05;
 constexpr double kMinMatchScale = 0.1;
 constexpr double kMaxMatchScale = 1e3;
 
+// The filter's options with the source's gyro model where it has one and the options ask for it.
+EkfOptions WithRobotGyro(EkfOptions options, const EstimatorContext& context) {
+  if (options.gyro_noise_from_robot && context.gyro && context.gyro->rate_hz > 0.0) {
+    options.filter.gyro_sigma_rad_s =
+        context.gyro->noise_density_rad_s_sqrt_hz * std::sqrt(context.gyro->rate_hz);
+    options.filter.gyro_bias_walk_rad_s_sqrt_s = context.gyro->random_walk_rad_s2_sqrt_hz;
+  }
+  return options;
+}
+
 }  // namespace
 
 std::vector<std::string> EkfOptions::Validate() const {
@@ -50,9 +60,9 @@ std::vector<std::string> EkfOptions::Validate() const {
 }
 
 EkfEstimator::EkfEstimator(const EkfOptions& options, const EstimatorContext& context)
-    : options_(options),
-      feed_(context.robot, context.use_gyro, options.filter),
-      ekf_(options.filter),
+    : options_(WithRobotGyro(options, context)),
+      feed_(context.robot, context.use_gyro, options_.filter),
+      ekf_(options_.filter),
       icp_(IcpOdometryOptions{}),
       map_(options.map) {}
 
@@ -190,6 +200,7 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
 std::map<std::string, double> EkfEstimator::Statistics() const {
   return {{"gyro_bias_rad_s", ekf_.gyro_bias()},
           {"gyro_scale_error", ekf_.gyro_scale_error()},
+          {"gyro_sigma_rad_s", options_.filter.gyro_sigma_rad_s},
           {"scan_updates", scan_updates_},
           {"zero_rate_updates", feed_.zero_rate_updates()},
           {"slip_inflations", slip_inflations_},

@@ -96,6 +96,28 @@ TEST(EkfEstimatorTest, FinalPoseNeesIsInsideTheChiSquareRegionOverSeeds) {
   EXPECT_GT(anis, AneesBounds(3, updates).lower) << anis;
 }
 
+// With gyro_noise_from_robot, a source that states its gyro's noise (a simulated robot file)
+// sets the filter's: a sample's sigma is the density times sqrt(rate). Without one (a log), or
+// with the option off (the default), the option's own value stays; the runs differ accordingly.
+TEST(EkfEstimatorTest, TakesTheGyroNoiseFromTheSourceWhenAsked) {
+  const testing::SyntheticRun run = ShortRun(5, 10.0);
+  EstimatorConfig config = DefaultEstimatorConfig("ekf", "ekf");
+  const EstimatorRun log_like = RunEstimator(config, run.records, 1);
+  EXPECT_EQ(log_like.statistics.at("gyro_sigma_rad_s"), 0.01);
+  config.gyro = GyroNoiseModel{2.0e-4, 3.0e-5, 100.0};
+  const EstimatorRun declined = RunEstimator(config, run.records, 1);
+  EXPECT_EQ(declined.statistics.at("gyro_sigma_rad_s"), 0.01);
+  EXPECT_EQ(declined.covariances.back()(2, 2), log_like.covariances.back()(2, 2));
+  ReadEstimatorFields(YamlNode::LoadString("{gyro_noise_from_robot: true}", "test"), &config);
+  const EstimatorRun modelled = RunEstimator(config, run.records, 1);
+  EXPECT_DOUBLE_EQ(modelled.statistics.at("gyro_sigma_rad_s"), 2.0e-4 * std::sqrt(100.0));
+  ASSERT_EQ(modelled.online.size(), log_like.online.size());
+  EXPECT_NE(modelled.covariances.back()(2, 2), log_like.covariances.back()(2, 2));
+  config.gyro.reset();
+  const EstimatorRun no_model = RunEstimator(config, run.records, 1);
+  EXPECT_EQ(no_model.statistics.at("gyro_sigma_rad_s"), 0.01);
+}
+
 // odometry.use_gyro: false leaves the IMU unread: no bias estimate, no zero-rate updates, and a
 // different path from the default's (which does read the gyro).
 TEST(EkfEstimatorTest, HonoursUseGyro) {

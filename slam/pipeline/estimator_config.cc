@@ -38,7 +38,8 @@ EstimatorConfig::EstimatorConfig(const EstimatorConfig& other)
       algorithm(other.algorithm),
       preset(other.preset),
       odometry(other.odometry),
-      options(other.options ? other.options->Clone() : nullptr) {}
+      options(other.options ? other.options->Clone() : nullptr),
+      gyro(other.gyro) {}
 
 EstimatorConfig& EstimatorConfig::operator=(const EstimatorConfig& other) {
   if (this != &other) *this = EstimatorConfig(other);
@@ -110,6 +111,7 @@ std::unique_ptr<Estimator> MakeEstimator(const EstimatorConfig& config, std::uin
   context.seed = RandomStream(run_seed, "slam." + config.name).NextU64();
   context.robot = config.odometry.robot;
   context.use_gyro = config.odometry.use_gyro;
+  context.gyro = config.gyro;
   return config.options->MakeEstimator(context);
 }
 

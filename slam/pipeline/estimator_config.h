@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,8 @@ struct EstimatorConfig {
   std::string preset = "default";  ///< one of the algorithm's presets
   ScanSyncOptions odometry;  ///< source, gyro, integration; the robot geometry is the source's
   std::unique_ptr<AlgorithmOptions> options;  ///< the algorithm's own options
+  /// The source's gyro noise (EstimatorContext::gyro): not a field, it comes from the robot file.
+  std::optional<GyroNoiseModel> gyro;
 
   EstimatorConfig() = default;
   EstimatorConfig(const EstimatorConfig& other);
