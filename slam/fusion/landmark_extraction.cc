@@ -70,8 +70,8 @@ void FitCluster(const std::vector<Eigen::Vector2d>& hits, std::size_t first_beam
   }
   // A corner (a square column's, a car's) or a short wall can fit a small circle under
   // max_fit_rms_m; lines then fit it to the noise, and the circle's residual variance exceeds
-  // theirs by more than chance allows (an F test at gate_probability, approximate: the models
-  // are not nested). With few points the test has little power; EkfSlam pools it over a
+  // theirs by more than chance allows (an F test at model_test_probability, approximate: the
+  // models are not nested). With few points the test has little power; EkfSlam pools it over a
   // tentative landmark's sightings (LinesAreBetter).
   const double circle_sse = fit->rms_m * fit->rms_m * static_cast<double>(hits.size());
   const LinesFit lines = FitLines(hits);
