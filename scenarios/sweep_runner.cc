@@ -655,16 +655,36 @@ int WriteSweepSummary(const SweepSpec& spec, const std::string& out_dir) {
   // Consistency: the final pose's NEES is independent across seeds, so its mean over a grid
   // point's seeds is an ANEES with a chi-square acceptance region (Bar-Shalom et al. 2001,
   // Sec. 5.4.2). A time-averaged NEES (mean_nees) is not: its samples are correlated in time.
-  const std::string nees_suffix = "final_nees";
+  // A landmark estimator's landmark_anees is a run's mean NEES over its mapped landmarks (2 dof
+  // each); weighted by the run's pillars_mapped (a metric of the same configuration, which the
+  // sweep must list) it pools into the ANEES over every landmark of every run. The region then
+  // treats the landmarks as independent, which they are not quite (they share the pose's error).
+  const auto ends_with = [](const std::string& name, const std::string& suffix) {
+    return name.size() >= suffix.size() &&
+           name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
   for (std::size_t m = first_metric; m + 1 < header.size(); ++m) {
     const std::string& name = header[m];
-    if (name.size() < nees_suffix.size() ||
-        name.compare(name.size() - nees_suffix.size(), nees_suffix.size(), nees_suffix) != 0) {
+    int dimension = 0;
+    std::size_t weight_column = 0;  // 0: one sample per run
+    std::string what;
+    if (ends_with(name, "final_nees")) {
+      dimension = 3;
+      what = "pose, 3 dof";
+    } else if (ends_with(name, "landmark_anees")) {
+      const std::string mapped =
+          name.substr(0, name.size() - std::string("landmark_anees").size()) + "pillars_mapped";
+      const auto it = std::find(header.begin() + first_metric, header.end(), mapped);
+      if (it == header.end()) continue;
+      weight_column = static_cast<std::size_t>(it - header.begin());
+      dimension = 2;
+      what = "landmarks, 2 dof, pooled over the mapped landmarks of all runs";
+    } else {
       continue;
     }
-    // One group per grid point (the swept values), in results.csv order.
+    // One group per grid point (the swept values), in results.csv order: (value, weight) pairs.
     std::vector<std::string> labels;
-    std::map<std::string, std::vector<double>> samples;
+    std::map<std::string, std::vector<std::pair<double, double>>> samples;
     for (const auto& row : rows) {
       if (row.size() != header.size()) continue;
       std::string label;
@@ -672,14 +692,15 @@ int WriteSweepSummary(const SweepSpec& spec, const std::string& out_dir) {
         label += (label.empty() ? "" : ", ") + spec.parameters[q].key + "=" + row[1 + q];
       if (label.empty()) label = "all runs";
       const double v = number(row[m]);
-      if (!std::isfinite(v)) continue;
+      const double w = weight_column > 0 ? number(row[weight_column]) : 1.0;
+      if (!std::isfinite(v) || !std::isfinite(w) || !(w > 0.0)) continue;
       if (!samples.count(label)) labels.push_back(label);
-      samples[label].push_back(v);
+      samples[label].emplace_back(v, w);
     }
     if (labels.empty()) continue;
     html +=
-        "<h2>ANEES of " + name +
-        " (pose, 3 dof) with the two-sided 95 % chi-square region</h2><table><tr><th>grid "
+        "<h2>ANEES of " + name + " (" + what +
+        ") with the two-sided 95 % chi-square region</h2><table><tr><th>grid "
         "point</th><th>runs</th><th>ANEES</th><th>lower</th><th>upper</th><th>verdict</th></tr>";
     PlotSeries anees, lower, upper;
     anees.label = "ANEES";
@@ -690,11 +711,15 @@ int WriteSweepSummary(const SweepSpec& spec, const std::string& out_dir) {
     lower.colour = upper.colour = PaletteColour(1);
     lower.dashed = upper.dashed = true;
     for (std::size_t g = 0; g < labels.size(); ++g) {
-      const std::vector<double>& v = samples[labels[g]];
-      double sum = 0.0;
-      for (const double x : v) sum += x;
-      const double mean = sum / static_cast<double>(v.size());
-      const slam::NeesBounds bounds = slam::AneesBounds(3, static_cast<int>(v.size()));
+      const std::vector<std::pair<double, double>>& v = samples[labels[g]];
+      double sum = 0.0, weight = 0.0;
+      for (const auto& [x, w] : v) {
+        sum += w * x;
+        weight += w;
+      }
+      const double mean = sum / weight;
+      const slam::NeesBounds bounds =
+          slam::AneesBounds(dimension, static_cast<int>(std::lround(weight)));
       const bool inside = mean >= bounds.lower && mean <= bounds.upper;
       char cells[256];
       std::snprintf(cells, sizeof(cells), "<td>%zu</td><td>%.3f</td><td>%.3f</td><td>%.3f</td>",

@@ -132,6 +132,28 @@ TEST(SweepTest, SummaryShowsTheAneesWithItsChiSquareBounds) {
   EXPECT_TRUE(std::filesystem::exists(dir.File("out/summary_anees_ekf.final_nees.png")));
 }
 
+// A landmark_anees column pools over the landmarks: each run's mean weighted by its
+// pillars_mapped, the region that of all those landmarks' 2 dof. Here (2 * 10 + 5 * 5) / 15 = 3,
+// against chi2_30(0.025) / 15 = 1.119 and chi2_30(0.975) / 15 = 3.132.
+TEST(SweepTest, SummaryPoolsTheLandmarkAneesOverTheMappedLandmarks) {
+  testing::TempDir dir;
+  dir.Write("scenario.yaml", "name: x\n");
+  const SweepSpec spec =
+      LoadSweepSpec(dir.Write("sweep.yaml",
+                              "scenario: scenario.yaml\nseeds: 2\nparameters:\n  a.noise: [1]\n"
+                              "metrics: [s.landmark_anees, s.pillars_mapped]\n"));
+  std::filesystem::create_directories(dir.File("out"));
+  dir.Write("out/results.csv",
+            "run,a.noise,seed,status,s.landmark_anees,s.pillars_mapped,wall_time_s\n"
+            "r1,1,1,pass,2,10,1\nr2,1,2,pass,5,5,1\n");
+  WriteSweepSummary(spec, dir.File("out"));
+  std::ifstream in(dir.File("out/summary.html"));
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_THAT(html, ::testing::HasSubstr("<td>a.noise=1</td><td>2</td><td>3.000</td><td>1.119</td>"
+                                         "<td>3.132</td><td>inside</td>"));
+  EXPECT_TRUE(std::filesystem::exists(dir.File("out/summary_anees_s.landmark_anees.png")));
+}
+
 TEST(SweepTest, BadSweepFilesNameFileLineAndKey) {
   testing::TempDir dir;
   dir.Write("s.yaml", "name: x\n");

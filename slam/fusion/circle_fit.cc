@@ -58,7 +58,9 @@ std::optional<CircleFit> FitCircle(const std::vector<Eigen::Vector2d>& points) {
   fit.radius_m = r;
   fit.rms_m = std::sqrt(sum_sq / n);
   const double sigma2 = n > 3 ? sum_sq / (n - 3) : 0.0;
-  fit.center_covariance = (sigma2 * jtj.inverse()).topLeftCorner<2, 2>();
+  const Eigen::Matrix3d covariance = sigma2 * jtj.inverse();
+  fit.center_covariance = covariance.topLeftCorner<2, 2>();
+  fit.radius_variance = covariance(2, 2);
   return fit;
 }
 

@@ -17,6 +17,7 @@ struct CircleFit {
   double rms_m = 0.0;  ///< root mean square of the points' geometric distances to the circle
   /// Covariance of the centre (m^2) from the Gauss-Newton normal equations and the residuals.
   Eigen::Matrix2d center_covariance = Eigen::Matrix2d::Zero();
+  double radius_variance = 0.0;  ///< of the radius (m^2), from the same normal equations
 };
 
 /// The circle through `points` (at least 3, not collinear), or nullopt when there is none.

@@ -98,6 +98,19 @@ double ChiSquareQuantile(double p, double dof) {
   return x;
 }
 
+double FQuantile(double p, double d1, double d2) {
+  SLAMRIG_CHECK(p >= 0.5 && p < 1.0 && d1 > 0.0 && d2 > 0.0, "FQuantile: p in [0.5, 1), dof > 0");
+  // z = ((1 - c2) u - (1 - c1)) / sqrt(c1 + c2 u^2) with u = F^(1/3), c = 2 / (9 d): the larger
+  // root of the quadratic in u.
+  const double z = NormalQuantile(p);
+  const double c1 = 2.0 / (9.0 * d1), c2 = 2.0 / (9.0 * d2);
+  const double a = 1.0 - c2, b = 1.0 - c1;
+  const double qa = a * a - z * z * c2, qb = -2.0 * a * b, qc = b * b - z * z * c1;
+  if (!(qa > 0.0)) return std::numeric_limits<double>::infinity();  // d2 too small to bound
+  const double u = (-qb + std::sqrt(std::max(0.0, qb * qb - 4.0 * qa * qc))) / (2.0 * qa);
+  return u * u * u;
+}
+
 NeesBounds AneesBounds(int dimension, int runs) {
   SLAMRIG_CHECK(dimension > 0 && runs > 0, "AneesBounds: dimension and runs > 0");
   const double dof = static_cast<double>(dimension) * runs;

@@ -29,6 +29,11 @@ std::string CovarianceCsv(const Trajectory& poses, const std::vector<Eigen::Matr
 /// (Wilson-Hilferty's start refined by Newton steps on the incomplete gamma function).
 double ChiSquareQuantile(double p, double dof);
 
+/// The `p` quantile (p >= 0.5) of the F distribution with (d1, d2) degrees of freedom, by
+/// Paulson's cube-root normal approximation (Abramowitz and Stegun 26.6.15; within ~2 % of the
+/// tables for d2 >= 3, cruder below).
+double FQuantile(double p, double d1, double d2);
+
 /// The acceptance region of the average NEES over `runs` runs of a `dimension`-dimensional state.
 struct NeesBounds {
   double lower = 0.0;

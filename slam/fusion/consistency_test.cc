@@ -37,5 +37,13 @@ TEST(ConsistencyTest, NeesOfErrorsDrawnFromTheCovarianceAveragesTheDimension) {
   EXPECT_NEAR(sum / n, 3.0, 0.1);
 }
 
+// Against tables of the F distribution (Abramowitz and Stegun, Table 26.9).
+TEST(ConsistencyTest, FQuantileMatchesTables) {
+  EXPECT_NEAR(FQuantile(0.99, 40, 20), 2.69, 0.05);
+  EXPECT_NEAR(FQuantile(0.99, 10, 10), 4.85, 0.1);
+  EXPECT_NEAR(FQuantile(0.95, 5, 10), 3.33, 0.05);
+  EXPECT_NEAR(FQuantile(0.95, 60, 60), 1.53, 0.03);
+}
+
 }  // namespace
 }  // namespace slamrig::slam

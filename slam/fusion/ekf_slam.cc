@@ -204,6 +204,32 @@ void EkfSlam::Update(const std::vector<LandmarkObservation>& observations,
   out->dimension = 2 * k;
 }
 
+bool EkfSlam::RadiiAgree(const Tentative& t) const {
+  // The radii's spread about their inverse-variance weighted mean, in units of their variances:
+  // chi-square with n - 1 degrees of freedom when they measure one radius.
+  const int n = static_cast<int>(t.radii.size());
+  if (n < 2) return true;
+  double weight_sum = 0.0, weighted = 0.0;
+  for (int i = 0; i < n; ++i) {
+    // A fit without residual (exact points) has no variance; it cannot be tested.
+    if (!(t.radius_variances[i] > 0.0)) return true;
+    weight_sum += 1.0 / t.radius_variances[i];
+    weighted += t.radii[i] / t.radius_variances[i];
+  }
+  const double mean = weighted / weight_sum;
+  double q = 0.0;
+  for (int i = 0; i < n; ++i)
+    q += (t.radii[i] - mean) * (t.radii[i] - mean) / t.radius_variances[i];
+  return q <= ChiSquareQuantile(options_.gate_probability, static_cast<double>(n - 1));
+}
+
+bool EkfSlam::LooksRound(const Tentative& t) const {
+  // One sighting of a corner from afar has too few points to tell it from an arc; ten pooled
+  // have the degrees of freedom to.
+  return RadiiAgree(t) && !LinesAreBetter(t.circle_sse, t.circle_dof, t.lines_sse, t.lines_dof,
+                                          options_.extraction.model_test_probability);
+}
+
 LandmarkUpdate EkfSlam::Observe(const std::vector<LandmarkObservation>& observations,
                                 double range_max_m) {
   ++scans_;
@@ -291,12 +317,24 @@ LandmarkUpdate EkfSlam::Observe(const std::vector<LandmarkObservation>& observat
       }
     }
     if (!seen) {
-      tentative_.push_back({position, 0, 0});
+      tentative_.push_back({position, 0, 0, {}, {}, 0.0, 0.0, 0, 0});
       seen = &tentative_.back();
     }
     if (seen->sightings > 0 && seen->last_scan == scans_) continue;  // once per scan
     ++seen->sightings;
     seen->last_scan = scans_;
+    seen->radii.push_back(obs.radius_m);
+    seen->radius_variances.push_back(obs.radius_variance_m2);
+    seen->circle_sse += obs.circle_sse_m2;
+    seen->circle_dof += obs.circle_dof;
+    seen->lines_sse += obs.lines.sse_m2;
+    seen->lines_dof += obs.lines.dof;
+    if (seen->sightings >= options_.min_sightings && !LooksRound(*seen)) {
+      // Not one round object: forget what was seen, so that only sightings from here on count.
+      ++inconsistent_tentatives_;
+      *seen = {position, 0, scans_, {}, {}, 0.0, 0.0, 0, 0};
+      continue;
+    }
     if (seen->sightings >= options_.min_sightings) {
       out.landmark_of_observation[i] = Augment(z, obs.covariance);
       ++out.new_landmarks;

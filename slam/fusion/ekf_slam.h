@@ -81,6 +81,9 @@ class EkfSlam {
     return p_.block<2, 2>(kPoseDim + 2 * i, kPoseDim + 2 * i);
   }
   int tentative_landmarks() const { return static_cast<int>(tentative_.size()); }
+  /// Tentative landmarks dropped at admission because their sightings' radii disagreed or lines
+  /// fitted them better than circles.
+  int inconsistent_tentatives() const { return inconsistent_tentatives_; }
   const Eigen::VectorXd& state() const { return x_; }
   const Eigen::MatrixXd& covariance() const { return p_; }
 
@@ -95,6 +98,12 @@ class EkfSlam {
     Eigen::Vector2d position = Eigen::Vector2d::Zero();  ///< of the first sighting
     int sightings = 0;
     int last_scan = 0;
+    /// Each sighting's fitted radius and its variance.
+    std::vector<double> radii;
+    std::vector<double> radius_variances;
+    /// The sightings' circle and line-model residuals, pooled.
+    double circle_sse = 0.0, lines_sse = 0.0;
+    int circle_dof = 0, lines_dof = 0;
   };
 
   /// Runs one motion step through PoseEkf: the pose, bias and scale and their covariance from
@@ -107,6 +116,11 @@ class EkfSlam {
   void Update(const std::vector<LandmarkObservation>& observations,
               const std::vector<int>& landmark_of_observation, LandmarkUpdate* out);
 
+  /// Whether the sightings' fitted radii are consistent with one radius.
+  bool RadiiAgree(const Tentative& t) const;
+  /// Whether the sightings, pooled, look round: their radii agree, and lines fit them no better.
+  bool LooksRound(const Tentative& t) const;
+
   EkfSlamOptions options_;
   Eigen::VectorXd x_;
   Eigen::MatrixXd p_;
@@ -115,6 +129,7 @@ class EkfSlam {
   PoseEkf probe_gyro_;
   std::vector<Tentative> tentative_;
   int scans_ = 0;
+  int inconsistent_tentatives_ = 0;
 };
 
 }  // namespace slamrig::slam

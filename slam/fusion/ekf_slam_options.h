@@ -28,7 +28,10 @@ struct EkfSlamOptions {
   /// A landmark enters the state once it was seen in this many scans at about one place, with
   /// gaps shorter than tentative_max_age_scans (a tentative landmark until then): a pillar in view
   /// is found in nearly every scan, clutter that looks round from some viewpoints (a square
-  /// column's corner, a car's) only now and then, and never reaches the state.
+  /// column's corner, a car's) only now and then, and never reaches the state. Its sightings'
+  /// fitted radii must also agree within their fits' own variances (chi-square at
+  /// gate_probability): a pillar keeps its radius from every viewpoint, a corner that looks round
+  /// from a few does not.
   int min_sightings = 10;
   /// Sightings of a tentative landmark lie within this distance of its first, m.
   double tentative_radius_m = 0.3;

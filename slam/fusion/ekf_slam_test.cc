@@ -4,6 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <limits>
 #include <random>
 
 namespace slamrig::slam {
@@ -239,6 +240,118 @@ TEST(EkfSlamTest, JointCompatibilityResolvesWhatNearestNeighbourGetsWrong) {
       EXPECT_NEAR(slam.pose().theta(), -0.15, 0.01);
     }
   }
+}
+
+// A tentative landmark enters the state only when its sightings' radii agree within their fits'
+// variances: the same place seen min_sightings times with one radius (1 cm noise, 1 cm sigma) is
+// admitted; with radii that jump between 0.15 and 0.35 m (a corner that looks round from some
+// viewpoints) it never is, however often it is seen.
+TEST(EkfSlamTest, TentativeLandmarkNeedsConsistentRadii) {
+  for (const bool consistent : {true, false}) {
+    const EkfSlamOptions options;  // min_sightings 10
+    EkfSlam slam(options);
+    slam.ResetPose(Pose2());
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> noise(0.0, 0.01);
+    int admitted_at = -1;
+    for (int scan = 0; scan < 5 * options.min_sightings; ++scan) {
+      std::vector<LandmarkObservation> observations(1);
+      observations[0].range_m = 5.0;
+      observations[0].bearing_rad = 0.1;
+      observations[0].covariance = Eigen::Vector2d(1e-4, 4e-6).asDiagonal();
+      observations[0].radius_m = consistent ? 0.25 + noise(rng) : (scan % 2 ? 0.15 : 0.35);
+      observations[0].radius_variance_m2 = 1e-4;
+      const LandmarkUpdate update = slam.Observe(observations, 30.0);
+      if (update.new_landmarks > 0 && admitted_at < 0) admitted_at = scan;
+    }
+    if (consistent) {
+      EXPECT_EQ(admitted_at, options.min_sightings - 1);
+      EXPECT_EQ(slam.landmarks(), 1);
+    } else {
+      EXPECT_EQ(slam.landmarks(), 0);
+      EXPECT_GE(slam.inconsistent_tentatives(), 4);
+    }
+  }
+}
+
+// Range along the ray from `origin` in direction `u` to a square column of half side `half`
+// centred at `c` and turned by `yaw` (slab intersection in the column's frame), or to a disc of
+// radius `half` there when `round`; infinity when it misses.
+double CastRayAtColumn(const Eigen::Vector2d& origin, const Eigen::Vector2d& u,
+                       const Eigen::Vector2d& c, double half, double yaw, bool round) {
+  const double miss = std::numeric_limits<double>::infinity();
+  if (round) {
+    const Eigen::Vector2d m = origin - c;
+    const double b = m.dot(u), disc = b * b - (m.squaredNorm() - half * half);
+    return disc >= 0.0 && -b - std::sqrt(disc) > 0.0 ? -b - std::sqrt(disc) : miss;
+  }
+  const double cy = std::cos(yaw), sy = std::sin(yaw);
+  const Eigen::Vector2d d = origin - c;
+  const Eigen::Vector2d o(cy * d.x() + sy * d.y(), -sy * d.x() + cy * d.y());
+  const Eigen::Vector2d v(cy * u.x() + sy * u.y(), -sy * u.x() + cy * u.y());
+  double near = -miss, far = miss;
+  for (int k = 0; k < 2; ++k) {
+    if (std::abs(v(k)) < 1e-12) {
+      if (std::abs(o(k)) > half) return miss;
+      continue;
+    }
+    double t0 = (-half - o(k)) / v(k), t1 = (half - o(k)) / v(k);
+    if (t0 > t1) std::swap(t0, t1);
+    near = std::max(near, t0);
+    far = std::min(far, t1);
+  }
+  return near <= far && near > 0.0 ? near : miss;
+}
+
+// A Hokuyo-like scan (1081 beams of 0.25 degrees, 1 cm noise) from base_link that sees only one
+// column.
+LaserScan ColumnScan(const Eigen::Vector2d& c, double half, double yaw, bool round,
+                     std::mt19937_64& rng) {
+  LaserScan scan;
+  scan.angle_min_rad = -2.35;
+  scan.angle_increment_rad = 0.25 * M_PI / 180.0;
+  scan.range_min_m = 0.1;
+  scan.range_max_m = 30.0;
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (int i = 0; i < 1081; ++i) {
+    const double a = scan.BeamAngle(i);
+    const double r = CastRayAtColumn(
+        Eigen::Vector2d::Zero(), Eigen::Vector2d(std::cos(a), std::sin(a)), c, half, yaw, round);
+    scan.ranges_m.push_back(std::isfinite(r) ? static_cast<float>(r + noise(rng))
+                                             : std::numeric_limits<float>::infinity());
+  }
+  return scan;
+}
+
+// A 0.5 m square column seen from 2 to 24 m at every angle (a corner towards the laser, a face,
+// and all between), in 2 * min_sightings scans from a standstill, never enters the state. From
+// afar a single scan has 5 to 8 hits on it, too few to tell its corner from an arc, and some
+// scans pass as round; pooled over the sightings, lines fit them significantly better. A round
+// pillar of the same size at the same places enters nearly every time, so the test is not
+// passed by mapping nothing.
+TEST(EkfSlamTest, ASquareColumnNeverEntersTheState) {
+  std::mt19937_64 rng(11);
+  const EkfSlamOptions options;
+  int views = 0, square_mapped = 0, round_mapped = 0;
+  for (double range = 2.0; range <= 24.0; range += 2.0) {
+    for (double bearing = -1.0; bearing <= 1.0; bearing += 0.5) {
+      for (double yaw = 0.0; yaw < 0.5 * M_PI; yaw += M_PI / 12.0) {
+        const Eigen::Vector2d c(range * std::cos(bearing), range * std::sin(bearing));
+        ++views;
+        for (const bool round : {false, true}) {
+          EkfSlam slam(options);
+          slam.ResetPose(Pose2());
+          for (int scan = 0; scan < 2 * options.min_sightings; ++scan) {
+            slam.Observe(ExtractLandmarks(ColumnScan(c, 0.25, yaw, round, rng), options.extraction),
+                         30.0);
+          }
+          (round ? round_mapped : square_mapped) += slam.landmarks();
+        }
+      }
+    }
+  }
+  EXPECT_EQ(square_mapped, 0) << "of " << views;
+  EXPECT_GE(round_mapped, 0.9 * views) << "of " << views;
 }
 
 TEST(EkfSlamTest, ValidateNamesTheKeys) {

@@ -1,13 +1,60 @@
 #include "slam/fusion/landmark_extraction.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "slam/fusion/circle_fit.h"
+#include "slam/fusion/consistency.h"
 #include "slam/types/check.h"
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
 namespace {
+
+// Running sums of points, from which the total-least-squares line of any run of them and its
+// sum of squared perpendicular distances follow in O(1).
+struct Moments {
+  double n = 0.0, x = 0.0, y = 0.0, xx = 0.0, xy = 0.0, yy = 0.0;
+  void Add(const Eigen::Vector2d& p) {
+    n += 1.0;
+    x += p.x();
+    y += p.y();
+    xx += p.x() * p.x();
+    xy += p.x() * p.y();
+    yy += p.y() * p.y();
+  }
+  Moments Minus(const Moments& o) const {
+    return {n - o.n, x - o.x, y - o.y, xx - o.xx, xy - o.xy, yy - o.yy};
+  }
+  // The smaller eigenvalue of the scatter matrix: the residual of the best line.
+  double LineSse() const {
+    if (n < 2.0) return 0.0;
+    const double a = xx - x * x / n, b = xy - x * y / n, c = yy - y * y / n;
+    return std::max(0.0, 0.5 * (a + c) - std::hypot(0.5 * (a - c), b));
+  }
+};
+
+// The residual of the better of two line models of `hits`, a straight line or a corner (two
+// lines meeting at the best split point), as the one with the smaller unbiased residual variance
+// (squared residuals over the degrees of freedom left: n - 2 for the line, n - 4 for the corner's
+// two lines; the split, a choice among n - 3 places, is not counted, so that five points, the
+// fewest a landmark has, leave the corner one degree of freedom to pool over sightings).
+LinesFit FitLines(const std::vector<Eigen::Vector2d>& hits) {
+  const int n = static_cast<int>(hits.size());
+  std::vector<Moments> prefix(n + 1);
+  for (int i = 0; i < n; ++i) {
+    prefix[i + 1] = prefix[i];
+    prefix[i + 1].Add(hits[i]);
+  }
+  LinesFit best{prefix[n].LineSse(), n - 2};
+  // Each leg has at least two points; the split point belongs to the first.
+  for (int k = 2; n >= 5 && k + 2 <= n; ++k) {
+    const double sse = prefix[k].LineSse() + prefix[n].Minus(prefix[k]).LineSse();
+    if (sse / (n - 4) < best.sse_m2 / best.dof) best = {sse, n - 4};
+  }
+  return best;
+}
 
 // A cluster of hits (laser frame) becomes a landmark when a small circle fits it well.
 void FitCluster(const std::vector<Eigen::Vector2d>& hits, std::size_t first_beam,
@@ -19,6 +66,17 @@ void FitCluster(const std::vector<Eigen::Vector2d>& hits, std::size_t first_beam
   const std::optional<CircleFit> fit = FitCircle(hits);
   if (!fit || fit->radius_m < o.min_radius_m || fit->radius_m > o.max_radius_m ||
       fit->rms_m > o.max_fit_rms_m) {
+    return;
+  }
+  // A corner (a square column's, a car's) or a short wall can fit a small circle under
+  // max_fit_rms_m; lines then fit it to the noise, and the circle's residual variance exceeds
+  // theirs by more than chance allows (an F test at model_test_probability, approximate: the
+  // models are not nested). With few points the test has little power; EkfSlam pools it over a
+  // tentative landmark's sightings (LinesAreBetter).
+  const double circle_sse = fit->rms_m * fit->rms_m * static_cast<double>(hits.size());
+  const LinesFit lines = FitLines(hits);
+  if (LinesAreBetter(circle_sse, static_cast<int>(hits.size()) - 3, lines.sse_m2, lines.dof,
+                     o.model_test_probability)) {
     return;
   }
   // The centre must lie beyond the hits (the laser sees the near side of a convex object): a
@@ -53,12 +111,24 @@ void FitCluster(const std::vector<Eigen::Vector2d>& hits, std::size_t first_beam
   z.covariance(1, 1) += o.bearing_sigma_floor_rad * o.bearing_sigma_floor_rad;
   z.center_m = center;
   z.radius_m = fit->radius_m;
+  z.radius_variance_m2 = fit->radius_variance;
+  z.circle_sse_m2 = circle_sse;
+  z.circle_dof = static_cast<int>(hits.size()) - 3;
+  z.lines = lines;
   z.fit_rms_m = fit->rms_m;
   z.points = static_cast<int>(hits.size());
   out->push_back(z);
 }
 
 }  // namespace
+
+bool LinesAreBetter(double circle_sse_m2, int circle_dof, double lines_sse_m2, int lines_dof,
+                    double probability) {
+  if (circle_dof < 1 || lines_dof < 1) return false;
+  const double circle_variance = circle_sse_m2 / circle_dof;
+  const double lines_variance = lines_sse_m2 / lines_dof;
+  return circle_variance > FQuantile(probability, circle_dof, lines_dof) * lines_variance;
+}
 
 std::vector<std::string> LandmarkExtractionOptions::Validate() const {
   std::vector<std::string> errors;
@@ -74,6 +144,10 @@ std::vector<std::string> LandmarkExtractionOptions::Validate() const {
   }
   if (!(max_fit_rms_m > 0.0))
     errors.push_back(RuleViolation("max_fit_rms_m", max_fit_rms_m, "must be > 0"));
+  if (!(model_test_probability >= 0.5 && model_test_probability < 1.0)) {
+    errors.push_back(
+        RuleViolation("model_test_probability", model_test_probability, "must be in [0.5, 1)"));
+  }
   if (!(range_sigma_floor_m > 0.0)) {
     errors.push_back(RuleViolation("range_sigma_floor_m", range_sigma_floor_m, "must be > 0"));
   }

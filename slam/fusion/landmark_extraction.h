@@ -2,7 +2,8 @@
 // jump (Premebida and Nunes, "Segmentation and geometric primitives extraction from 2D laser
 // range data for mobile robot applications", 2005, Sec. II), and a cluster counts as a landmark
 // when a circle fits it (slam/fusion/circle_fit.h) with a radius in a configured range and a small
-// residual: pillars, posts, table legs. Walls and corners fit no small circle, or fit one badly.
+// residual that beats a line's and a corner's (two lines'): pillars, posts, table legs. Walls fit
+// no small circle; corners (a square column's, a car's) may, but two lines fit them better.
 #pragma once
 
 #include <Eigen/Core>
@@ -22,6 +23,9 @@ struct LandmarkExtractionOptions {
   double min_radius_m = 0.05;  ///< fitted radii outside [min, max] are not landmarks
   double max_radius_m = 0.5;
   double max_fit_rms_m = 0.02;  ///< root mean square distance of the hits to the fitted circle
+  /// A cluster is not round when lines fit it significantly better than the circle: the
+  /// probability of the F test on their residual variances (see LinesAreBetter).
+  double model_test_probability = 0.99;
   /// Added to the fit's range-bearing covariance (what the fit misses: the beam's width, the
   /// arc's bias when the pillar is seen edge-on).
   double range_sigma_floor_m = 0.01;
@@ -40,9 +44,24 @@ void VisitFields(V& v, LandmarkExtractionOptions& o) {
   v("min_radius_m", o.min_radius_m);
   v("max_radius_m", o.max_radius_m);
   v("max_fit_rms_m", o.max_fit_rms_m);
+  v("model_test_probability", o.model_test_probability);
   v("range_sigma_floor_m", o.range_sigma_floor_m);
   v("bearing_sigma_floor_rad", o.bearing_sigma_floor_rad);
 }
+
+/// The residual of a line model of a cluster (a straight line or a corner) and its degrees of
+/// freedom (points less the model's parameters).
+struct LinesFit {
+  double sse_m2 = 0.0;
+  int dof = 0;
+};
+
+/// Whether lines explain hits significantly better than a circle: the circle's residual variance
+/// (sse / dof) exceeds theirs by more than the F(circle_dof, lines_dof) quantile at `probability`.
+/// An F test, approximate (the models are not nested); the residuals of several sightings may be
+/// pooled (sums of sse and of dof).
+bool LinesAreBetter(double circle_sse_m2, int circle_dof, double lines_sse_m2, int lines_dof,
+                    double probability);
 
 /// One round landmark seen in a scan, in base_link (the laser's mount applied).
 struct LandmarkObservation {
@@ -53,6 +72,10 @@ struct LandmarkObservation {
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   Eigen::Vector2d center_m = Eigen::Vector2d::Zero();  ///< the centre in base_link
   double radius_m = 0.0;
+  double radius_variance_m2 = 0.0;  ///< the fit's, from its residuals
+  double circle_sse_m2 = 0.0;       ///< the circle fit's squared residuals
+  int circle_dof = 0;               ///< points less 3
+  LinesFit lines;                   ///< the better line model's
   double fit_rms_m = 0.0;
   int points = 0;  ///< hits in the cluster
 };

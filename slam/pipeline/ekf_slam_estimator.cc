@@ -98,6 +98,7 @@ EstimatorView EkfSlamEstimator::View() const {
 std::map<std::string, double> EkfSlamEstimator::Statistics() const {
   return {{"landmarks", slam_.landmarks()},
           {"tentative_landmarks", slam_.tentative_landmarks()},
+          {"inconsistent_tentatives", slam_.inconsistent_tentatives()},
           {"landmark_observations", observations_},
           {"landmark_pairings", pairings_},
           {"ambiguous_observations", ambiguous_},
