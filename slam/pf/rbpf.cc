@@ -36,7 +36,10 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
                           std::uint64_t seed, bool* failed) const {
   RandomEngine rng(seed);
   const Pose2 predicted = particle.pose * motion;
-  const auto [sigma_xy, sigma_yaw] = MotionSigmas(motion);
+  // Not a structured binding: clang 14 (the fuzz build) refuses one captured by a lambda.
+  const std::pair<double, double> sigmas = MotionSigmas(motion);
+  const double sigma_xy = sigmas.first;
+  const double sigma_yaw = sigmas.second;
   const double scale = options_.observation_scale;
 
   // The climb starts from a draw of the motion model, not from the prediction itself (as the
@@ -130,7 +133,10 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
   // ratio outweighs (a corridor's axis gives equal likelihoods: the odometry wins there).
   const RbpfParticle& best = particles_[best_];
   const Pose2 predicted = best.pose * motion;
-  const auto [sigma_xy, sigma_yaw] = MotionSigmas(motion);
+  // Not a structured binding: clang 14 (the fuzz build) refuses one captured by a lambda.
+  const std::pair<double, double> sigmas = MotionSigmas(motion);
+  const double sigma_xy = sigmas.first;
+  const double sigma_yaw = sigmas.second;
   const double scale = options_.observation_scale;
   const double eps = options_.odometry_failure_probability;
   constexpr double kLog2Pi = 1.8378770664093453;
