@@ -108,22 +108,37 @@ TEST(SweepTest, RefusesResultsOfAnotherSweep) {
   EXPECT_THROW(RunSweep(f.spec, f.options), ConfigError);
 }
 
+// A sweep of two seeds over `parameter` (a YAML entry) and `metrics` (a YAML list's items)
+// whose results.csv is `results`: the summary it writes, and the number of plots.
+struct SummaryRun {
+  int plots = 0;
+  std::string html;
+};
+SummaryRun SummarizeResults(testing::TempDir* dir, const std::string& parameter,
+                            const std::string& metrics, const std::string& results) {
+  dir->Write("scenario.yaml", "name: x\n");
+  const SweepSpec spec =
+      LoadSweepSpec(dir->Write("sweep.yaml", "scenario: scenario.yaml\nseeds: 2\nparameters:\n  " +
+                                                 parameter + "\nmetrics: [" + metrics + "]\n"));
+  std::filesystem::create_directories(dir->File("out"));
+  dir->Write("out/results.csv", results);
+  SummaryRun run;
+  run.plots = WriteSweepSummary(spec, dir->File("out"));
+  std::ifstream in(dir->File("out/summary.html"));
+  run.html.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return run;
+}
+
 // The summary states each grid point's ANEES of a final_nees column with the chi-square region
 // of its number of runs: here 2 runs of a.noise=1 (mean 2.5) and 1 of a.noise=2 (a NaN skipped).
 TEST(SweepTest, SummaryShowsTheAneesWithItsChiSquareBounds) {
   testing::TempDir dir;
-  dir.Write("scenario.yaml", "name: x\n");
-  const SweepSpec spec =
-      LoadSweepSpec(dir.Write("sweep.yaml",
-                              "scenario: scenario.yaml\nseeds: 2\nparameters:\n  a.noise: [1, 2]\n"
-                              "metrics: [ekf.final_nees]\n"));
-  std::filesystem::create_directories(dir.File("out"));
-  dir.Write("out/results.csv",
-            "run,a.noise,seed,status,ekf.final_nees,wall_time_s\n"
-            "r1,1,1,pass,2,1\nr2,1,2,pass,3,1\nr3,2,1,pass,40,1\nr4,2,2,error,,1\n");
-  EXPECT_EQ(WriteSweepSummary(spec, dir.File("out")), 2);  // the metric's plot and the ANEES's
-  std::ifstream in(dir.File("out/summary.html"));
-  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const SummaryRun run =
+      SummarizeResults(&dir, "a.noise: [1, 2]", "ekf.final_nees",
+                       "run,a.noise,seed,status,ekf.final_nees,wall_time_s\n"
+                       "r1,1,1,pass,2,1\nr2,1,2,pass,3,1\nr3,2,1,pass,40,1\nr4,2,2,error,,1\n");
+  EXPECT_EQ(run.plots, 2);  // the metric's plot and the ANEES's
+  const std::string& html = run.html;
   // chi2_6(0.025) / 2 = 1.2373 / 2, chi2_6(0.975) / 2 = 14.4494 / 2; chi2_3: 0.2158, 9.3484.
   EXPECT_THAT(html, ::testing::HasSubstr("<td>a.noise=1</td><td>2</td><td>2.500</td><td>0.619</td>"
                                          "<td>7.225</td><td>inside</td>"));
@@ -137,18 +152,11 @@ TEST(SweepTest, SummaryShowsTheAneesWithItsChiSquareBounds) {
 // against chi2_30(0.025) / 15 = 1.119 and chi2_30(0.975) / 15 = 3.132.
 TEST(SweepTest, SummaryPoolsTheLandmarkAneesOverTheMappedLandmarks) {
   testing::TempDir dir;
-  dir.Write("scenario.yaml", "name: x\n");
-  const SweepSpec spec =
-      LoadSweepSpec(dir.Write("sweep.yaml",
-                              "scenario: scenario.yaml\nseeds: 2\nparameters:\n  a.noise: [1]\n"
-                              "metrics: [s.landmark_anees, s.pillars_mapped]\n"));
-  std::filesystem::create_directories(dir.File("out"));
-  dir.Write("out/results.csv",
-            "run,a.noise,seed,status,s.landmark_anees,s.pillars_mapped,wall_time_s\n"
-            "r1,1,1,pass,2,10,1\nr2,1,2,pass,5,5,1\n");
-  WriteSweepSummary(spec, dir.File("out"));
-  std::ifstream in(dir.File("out/summary.html"));
-  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string html =
+      SummarizeResults(&dir, "a.noise: [1]", "s.landmark_anees, s.pillars_mapped",
+                       "run,a.noise,seed,status,s.landmark_anees,s.pillars_mapped,wall_time_s\n"
+                       "r1,1,1,pass,2,10,1\nr2,1,2,pass,5,5,1\n")
+          .html;
   EXPECT_THAT(html, ::testing::HasSubstr("<td>a.noise=1</td><td>2</td><td>3.000</td><td>1.119</td>"
                                          "<td>3.132</td><td>inside</td>"));
   EXPECT_TRUE(std::filesystem::exists(dir.File("out/summary_anees_s.landmark_anees.png")));

@@ -30,6 +30,24 @@ std::vector<Pose2> TruthAtScans(const testing::SyntheticRun& run) {
   return truth;
 }
 
+// A 181-beam lidar over 270 degrees (1.5 degree steps), as the tests' scans are taken.
+testing::RangeFinderSpec Lidar181() {
+  testing::RangeFinderSpec lidar;
+  lidar.num_beams = 181;
+  lidar.angle_increment_rad = 1.5 * M_PI / 180.0;
+  lidar.angle_min_rad = -M_PI / 2.0 * 1.5;
+  return lidar;
+}
+
+// A 6 m x 4 m room with a desk and a pillar: enough structure for ICP in every direction.
+testing::SegmentWorld RoomWithDeskAndPillar() {
+  testing::SegmentWorld world({});
+  world.AddBox(0.0, 0.0, 6.0, 4.0);
+  world.AddBox(1.0, 2.5, 1.6, 3.1);
+  world.AddBox(4.2, 0.8, 4.6, 1.4);
+  return world;
+}
+
 TEST(GraphSlamTest, ClosesTheOfficeLoopAndBeatsOdometry) {
   testing::SyntheticRunOptions options;
   options.waypoints = testing::OfficeLoop();
@@ -83,10 +101,7 @@ IdenticalRoomsRun RunIdenticalRooms(GraphSlamOptions options) {
     world.AddBox(x0 + 1.0, 2.5, x0 + 1.6, 3.1);  // the same desk in each
     world.AddBox(x0 + 2.8, 0.8, x0 + 3.2, 1.2);  // and the same pillar
   }
-  testing::RangeFinderSpec lidar;
-  lidar.num_beams = 181;
-  lidar.angle_increment_rad = 1.5 * M_PI / 180.0;
-  lidar.angle_min_rad = -M_PI / 2.0 * 1.5;
+  const testing::RangeFinderSpec lidar = Lidar181();
   RandomEngine rng(3);
   // A circle in a room, 40 poses, then (without scans) a jump to the other room.
   std::vector<Pose2> truth;
@@ -152,14 +167,8 @@ TEST(GraphSlamTest, PairwiseConsistencyRejectsAliasedClosuresWithoutTheGate) {
 // fix it (its prior stands, as when ICP falls into a local minimum): the odometry check re-matches
 // the node against the last nodes and repairs the edge; without it the heading error stays.
 TEST(GraphSlamTest, OdometryCheckRepairsAWrongOdometryEdge) {
-  testing::SegmentWorld world({});
-  world.AddBox(0.0, 0.0, 6.0, 4.0);
-  world.AddBox(1.0, 2.5, 1.6, 3.1);
-  world.AddBox(4.2, 0.8, 4.6, 1.4);
-  testing::RangeFinderSpec lidar;
-  lidar.num_beams = 181;
-  lidar.angle_increment_rad = 1.5 * M_PI / 180.0;
-  lidar.angle_min_rad = -M_PI / 2.0 * 1.5;
+  const testing::SegmentWorld world = RoomWithDeskAndPillar();
+  const testing::RangeFinderSpec lidar = Lidar181();
   std::vector<Pose2> truth;
   for (int k = 0; k < 30; ++k) truth.emplace_back(1.0 + 0.13 * k, 1.5, 0.02 * k);
   const int wrong = 15;
@@ -196,14 +205,8 @@ TEST(GraphSlamTest, OdometryCheckRepairsAWrongOdometryEdge) {
 // ICP odometry's match fails there, and the widened check (every heading) at the next node finds
 // the turn; without it the heading error stays.
 TEST(GraphSlamTest, WideOdometryCheckRecoversAMissedTurn) {
-  testing::SegmentWorld world({});
-  world.AddBox(0.0, 0.0, 6.0, 4.0);
-  world.AddBox(1.0, 2.5, 1.6, 3.1);
-  world.AddBox(4.2, 0.8, 4.6, 1.4);
-  testing::RangeFinderSpec lidar;
-  lidar.num_beams = 181;
-  lidar.angle_increment_rad = 1.5 * M_PI / 180.0;
-  lidar.angle_min_rad = -M_PI / 2.0 * 1.5;
+  const testing::SegmentWorld world = RoomWithDeskAndPillar();
+  const testing::RangeFinderSpec lidar = Lidar181();
   constexpr int kTurn = 12;
   constexpr double kTurnRad = 1.2;
   std::vector<Pose2> truth;

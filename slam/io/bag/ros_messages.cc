@@ -353,34 +353,6 @@ RosOdometry DecodeOdometry(std::string_view data) {
   return odometry;
 }
 
-void EncodeTfMessage(const std::vector<RosTransform>& transforms, std::string* out) {
-  CdrWriter w(out);
-  w.Uint32(static_cast<std::uint32_t>(transforms.size()));
-  for (const RosTransform& t : transforms) {
-    WriteHeader(t.time, t.parent_frame, &w);
-    w.String(t.child_frame);
-    w.Float64(t.parent_from_child.x());
-    w.Float64(t.parent_from_child.y());
-    w.Float64(0.0);
-    WriteYawQuaternion(t.parent_from_child.theta(), &w);
-  }
-}
-
-std::vector<RosTransform> DecodeTfMessage(std::string_view data) {
-  CdrReader r(data);
-  // A TransformStamped is at least 8 (stamp) + 4 + 4 (strings) + 56 (transform) bytes.
-  const std::uint32_t n = r.SequenceLength(72);
-  std::vector<RosTransform> transforms(n);
-  for (RosTransform& t : transforms) {
-    t.time = ReadHeader(&r, &t.parent_frame);
-    t.child_frame = r.String();
-    const double x = r.Float64(), y = r.Float64();
-    r.Float64();  // z
-    t.parent_from_child = Pose2(x, y, ReadYawQuaternion(&r));
-  }
-  return transforms;
-}
-
 RosTransform3d RosTransform3d::From(Time time, std::string parent, std::string child,
                                     const Eigen::Isometry3d& t) {
   RosTransform3d out{time, std::move(parent), std::move(child), t.translation(),
@@ -421,6 +393,28 @@ std::vector<RosTransform3d> DecodeTfMessage3d(std::string_view data) {
     for (int i = 0; i < 3; ++i) t.translation[i] = r.Float64();
     const double x = r.Float64(), y = r.Float64(), z = r.Float64(), w = r.Float64();
     t.rotation = Eigen::Quaterniond(w, x, y, z);
+  }
+  return transforms;
+}
+
+// The planar messages are the spatial ones with z = 0 and a yaw quaternion: one encoder and one
+// decoder write and read the bytes, so the two can never disagree.
+void EncodeTfMessage(const std::vector<RosTransform>& transforms, std::string* out) {
+  std::vector<RosTransform3d> spatial;
+  spatial.reserve(transforms.size());
+  for (const RosTransform& t : transforms) spatial.push_back(RosTransform3d::From(t));
+  EncodeTfMessage(spatial, out);
+}
+
+std::vector<RosTransform> DecodeTfMessage(std::string_view data) {
+  const std::vector<RosTransform3d> spatial = DecodeTfMessage3d(data);
+  std::vector<RosTransform> transforms;
+  transforms.reserve(spatial.size());
+  for (const RosTransform3d& t : spatial) {
+    const Eigen::Quaterniond& q = t.rotation;
+    transforms.push_back({t.time, t.parent_frame, t.child_frame,
+                          Pose2(t.translation.x(), t.translation.y(),
+                                YawFromQuaternion(q.x(), q.y(), q.z(), q.w()))});
   }
   return transforms;
 }
