@@ -122,7 +122,7 @@ IdenticalRoomsRun RunIdenticalRooms(GraphSlamOptions options) {
   Pose2 previous = truth[0];
   for (std::size_t i = 0; i < truth.size(); ++i) {
     Pose2 increment = previous.Between(truth[i]);
-    slam.Add(world.Scan(truth[i], Time(static_cast<std::int64_t>(i) * 100'000'000), lidar, &rng),
+    slam.Add(world.Scan(truth[i], Time{static_cast<std::int64_t>(i) * 100'000'000}, lidar, &rng),
              increment);
     previous = truth[i];
   }
@@ -184,7 +184,7 @@ TEST(GraphSlamTest, OdometryCheckRepairsAWrongOdometryEdge) {
     for (std::size_t i = 0; i < truth.size(); ++i) {
       Pose2 increment = i == 0 ? Pose2() : truth[i - 1].Between(truth[i]);
       if (static_cast<int>(i) == wrong) increment = increment * Pose2(0.15, 0.0, 0.25);
-      slam.Add(world.Scan(truth[i], Time(static_cast<std::int64_t>(i) * 100'000'000), lidar, &rng),
+      slam.Add(world.Scan(truth[i], Time{static_cast<std::int64_t>(i) * 100'000'000}, lidar, &rng),
                increment);
     }
     slam.Finish();
@@ -226,7 +226,7 @@ TEST(GraphSlamTest, WideOdometryCheckRecoversAMissedTurn) {
     for (std::size_t i = 0; i < truth.size(); ++i) {
       Pose2 increment = i == 0 ? Pose2() : truth[i - 1].Between(truth[i]);
       if (static_cast<int>(i) == kTurn) increment = increment * Pose2(0.0, 0.0, -kTurnRad);
-      slam.Add(world.Scan(truth[i], Time(static_cast<std::int64_t>(i) * 100'000'000), lidar, &rng),
+      slam.Add(world.Scan(truth[i], Time{static_cast<std::int64_t>(i) * 100'000'000}, lidar, &rng),
                increment);
     }
     slam.Finish();
