@@ -36,7 +36,7 @@ struct ParticleFilterStep {
   int points_used = 0;      ///< scan points used for weighting
   /// The best particle's match quality: its score / (points x the field's maximum), in [0, 1].
   double quality = 0.0;
-  bool lost = false;         ///< the filter is lost: the map is frozen, poses follow odometry
+  bool lost = false;         ///< the filter is lost: the map is frozen, the cloud goes on filtering
   bool relocalised = false;  ///< a global match was confirmed and the cloud put there
 };
 
@@ -81,9 +81,15 @@ class ParticleFilter {
   bool Relocalise(const std::vector<Eigen::Vector2d>& points, const LaserScan& scan,
                   ParticleFilterStep* step);
   void ResumeTracking();
+  // The fraction of `points` seen from `pose` that land on observed map cells.
+  double ObservedFraction(const std::vector<Eigen::Vector2d>& points, const Pose2& pose) const;
   void GiveUpWhenLostTooLong(const LaserScan& scan, ParticleFilterStep* step);
   // The shift search and refinement around `pose` on the (frozen) map.
   ScoredPose LocalMatch(const std::vector<Eigen::Vector2d>& points, const Pose2& pose);
+  // The best pose within slip_radius_m and slip_angle_rad of `pose`, when it fits as a place
+  // must (accept_ratio).
+  std::optional<ScoredPose> NearMatch(const std::vector<Eigen::Vector2d>& points,
+                                      const Pose2& pose);
   std::optional<ScoredPose> GlobalMatch(const std::vector<Eigen::Vector2d>& near,
                                         const std::vector<Eigen::Vector2d>& points);
   std::vector<double> Score(const std::vector<Eigen::Vector2d>& points,
@@ -113,7 +119,9 @@ class ParticleFilter {
   Eigen::Vector2d search_centre_ = Eigen::Vector2d::Zero();
   std::optional<Pose2> candidate_;  // the last global match, carried by the odometry
   int confirmations_ = 0;           // lost updates in a row whose global matches agree
+  int unsupported_updates_ = 0;     // lost updates in a row with no place elsewhere winning
   std::unique_ptr<CorrelativeMatcher> global_matcher_;
+  std::unique_ptr<CorrelativeMatcher> near_matcher_;  // within slip_radius_m of the filter
   int lost_count_ = 0;
   int relocalisation_count_ = 0;
   int resumed_count_ = 0;

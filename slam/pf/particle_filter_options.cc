@@ -36,9 +36,11 @@ std::vector<std::string> RelocalisationOptions::Validate() const {
   positive("confirm_angle_rad", confirm_angle_rad);
   if (!(win_margin >= 0.0)) errors.push_back(Rule("win_margin", win_margin, "must be >= 0"));
   positive("slip_radius_m", slip_radius_m);
+  positive("slip_angle_rad", slip_angle_rad);
   if (confirm_updates < 1) {
     errors.push_back(Rule("confirm_updates", confirm_updates, "must be >= 1"));
   }
+  if (resume_updates < 1) errors.push_back(Rule("resume_updates", resume_updates, "must be >= 1"));
   positive("search_max_range_m", search_max_range_m);
   positive("search_window_m", search_window_m);
   positive("max_lost_s", max_lost_s);
