@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -191,6 +192,43 @@ TEST(CameraRigTest, TextureFolderIsRelativeToTheRobotFile) {
               std::string::npos)
         << e.what();
   }
+}
+
+TEST(CameraRigTest, TextureFolderOnTheCommandLineIsRelativeToTheWorkingDirectory) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(::testing::TempDir()) / "robot_tex_cwd";
+  fs::remove_all(dir);
+  // The robot file in one folder, the textures in a folder beside it, the working directory the
+  // textures' parent: "cwd_textures" exists from the working directory only.
+  fs::create_directories(dir / "robots");
+  testing::WriteSolidPng((dir / "work" / "cwd_textures").string(), "grey.png", {90, 90, 90});
+  const fs::path robot_file = dir / "robots" / "robot.yaml";
+  {
+    std::ifstream in(FindPresetFile("ece276a", "robots"));
+    std::ofstream out(robot_file.string());
+    out << in.rdbuf() << "camera:\n  floor_image: grey.png\n  wall_image: ''\n";
+  }
+  const fs::path cwd = fs::current_path();
+  fs::current_path(dir / "work");
+  const auto parse = [&](const std::string& origin) {
+    YamlNode root = YamlNode::LoadFile(robot_file.string());
+    root.Override("camera.texture_dir", "cwd_textures", origin);
+    return ParseRobotSpec(root);
+  };
+  std::optional<RobotSpec> from_command_line;
+  std::string file_error;
+  try {
+    from_command_line = parse("--set robot.camera.texture_dir=cwd_textures");
+    // Without an origin the override is the file's own, and relative to it: not there.
+    parse("");
+  } catch (const ConfigError& e) {
+    file_error = e.what();
+  }
+  fs::current_path(cwd);
+  ASSERT_TRUE(from_command_line.has_value()) << file_error;
+  EXPECT_EQ(from_command_line->camera->texture_dir, (dir / "work" / "cwd_textures").string());
+  EXPECT_NE(file_error.find((dir / "robots" / "cwd_textures").string()), std::string::npos)
+      << file_error;
 }
 
 TEST(CameraRigTest, TheRobotFileCarriesTheCameraAndWritesItBack) {

@@ -52,6 +52,16 @@ std::string YamlNode::Where() const {
   return path_.empty() ? location : location + ": " + path_;
 }
 
+bool YamlNode::SetOutsideFile() const {
+  for (const std::string& path : usage_->set_outside_file) {
+    if (path_ == path || (path_.size() > path.size() && path_.compare(0, path.size(), path) == 0 &&
+                          (path_[path.size()] == '.' || path_[path.size()] == '['))) {
+      return true;
+    }
+  }
+  return false;
+}
+
 void YamlNode::Fail(const std::string& message) const {
   throw ConfigError(Where() + ": " + message);
 }
@@ -152,7 +162,13 @@ void YamlNode::Override(const std::string& key_path, const std::string& value,
                         const std::string& origin) {
   const std::string label = origin.empty() ? "override " + key_path + "=" + value : origin;
   const std::string where = origin.empty() ? usage_->file + ": " + label + ": " : label + ": ";
-  usage_->overridden[path_.empty() ? key_path : path_ + "." + key_path] = label;
+  const std::string full_path = path_.empty() ? key_path : path_ + "." + key_path;
+  usage_->overridden[full_path] = label;
+  if (origin.empty()) {
+    usage_->set_outside_file.erase(full_path);
+  } else {
+    usage_->set_outside_file.insert(full_path);
+  }
   // Split "a.b[2].c" into steps: names and indices.
   struct Step {
     std::string key;

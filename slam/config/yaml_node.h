@@ -64,6 +64,11 @@ class YamlNode {
   void Override(const std::string& key_path, const std::string& value,
                 const std::string& origin = "");
 
+  /// True when this node's value (or that of a node above it) was set by an Override with an
+  /// `origin` (the command line) rather than read from the file: a relative path in it is
+  /// relative to the working directory, not to file().
+  bool SetOutsideFile() const;
+
   /// Throws a ConfigError for the first map key, anywhere below this node, that was never read.
   void CheckAllKeysUsed() const;
 
@@ -83,6 +88,7 @@ class YamlNode {
     std::string file;
     std::map<std::string, std::set<std::string>> used_keys;  // by node path
     std::map<std::string, std::string> overridden;           // node path -> origin
+    std::set<std::string> set_outside_file;                  // paths overridden with an origin
   };
 
   YamlNode(YAML::Node node, std::string path, std::shared_ptr<Usage> usage)
