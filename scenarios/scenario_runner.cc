@@ -329,6 +329,12 @@ void Finish(Runners& runners, const Pose2& map_from_start, double data_time_s,
       ScoreTextureMetrics(*c.texture, result->truth_metrics["texture_psnr_db"], &c.metrics);
       c.metrics["texture_psnr_anchored_db"] =
           texture->WithPoses(c.estimate).score.psnr_db.value_or(NAN);
+      // Where the loss comes from: the error's slowly varying part (the map's distortion) and its
+      // scan-to-scan jitter, each alone on the true poses; 1 s either side separates them.
+      const auto [slow, jitter] = texture->WithErrorParts(c.estimate, result->truth, 1.0);
+      const double truth_psnr = result->truth_metrics["texture_psnr_db"];
+      c.metrics["texture_psnr_loss_slow_db"] = truth_psnr - slow.score.psnr_db.value_or(NAN);
+      c.metrics["texture_psnr_loss_jitter_db"] = truth_psnr - jitter.score.psnr_db.value_or(NAN);
     }
     result->configs.push_back(std::move(c));
   }

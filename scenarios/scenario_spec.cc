@@ -163,7 +163,9 @@ const std::vector<std::string>& KnownMetrics() {
                                                    "texture_coverage",
                                                    "texture_frames",
                                                    "texture_psnr_loss_db",
-                                                   "texture_psnr_anchored_db"};
+                                                   "texture_psnr_anchored_db",
+                                                   "texture_psnr_loss_slow_db",
+                                                   "texture_psnr_loss_jitter_db"};
   return metrics;
 }
 

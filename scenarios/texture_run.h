@@ -3,6 +3,7 @@
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "slam/texture/texture_map.h"
@@ -22,6 +23,20 @@ struct TextureResult {
   /// The rigid motion applied to the poses before mapping (identity unless aligned).
   Pose2 reference_from_estimate;
 };
+
+/// A trajectory's error against the truth split in two, each part added alone to the true poses
+/// (at the truth's stamps): `slow` carries the centred moving average of the error, the part that
+/// distorts a map built from the poses; `jitter` the rest, the scan-to-scan noise.
+struct PoseErrorParts {
+  Trajectory slow;
+  Trajectory jitter;
+};
+
+/// Splits the error of `estimate` (interpolated at each stamp of `truth`; stamps outside its span
+/// are left out) as (dx, dy) in the map frame and the wrapped heading difference, averaged over
+/// the stamps within `half_window_s` either side. Same frame for both: align `estimate` first.
+PoseErrorParts SplitPoseError(const Trajectory& estimate, const Trajectory& truth,
+                              double half_window_s);
 
 /// The texture side of a scenario run with a camera. Each frame is reduced once to its floor
 /// pixels in base_link (slam::ExtractFloorPixels, independent of the pose), kept with the true
@@ -49,6 +64,12 @@ class TextureRun {
   /// about the map's shape (sim/camera/office_texture_test.cc). With fewer than two pose pairs
   /// there is no alignment and the poses are used as they are.
   TextureResult WithAlignedPoses(const Trajectory& map_from_base, const Trajectory& truth) const;
+
+  /// SplitPoseError of `map_from_base` after WithAlignedPoses' alignment: the maps from the true
+  /// poses plus each part alone, in that order, which say where the texture loss comes from.
+  std::pair<TextureResult, TextureResult> WithErrorParts(const Trajectory& map_from_base,
+                                                         const Trajectory& truth,
+                                                         double half_window_s) const;
 
   const slam::TextureMapOptions& options() const { return options_; }
   /// The true floor texture, r, g, b.

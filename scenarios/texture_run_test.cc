@@ -9,6 +9,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
+#include <random>
+#include <utility>
 
 #include "scenarios/scenario_runner.h"
 #include "scenarios/scenario_spec.h"
@@ -139,6 +142,70 @@ TEST(TextureRunTest, AlignedScoringUndoesARigidMotionButNotADistortion) {
   Trajectory one;
   one.Append(d.truth.poses().front().time, offset * d.truth.poses().front().pose);
   EXPECT_EQ(d.run.WithAlignedPoses(one, d.truth).frames, 1);
+}
+
+TEST(TextureRunTest, SplitPoseErrorSeparatesAnOffsetFromAlternatingNoise) {
+  // 10 s at 10 Hz heading along -x near yaw pi; the estimate is a constant offset plus +-a in x
+  // alternating stamp by stamp, and stops 1 s before the truth does.
+  const Eigen::Vector3d offset(0.02, -0.01, 0.003);
+  const double a = 0.005;
+  Trajectory truth, estimate;
+  for (int k = 0; k <= 100; ++k) {
+    const Time t = Time::FromSeconds(0.1 * k);
+    const Pose2 p(-0.5 * 0.1 * k, 1.0, std::numbers::pi - 0.001);
+    truth.Append(t, p);
+    const double noise = k % 2 == 0 ? a : -a;
+    if (k <= 90) {
+      estimate.Append(t, Pose2(p.x() + offset.x() + noise, p.y() + offset.y(),
+                               p.theta() + offset.z()));  // past pi: wraps to near -pi
+    }
+  }
+  const PoseErrorParts parts = SplitPoseError(estimate, truth, 1.0);
+  ASSERT_EQ(parts.slow.size(), 91u);
+  ASSERT_EQ(parts.jitter.size(), 91u);
+  // Away from the ends the window holds 21 stamps: the alternating noise averages to a / 21.
+  for (std::size_t i = 10; i <= 80; ++i) {
+    const Pose2& t = truth.poses()[i].pose;
+    const Pose2& slow = parts.slow.poses()[i].pose;
+    const Pose2& jitter = parts.jitter.poses()[i].pose;
+    const double noise = i % 2 == 0 ? a : -a;
+    EXPECT_NEAR(slow.x() - t.x(), offset.x() + noise / 21.0, 1e-9) << i;
+    EXPECT_NEAR(slow.y() - t.y(), offset.y(), 1e-9) << i;
+    EXPECT_NEAR(std::remainder(slow.theta() - t.theta(), 2.0 * std::numbers::pi), offset.z(), 1e-9)
+        << i;
+    EXPECT_NEAR(jitter.x() - t.x(), noise * 20.0 / 21.0, 1e-9) << i;
+    EXPECT_NEAR(jitter.y() - t.y(), 0.0, 1e-9) << i;
+    EXPECT_NEAR(std::remainder(jitter.theta() - t.theta(), 2.0 * std::numbers::pi), 0.0, 1e-9) << i;
+  }
+}
+
+TEST(TextureRunTest, ErrorPartsPutADistortionInSlowAndNoiseInJitter) {
+  const LDrive d = DriveAnL();
+  const double truth_db = *d.run.WithTruePoses().score.psnr_db;
+  // A distortion (an error growing to 5 cm along the path) and white noise of 2 cm and 0.3 deg.
+  Trajectory bent, noisy;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> xy(0.0, 0.02), yaw(0.0, 0.005);
+  for (const StampedPose& p : d.truth.poses()) {
+    const double grow = 0.05 * p.time.seconds() / 6.0;
+    bent.Append(p.time, Pose2(p.pose.x() + grow, p.pose.y(), p.pose.theta()));
+    noisy.Append(p.time,
+                 Pose2(p.pose.x() + xy(rng), p.pose.y() + xy(rng), p.pose.theta() + yaw(rng)));
+  }
+  for (const Trajectory* t : {&bent, &noisy}) {
+    const double full = truth_db - *d.run.WithAlignedPoses(*t, d.truth).score.psnr_db;
+    const std::pair<TextureResult, TextureResult> parts = d.run.WithErrorParts(*t, d.truth, 1.0);
+    const double slow = truth_db - *parts.first.score.psnr_db;
+    const double jitter = truth_db - *parts.second.score.psnr_db;
+    std::printf("%s: loss %.2f dB, slow part alone %.2f dB, jitter alone %.2f dB\n",
+                t == &bent ? "distortion" : "noise", full, slow, jitter);
+    EXPECT_GT(full, 1.0);
+    // The part that carries the error carries its loss; the other costs next to nothing.
+    const double carried = t == &bent ? slow : jitter;
+    const double other = t == &bent ? jitter : slow;
+    EXPECT_NEAR(carried, full, 0.25 * full);
+    EXPECT_LT(other, 0.2 * full);
+  }
 }
 
 TEST(TextureRunTest, ACameraThatSeesNoFloorIsOneErrorNamingIt) {
