@@ -158,6 +158,11 @@ struct ParticleFilterOptions {
   /// 0 = always the best particle: the default, because with 0.1 the simulated office's map F1
   /// fell below 0.7 (0.68) and infinite-corridor went 4.96 -> 8.27 m, acapulco (seed 1) 0.081 ->
   /// 0.180 m, while fhw 0.219 -> 0.126, aces 0.930 -> 0.366 and freiburg-079 1.31 -> 1.26 m.
+  /// 0.05 is no safer (seed 1): intel 0.174 -> 0.081 m, aces 0.26, but acapulco 0.164,
+  /// belgioioso 0.191 -> 0.662 and edmonton 0.669 -> 1.579 m. Intel seed 1's 0.174 m is a slow
+  /// heading drift (~0.02 rad) on the first lap's new ground (scans 52-95), closed at scan 96 in
+  /// one update but left in the map, so later passes follow the bent part; no corridor slide
+  /// (weak-to-strong ratios there 0.14-0.89) and no best-particle switch (the mean ends the same).
   double unimodal_radius_m = 0.0;
   double unimodal_yaw_rad = 0.1;
 
