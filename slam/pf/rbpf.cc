@@ -105,7 +105,7 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
     drawn = Pose2(match.pose.x() + d.x(), match.pose.y() + d.y(), match.pose.theta() + d.z());
   }
   particle.pose = drawn;
-  particle.log_weight += log_eta;
+  particle.log_weight += options_.weight_exponent * log_eta;
   particle.path_log_likelihood += log_eta;
   particle.map.InsertScan(scan, drawn);
   particle.history = std::make_shared<RbpfPoseNode>(drawn, std::move(particle.history));
@@ -128,16 +128,18 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
   //  - the odometry failed: the best match anywhere in the window, whose translation density is
   //    eps / window area (yaw still from the Gaussian: the failures this guards against, slip
   //    and a reversal counted as forward motion, are of the translation).
-  // Each is scored by its observation likelihood (observation_scale, as the weights) times that
-  // density. Without a failure the window's best match is the prediction's or one the density
-  // ratio outweighs (a corridor's axis gives equal likelihoods: the odometry wins there).
+  // Each is scored by its tempered observation likelihood (observation_scale times
+  // weight_exponent, as the weights: the beams' evidence is not independent, and counted in full
+  // a slightly better fit elsewhere along a corridor outweighs the odometry) times that density.
+  // Without a failure the window's best match is the prediction's or one the density ratio
+  // outweighs (a corridor's axis gives equal likelihoods: the odometry wins there).
   const RbpfParticle& best = particles_[best_];
   const Pose2 predicted = best.pose * motion;
   // Not a structured binding: clang 14 (the fuzz build) refuses one captured by a lambda.
   const std::pair<double, double> sigmas = MotionSigmas(motion);
   const double sigma_xy = sigmas.first;
   const double sigma_yaw = sigmas.second;
-  const double scale = options_.observation_scale;
+  const double scale = options_.observation_scale * options_.weight_exponent;
   const double eps = options_.odometry_failure_probability;
   constexpr double kLog2Pi = 1.8378770664093453;
   auto log_yaw_density = [&](const Pose2& pose) {

@@ -41,6 +41,9 @@ std::vector<std::string> RbpfOptions::Validate() const {
   Positive("proposal_xy_step_m", proposal_xy_step_m, errors);
   Positive("proposal_yaw_step_rad", proposal_yaw_step_rad, errors);
   Positive("observation_scale", observation_scale, errors);
+  if (!(weight_exponent > 0.0 && weight_exponent <= 1.0)) {
+    errors.push_back(Rule("weight_exponent", weight_exponent, "must be in (0, 1]"));
+  }
   if (!(odometry_failure_probability >= 0.0 && odometry_failure_probability < 1.0)) {
     errors.push_back(
         Rule("odometry_failure_probability", odometry_failure_probability, "must be in [0, 1)"));

@@ -52,6 +52,13 @@ struct RbpfOptions {
   /// p(z | m, x) = exp(observation_scale * log-likelihood): below 1 the beams count as
   /// correlated (GMapping flattens its weights in the same way).
   double observation_scale = 0.2;
+  /// The importance weight is multiplied by eta ^ weight_exponent, not by eta: a tempered weight
+  /// (GMapping flattens its weights in its normalisation, obsSigmaGain). The proposal keeps the
+  /// full observation_scale; the weights, which decide resampling, and the odometry check, which
+  /// weighs the same evidence, are flattened, so that a scan's many correlated beams neither
+  /// deplete the particles nor move them all to a slightly better fit along a corridor.
+  /// 1 = untempered (intel, 100 particles: resampled at 598 of 909 updates, seed 2 0.25 m off).
+  double weight_exponent = 0.25;
 
   /// The odometry check: the odometry model is a mixture, with this probability of a failed
   /// increment (wheel slip, a reversal reported as forward motion, a collision) whose translation
@@ -94,6 +101,7 @@ void VisitFields(V& v, RbpfOptions& o) {
   v("proposal_xy_step_m", o.proposal_xy_step_m);
   v("proposal_yaw_step_rad", o.proposal_yaw_step_rad);
   v("observation_scale", o.observation_scale);
+  v("weight_exponent", o.weight_exponent);
   v("odometry_failure_probability", o.odometry_failure_probability);
   v("odometry_window_per_m", o.odometry_window_per_m);
   v("odometry_window_min_m", o.odometry_window_min_m);

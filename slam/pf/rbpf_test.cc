@@ -81,6 +81,22 @@ TEST(RbpfTest, OdometryCheckFollowsTheScansWhenTheOdometryReversesItsSign) {
   EXPECT_GT(with_check.odometry_rejections, 0);
 }
 
+// Tempered weights (weight_exponent < 1) keep the effective sample size up, so the filter resamples
+// less often and keeps more lineages alive, without losing the track.
+TEST(RbpfTest, TemperedWeightsResampleLessOften) {
+  const ShortRun& run = GetShortRun();
+  RbpfOptions options = FastOptions();
+  options.weight_exponent = 1.0;
+  const RbpfRun full = RunFilter(run.scans, options);
+  options.weight_exponent = 0.25;
+  const RbpfRun tempered = RunFilter(run.scans, options);
+  RecordProperty("resamples_full", std::to_string(full.resamples));
+  RecordProperty("resamples_tempered", std::to_string(tempered.resamples));
+  EXPECT_GT(full.resamples, 0);
+  EXPECT_LT(tempered.resamples, full.resamples * 3 / 4) << "full " << full.resamples;
+  EXPECT_LT(PositionRmse(tempered.online, run.run.truth), 0.1);
+}
+
 TEST(RbpfTest, SameSeedSameTrajectoryWhateverTheThreadCount) {
   const ShortRun& run = GetShortRun();
   const std::vector<SyncedScan> scans(run.scans.begin(), run.scans.begin() + 80);
@@ -101,6 +117,8 @@ TEST(RbpfTest, SameSeedSameTrajectoryWhateverTheThreadCount) {
 TEST(RbpfTest, ParticlesShareTheirPastAndTheirMapTiles) {
   const ShortRun& run = GetShortRun();
   RbpfOptions options = FastOptions();
+  // Untempered weights resample often, so that 120 scans show the sharing clearly.
+  options.weight_exponent = 1.0;
   Rbpf filter(options);
   RbpfStep step;
   for (std::size_t i = 0; i < 120; ++i)
@@ -161,9 +179,11 @@ TEST(RbpfTest, ValidateNamesFieldValueAndRule) {
   options.num_particles = 0;
   options.matcher.kernel_cells = -1;
   options.motion.min_xy_m = 0.0;
+  options.weight_exponent = 0.0;
   EXPECT_THAT(options.Validate(), ::testing::ElementsAre("particles = 0; must be > 0",
                                                          "matcher.kernel_cells = -1; must be >= 0",
-                                                         "motion.min_xy_m = 0; must be > 0"));
+                                                         "motion.min_xy_m = 0; must be > 0",
+                                                         "weight_exponent = 0; must be in (0, 1]"));
   EXPECT_TRUE(RbpfOptions{}.Validate().empty());
 }
 
