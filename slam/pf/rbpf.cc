@@ -128,9 +128,9 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
   //  - the odometry failed: the best match anywhere in the window, whose translation density is
   //    eps / window area (yaw still from the Gaussian: the failures this guards against, slip
   //    and a reversal counted as forward motion, are of the translation).
-  // Each is scored by its tempered observation likelihood (observation_scale times
-  // weight_exponent, as the weights: the beams' evidence is not independent, and counted in full
-  // a slightly better fit elsewhere along a corridor outweighs the odometry) times that density.
+  // Each is scored by its observation likelihood (observation_scale, untempered: tempered like
+  // the weights, the check missed freiburg-079's reversals and ended 4.17 m off) times that
+  // density.
   // Without a failure the window's best match is the prediction's or one the density ratio
   // outweighs (a corridor's axis gives equal likelihoods: the odometry wins there).
   const RbpfParticle& best = particles_[best_];
@@ -139,7 +139,7 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
   const std::pair<double, double> sigmas = MotionSigmas(motion);
   const double sigma_xy = sigmas.first;
   const double sigma_yaw = sigmas.second;
-  const double scale = options_.observation_scale * options_.weight_exponent;
+  const double scale = options_.observation_scale;
   const double eps = options_.odometry_failure_probability;
   constexpr double kLog2Pi = 1.8378770664093453;
   auto log_yaw_density = [&](const Pose2& pose) {
