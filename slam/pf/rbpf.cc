@@ -10,6 +10,7 @@
 #include "slam/pf/rbpf.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -185,11 +186,47 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
   constexpr double kNoPrior = 1e6;
   const ClimbResult far =
       matcher_.Climb(best.map, points, start, PosePrior{predicted, kNoPrior, sigma_yaw});
-  const double log_far = scale * matcher_.Evaluate(best.map, points, far.pose).log_likelihood +
-                         log_far_density + log_yaw_density(far.pose);
+  const Pose2 remapped = RemapDegenerate(best.map, points, near.pose, far.pose);
+  const double log_far = scale * matcher_.Evaluate(best.map, points, remapped).log_likelihood +
+                         log_far_density + log_yaw_density(remapped);
   if (!(log_far > log_near)) return motion;
   *rejected = true;
-  return best.pose.Between(far.pose);
+  return best.pose.Between(remapped);
+}
+
+Pose2 Rbpf::RemapDegenerate(const TiledGrid& map, const std::vector<MatchPoint>& points,
+                            const Pose2& near, const Pose2& far) const {
+  // Solution remapping after Zhang, Kaess, Singh, "On Degeneracy of Optimization-based State
+  // Estimation Problems", ICRA 2016: along a direction where the scan's information (the
+  // translation Hessian of its log-likelihood at the far match) is a small fraction of its
+  // information along the best-determined one, the scan cannot place the robot (a corridor's
+  // axis), so the far match's displacement from the near one is dropped there and the odometry
+  // stands. On intel the check otherwise moved the robot 1.3 m along a corridor whose far end
+  // the scan matched a little better.
+  const double ratio = options_.odometry_degenerate_ratio;
+  if (ratio <= 0.0) return far;
+  const double h = options_.map.resolution_m;
+  auto ll = [&](double dx, double dy) {
+    return matcher_.Evaluate(map, points, Pose2(far.x() + dx, far.y() + dy, far.theta()))
+        .log_likelihood;
+  };
+  const double l0 = ll(0.0, 0.0);
+  Eigen::Matrix2d information;
+  information(0, 0) = -(ll(h, 0.0) - 2.0 * l0 + ll(-h, 0.0)) / (h * h);
+  information(1, 1) = -(ll(0.0, h) - 2.0 * l0 + ll(0.0, -h)) / (h * h);
+  information(0, 1) = information(1, 0) =
+      -(ll(h, h) - ll(h, -h) - ll(-h, h) + ll(-h, -h)) / (4.0 * h * h);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(information);
+  const double strongest = eigen.eigenvalues()(1);
+  // Not a peak at all (the far match is on a slope or a plateau): nothing there to trust.
+  if (!(strongest > 0.0)) return near;
+  const Eigen::Vector2d d(far.x() - near.x(), far.y() - near.y());
+  Eigen::Vector2d kept = Eigen::Vector2d::Zero();
+  for (int k = 0; k < 2; ++k) {
+    const Eigen::Vector2d v = eigen.eigenvectors().col(k);
+    if (eigen.eigenvalues()(k) >= ratio * strongest) kept += v.dot(d) * v;
+  }
+  return Pose2(near.x() + kept.x(), near.y() + kept.y(), far.theta());
 }
 
 void Rbpf::Resample(const std::vector<double>& weights) {

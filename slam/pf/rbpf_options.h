@@ -74,6 +74,11 @@ struct RbpfOptions {
   double odometry_window_per_m = 2.0;
   double odometry_window_min_m = 0.1;
   double odometry_window_step_m = 0.1;  ///< spacing of the window's grid of starting poses
+  /// A direction in which the scan's information at the window's match is below this fraction of
+  /// its information in the best-determined direction is degenerate (a corridor's axis): the
+  /// match's displacement along it is dropped and the odometry kept there (Zhang, Kaess, Singh,
+  /// ICRA 2016, solution remapping). 0 = every direction trusted.
+  double odometry_degenerate_ratio = 0.45;
 
   ResamplingScheme resampling = ResamplingScheme::kSystematic;
   /// Resample when Neff < resample_neff_ratio * num_particles (selective resampling).
@@ -108,6 +113,7 @@ void VisitFields(V& v, RbpfOptions& o) {
   v("odometry_window_per_m", o.odometry_window_per_m);
   v("odometry_window_min_m", o.odometry_window_min_m);
   v("odometry_window_step_m", o.odometry_window_step_m);
+  v("odometry_degenerate_ratio", o.odometry_degenerate_ratio);
   v.Enum("resampling", o.resampling,
          {{ResamplingScheme::kSystematic, "systematic"},
           {ResamplingScheme::kStratified, "stratified"}});
