@@ -92,6 +92,10 @@ class Rbpf {
   /// the mixture model finds that more likely (then `*rejected` is set).
   Pose2 CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& points,
                       bool* rejected) const;
+  /// `far` with its translation from `near` dropped along the directions in which the scan
+  /// cannot place the robot (odometry_degenerate_ratio).
+  Pose2 RemapDegenerate(const TiledGrid& map, const std::vector<MatchPoint>& points,
+                        const Pose2& near, const Pose2& far) const;
   /// The motion model's standard deviations (x, y each; yaw) for an increment.
   std::pair<double, double> MotionSigmas(const Pose2& motion) const;
 

@@ -41,6 +41,9 @@ std::vector<std::string> RbpfOptions::Validate() const {
   Positive("proposal_xy_step_m", proposal_xy_step_m, errors);
   Positive("proposal_yaw_step_rad", proposal_yaw_step_rad, errors);
   Positive("observation_scale", observation_scale, errors);
+  if (!(weight_exponent > 0.0 && weight_exponent <= 1.0)) {
+    errors.push_back(Rule("weight_exponent", weight_exponent, "must be in (0, 1]"));
+  }
   if (!(odometry_failure_probability >= 0.0 && odometry_failure_probability < 1.0)) {
     errors.push_back(
         Rule("odometry_failure_probability", odometry_failure_probability, "must be in [0, 1)"));
@@ -48,6 +51,10 @@ std::vector<std::string> RbpfOptions::Validate() const {
   NonNegative("odometry_window_per_m", odometry_window_per_m, errors);
   Positive("odometry_window_min_m", odometry_window_min_m, errors);
   Positive("odometry_window_step_m", odometry_window_step_m, errors);
+  if (!(odometry_degenerate_ratio >= 0.0 && odometry_degenerate_ratio < 1.0)) {
+    errors.push_back(
+        Rule("odometry_degenerate_ratio", odometry_degenerate_ratio, "must be in [0, 1)"));
+  }
   if (!(resample_neff_ratio >= 0.0 && resample_neff_ratio <= 1.0)) {
     errors.push_back(Rule("resample_neff_ratio", resample_neff_ratio, "must be in [0, 1]"));
   }
