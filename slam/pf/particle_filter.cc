@@ -397,14 +397,7 @@ std::optional<ParticleFilter::ScoredPose> ParticleFilter::GlobalMatch(
   const std::optional<MatchResult> match =
       global_matcher_->Match(near, Pose2(search_centre_.x(), search_centre_.y(), 0.0));
   if (!match) return std::nullopt;
-  // Judge it as the tracking judges itself: refined on the likelihood field, all points.
-  likelihood_field_.Follow(map_);
-  const float field_max = static_cast<float>(likelihood_field_.Score(0.0));
-  const RefineResult refined =
-      refiner_.Refine(likelihood_field_.view(), field_max, points, match->pose);
-  const double quality = Quality(static_cast<float>(refined.score), points.size());
-  if (quality < o.accept_ratio * quality_slow_) return std::nullopt;
-  return ScoredPose{refined.pose, quality};
+  return AcceptedPlace(points, match->pose);
 }
 
 std::optional<ParticleFilter::ScoredPose> ParticleFilter::NearMatch(
@@ -420,12 +413,17 @@ std::optional<ParticleFilter::ScoredPose> ParticleFilter::NearMatch(
   }
   const std::optional<MatchResult> match = near_matcher_->Match(points, pose);
   if (!match) return std::nullopt;
+  return AcceptedPlace(points, match->pose);
+}
+
+std::optional<ParticleFilter::ScoredPose> ParticleFilter::AcceptedPlace(
+    const std::vector<Eigen::Vector2d>& points, const Pose2& pose) {
+  // Judged as the tracking judges itself: refined on the likelihood field, all points.
   likelihood_field_.Follow(map_);
   const float field_max = static_cast<float>(likelihood_field_.Score(0.0));
-  const RefineResult refined =
-      refiner_.Refine(likelihood_field_.view(), field_max, points, match->pose);
+  const RefineResult refined = refiner_.Refine(likelihood_field_.view(), field_max, points, pose);
   const double quality = Quality(static_cast<float>(refined.score), points.size());
-  if (quality < o.accept_ratio * quality_slow_) return std::nullopt;
+  if (quality < options_.relocalisation.accept_ratio * quality_slow_) return std::nullopt;
   return ScoredPose{refined.pose, quality};
 }
 

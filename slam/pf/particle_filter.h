@@ -92,6 +92,10 @@ class ParticleFilter {
                                       const Pose2& pose);
   std::optional<ScoredPose> GlobalMatch(const std::vector<Eigen::Vector2d>& near,
                                         const std::vector<Eigen::Vector2d>& points);
+  // `pose` refined on the likelihood field with all `points`, when it fits as a place must
+  // (accept_ratio x the long-term quality): the judgement of both searches above.
+  std::optional<ScoredPose> AcceptedPlace(const std::vector<Eigen::Vector2d>& points,
+                                          const Pose2& pose);
   std::vector<double> Score(const std::vector<Eigen::Vector2d>& points,
                             const MatchConstraints& constraints, float* best_score);
 
