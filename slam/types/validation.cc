@@ -11,6 +11,7 @@ std::string FormatNumber(double value) {
 }
 
 std::vector<std::string> PrefixErrors(const std::string& prefix, std::vector<std::string> errors) {
+  if (prefix.empty()) return errors;  // the root: keys are already whole paths
   for (auto& e : errors) e = prefix + "." + e;
   return errors;
 }

@@ -21,7 +21,8 @@ std::string RuleViolation(std::string_view field, const T& value, std::string_vi
   return s.str();
 }
 
-/// `prefix` + "." + each of `errors`: the key path of a nested options struct.
+/// `prefix` + "." + each of `errors`: the key path of a nested options struct (an empty prefix,
+/// the root, leaves them as they are).
 std::vector<std::string> PrefixErrors(const std::string& prefix, std::vector<std::string> errors);
 
 /// Appends `more` to `*errors`.
