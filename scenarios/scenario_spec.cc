@@ -452,7 +452,10 @@ ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string
         for (const std::string& key : o->Keys()) {
           const YamlNode value = o->Required(key);
           if (!value.IsScalar()) value.Fail("override values must be scalars");
-          (section[0] == 'w' ? world : robot).Override(key, value.As<std::string>());
+          // Located and resolved (a relative path) by the scenario file that says it.
+          (section[0] == 'w' ? world : robot)
+              .Override(key, value.As<std::string>(), value.Where(),
+                        std::filesystem::path(path).parent_path().string());
         }
       }
     }

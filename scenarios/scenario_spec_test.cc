@@ -58,5 +58,27 @@ TEST(ScenarioSpecTest, BadTopicNamesNameFileLineAndKey) {
   EXPECT_NE(not_map.find("topics is a map"), std::string::npos) << not_map;
 }
 
+// A path in a scenario's robot_overrides is relative to the scenario file, and errors about it
+// name the scenario's line, not the robot file's.
+TEST(ScenarioSpecTest, RobotOverridePathsAreRelativeToTheScenario) {
+  const std::string dir = (std::filesystem::path(testing::TempDir()) / "spec_override_path")
+                              .lexically_normal()
+                              .string();
+  std::filesystem::create_directories(dir + "/tex");
+  const auto write = [&](const std::string& texture_dir) {
+    const std::string path = dir + "/s.yaml";
+    std::ofstream(path) << "name: cam\nworld: office\nrobot: ece276a\n"
+                        << "robot_overrides: {camera.texture_dir: " << texture_dir << "}\n"
+                        << "slam:\n  dr: {algorithm: dead-reckoning}\n";
+    return path;
+  };
+  const ScenarioSpec spec = LoadScenario(write("tex"));
+  ASSERT_TRUE(spec.simulated && spec.simulated->options.robot.camera);
+  EXPECT_EQ(spec.simulated->options.robot.camera->texture_dir, dir + "/tex");
+  const std::string missing = ErrorOf(write("nope"));
+  EXPECT_NE(missing.find("s.yaml:4:"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("no such folder '" + dir + "/nope'"), std::string::npos) << missing;
+}
+
 }  // namespace
 }  // namespace slamrig::scenario

@@ -177,17 +177,13 @@ RobotSpec ParseRobotSpec(const YamlNode& node) {
   RobotSpec spec;
   FieldReader reader(node);
   VisitFields(reader, spec);
-  // The camera's texture folder, like a world's map file, is relative to the file naming it; one
-  // given on the command line (--set robot.camera.texture_dir=...) is relative to the working
-  // directory, as any path typed there is.
+  // The camera's texture folder, like a world's map file, is relative to the file naming it: the
+  // robot file, the scenario whose robot_overrides set it, or the working directory for
+  // --set robot.camera.texture_dir=... on the command line.
   if (spec.camera && !spec.camera->texture_dir.empty()) {
     namespace fs = std::filesystem;
     const YamlNode dir_node = node.Required("camera").Required("texture_dir");
-    fs::path dir(spec.camera->texture_dir);
-    if (dir.is_relative() && !node.file().empty() && !dir_node.SetOutsideFile()) {
-      dir = fs::path(node.file()).parent_path() / dir;
-    }
-    spec.camera->texture_dir = fs::absolute(dir).lexically_normal().string();
+    spec.camera->texture_dir = dir_node.ResolvePath(spec.camera->texture_dir);
     std::error_code error;
     if (!fs::is_directory(spec.camera->texture_dir, error)) {
       dir_node.Fail("no such folder '" + spec.camera->texture_dir + "'");

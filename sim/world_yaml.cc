@@ -114,9 +114,8 @@ WorldSpec ParseWorldSpec(const YamlNode& node) {
   if (spec.map) {
     const YamlNode map_node = node.Required("map");
     namespace fs = std::filesystem;
-    fs::path map_path(spec.map->yaml_path);
-    if (map_path.is_relative()) map_path = fs::path(node.file()).parent_path() / map_path;
-    spec.map->yaml_path = std::filesystem::absolute(map_path).lexically_normal().string();
+    spec.map->yaml_path = map_node.Required("yaml_path").ResolvePath(spec.map->yaml_path);
+    const fs::path map_path(spec.map->yaml_path);
     std::error_code error;  // e.g. a name too long for the OS: no such file either
     if (!fs::exists(map_path, error)) {
       map_node.Required("yaml_path").Fail("no such map file '" + spec.map->yaml_path + "'");

@@ -52,14 +52,30 @@ std::string YamlNode::Where() const {
   return path_.empty() ? location : location + ": " + path_;
 }
 
-bool YamlNode::SetOutsideFile() const {
-  for (const std::string& path : usage_->set_outside_file) {
-    if (path_ == path || (path_.size() > path.size() && path_.compare(0, path.size(), path) == 0 &&
-                          (path_[path.size()] == '.' || path_[path.size()] == '['))) {
-      return true;
+std::string YamlNode::ResolvePath(const std::string& text) const {
+  namespace fs = std::filesystem;
+  fs::path path(text);
+  if (path.is_relative()) {
+    // The innermost override that set this node (or a node above it) decides; else the file.
+    const std::string* base = nullptr;
+    std::size_t matched = 0;
+    for (const auto& [set_path, dir] : usage_->path_base) {
+      const bool covers =
+          path_ == set_path ||
+          (path_.size() > set_path.size() && path_.compare(0, set_path.size(), set_path) == 0 &&
+           (path_[set_path.size()] == '.' || path_[set_path.size()] == '['));
+      if (covers && (base == nullptr || set_path.size() > matched)) {
+        base = &dir;
+        matched = set_path.size();
+      }
+    }
+    if (base != nullptr) {
+      if (!base->empty()) path = fs::path(*base) / path;
+    } else if (!usage_->file.empty()) {
+      path = fs::path(usage_->file).parent_path() / path;
     }
   }
-  return false;
+  return fs::absolute(path).lexically_normal().string();
 }
 
 void YamlNode::Fail(const std::string& message) const {
@@ -159,15 +175,15 @@ template double YamlNode::As<double>() const;
 template std::string YamlNode::As<std::string>() const;
 
 void YamlNode::Override(const std::string& key_path, const std::string& value,
-                        const std::string& origin) {
+                        const std::string& origin, const std::string& base_dir) {
   const std::string label = origin.empty() ? "override " + key_path + "=" + value : origin;
   const std::string where = origin.empty() ? usage_->file + ": " + label + ": " : label + ": ";
   const std::string full_path = path_.empty() ? key_path : path_ + "." + key_path;
   usage_->overridden[full_path] = label;
   if (origin.empty()) {
-    usage_->set_outside_file.erase(full_path);
+    usage_->path_base.erase(full_path);
   } else {
-    usage_->set_outside_file.insert(full_path);
+    usage_->path_base[full_path] = base_dir;
   }
   // Split "a.b[2].c" into steps: names and indices.
   struct Step {

@@ -57,17 +57,19 @@ class YamlNode {
   }
 
   /// Sets the value at dotted `key_path` (`slam.pf.num_particles`, `drive.waypoints[2]`) to the
-  /// YAML text `value`, creating missing map keys: command-line overrides of a file. A path
-  /// through a scalar, or an index past a list's end, is a ConfigError naming the path.
-  /// `origin` names where the override came from (e.g. "--set slam.pf.particles=0"): errors
-  /// about the new value, or anything below it, name it instead of a line of the file.
+  /// YAML text `value`, creating missing map keys: overrides of a file from the command line or
+  /// from another file. A path through a scalar, or an index past a list's end, is a ConfigError
+  /// naming the path. `origin` names where the override came from (e.g. "--set
+  /// slam.pf.particles=0", or a scenario's "scenario.yaml:5:18: robot_overrides.x"): errors about
+  /// the new value, or anything below it, name it instead of a line of this file. A relative path
+  /// in an override with an origin is relative to `base_dir` (empty: the working directory, as
+  /// for anything typed on the command line).
   void Override(const std::string& key_path, const std::string& value,
-                const std::string& origin = "");
+                const std::string& origin = "", const std::string& base_dir = "");
 
-  /// True when this node's value (or that of a node above it) was set by an Override with an
-  /// `origin` (the command line) rather than read from the file: a relative path in it is
-  /// relative to the working directory, not to file().
-  bool SetOutsideFile() const;
+  /// `text`, a path this node holds, made absolute: relative to the folder of the file it was
+  /// read from, or to the base_dir of the Override that set it (or a node above it).
+  std::string ResolvePath(const std::string& text) const;
 
   /// Throws a ConfigError for the first map key, anywhere below this node, that was never read.
   void CheckAllKeysUsed() const;
@@ -88,7 +90,8 @@ class YamlNode {
     std::string file;
     std::map<std::string, std::set<std::string>> used_keys;  // by node path
     std::map<std::string, std::string> overridden;           // node path -> origin
-    std::set<std::string> set_outside_file;                  // paths overridden with an origin
+    // Paths overridden with an origin -> the folder relative paths in them are relative to.
+    std::map<std::string, std::string> path_base;
   };
 
   YamlNode(YAML::Node node, std::string path, std::shared_ptr<Usage> usage)

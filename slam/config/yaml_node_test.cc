@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 namespace slamrig {
 namespace {
 
@@ -85,6 +87,26 @@ TEST(YamlNodeTest, ErrorsAboutOverriddenValuesNameTheOverride) {
   EXPECT_EQ(ErrorOf([&] { root.Required("a").Get<int>("b"); }).substr(0, 17), "--set a.b=x: a.b:");
   root.Required("a").Required("b");
   EXPECT_EQ(ErrorOf([&] { root.CheckAllKeysUsed(); }), "--set c.d=2: c: unknown key");
+}
+
+TEST(YamlNodeTest, RelativePathsAreRelativeToWhoeverSaidThem) {
+  namespace fs = std::filesystem;
+  YamlNode root =
+      YamlNode::LoadString("own: tex\ncam: {dir: a, sub: {dir: b}}\n", "/data/robots/r.yaml");
+  root.Override("cam.dir", "from_cli", "--set cam.dir=from_cli");
+  root.Override("cam.sub", "{dir: from_scenario}", "s.yaml:3:9: robot_overrides.cam.sub",
+                "/data/scenarios");
+  root.Override("plain", "p");  // no origin: the file's own
+  EXPECT_EQ(root.Required("own").ResolvePath("tex"), "/data/robots/tex");
+  EXPECT_EQ(root.Required("plain").ResolvePath("p"), "/data/robots/p");
+  EXPECT_EQ(root.Required("cam").Required("dir").ResolvePath("from_cli"),
+            (fs::current_path() / "from_cli").lexically_normal().string());
+  // The innermost override decides; ".." and absolute paths are kept as written.
+  const YamlNode sub = root.Required("cam").Required("sub").Required("dir");
+  EXPECT_EQ(sub.ResolvePath("../textures"), "/data/textures");
+  EXPECT_EQ(sub.ResolvePath("/abs/t"), "/abs/t");
+  EXPECT_THAT(ErrorOf([&] { sub.Fail("no such folder"); }),
+              HasSubstr("s.yaml:3:9: robot_overrides.cam.sub: cam.sub.dir: no such folder"));
 }
 
 }  // namespace
