@@ -128,14 +128,14 @@ TEST(CliTest, BadFlagsFailWithUsageError) {
   // A broken rule about a value from the command line names the flag that set it, for every
   // algorithm's own options.
   for (const char* algorithm : {"pf", "rbpf"}) {
-    run = RunCommand(Slamrig("slam " + log + " --algorithm " + algorithm +
-                             " --particles 0 --out " + dir.File("o")));
+    run = RunCommand(Slamrig("slam " + log + " --algorithm " + algorithm + " --particles 0 --out " +
+                             dir.File("o")));
     EXPECT_EQ(run.exit_code, 2) << algorithm;
     EXPECT_THAT(run.output, StartsWith("slamrig: error: --particles 0: particles = 0; must be > 0"))
         << algorithm;
   }
-  run = RunCommand(Slamrig("slam " + log + " --algorithm rbpf --set weight_exponent=3 --out " +
-                           dir.File("o")));
+  run = RunCommand(
+      Slamrig("slam " + log + " --algorithm rbpf --set weight_exponent=3 --out " + dir.File("o")));
   EXPECT_THAT(run.output, HasSubstr("--set weight_exponent=3: weight_exponent = 3; must be in"));
   EXPECT_FALSE(std::filesystem::exists(dir.File("o")));
 }
