@@ -92,6 +92,7 @@ TEST(OdometryCalibrationTest, CorrectionIsAConstantTurnRateAlongTheStep) {
   // A fitted drift a turns a straight step of length d into the chord of an arc of angle a d:
   // heading + a d, the translation turned by half of it.
   OdometryCalibrationOptions o = Enabled();
+  o.min_significance = 0.0;  // one observation has no scatter to judge by
   o.prior_m = 1e-9;
   o.memory_m = 1e9;
   OdometryCalibration c(o);
@@ -110,6 +111,49 @@ TEST(OdometryCalibrationTest, CorrectionIsAConstantTurnRateAlongTheStep) {
   EXPECT_NEAR(quarters.theta(), whole.theta(), 1e-12);
   EXPECT_NEAR(quarters.x(), whole.x(), 1e-3);
   EXPECT_NEAR(quarters.y(), whole.y(), 1e-3);
+}
+
+// The standard error is the spread the fit really has: over many independent runs of the same
+// noisy drive, the fits scatter by about the standard error each run reports.
+TEST(OdometryCalibrationTest, StandardErrorMatchesTheSpreadOverRuns) {
+  OdometryCalibrationOptions o = Enabled();
+  RandomEngine rng(11);
+  const double drift = 0.02, noise = 0.015;
+  double sum = 0.0, sum_sq = 0.0, sum_se = 0.0;
+  const int runs = 400;
+  for (int r = 0; r < runs; ++r) {
+    OdometryCalibration c(o);
+    for (int i = 0; i < 300; ++i) {
+      const double d = 0.25 + 0.1 * Uniform01(rng);
+      c.Observe(Pose2(d, 0.0, 0.0), Pose2(d, 0.0, drift * d + noise * StandardNormal(rng)));
+    }
+    sum += c.drift_rad_per_m();
+    sum_sq += c.drift_rad_per_m() * c.drift_rad_per_m();
+    sum_se += c.standard_error_rad_per_m();
+  }
+  const double mean = sum / runs;
+  const double spread = std::sqrt(sum_sq / runs - mean * mean);
+  EXPECT_NEAR(sum_se / runs, spread, 0.15 * spread);
+}
+
+// A drift well clear of its standard error is applied; the matcher's noise about zero is not.
+TEST(OdometryCalibrationTest, OnlyASignificantDriftIsApplied) {
+  const OdometryCalibrationOptions o = Enabled();
+  RandomEngine rng(3);
+  OdometryCalibration none(o), some(o);
+  for (int i = 0; i < 400; ++i) {
+    const double d = 0.25;
+    const double n = 0.015 * StandardNormal(rng);
+    none.Observe(Pose2(d, 0.0, 0.0), Pose2(d, 0.0, n));
+    some.Observe(Pose2(d, 0.0, 0.0), Pose2(d, 0.0, 0.05 * d + n));
+  }
+  EXPECT_NE(none.drift_rad_per_m(), 0.0);
+  EXPECT_LT(std::abs(none.drift_rad_per_m()), 3.0 * none.standard_error_rad_per_m());
+  EXPECT_EQ(none.applied_drift_rad_per_m(), 0.0);
+  EXPECT_EQ(none.Correct(Pose2(0.25, 0.0, 0.0)).theta(), 0.0);
+  EXPECT_GT(some.drift_rad_per_m(), 10.0 * some.standard_error_rad_per_m());
+  EXPECT_EQ(some.applied_drift_rad_per_m(), some.drift_rad_per_m());
+  EXPECT_NEAR(some.Correct(Pose2(0.25, 0.0, 0.0)).theta(), 0.25 * some.drift_rad_per_m(), 1e-12);
 }
 
 }  // namespace
