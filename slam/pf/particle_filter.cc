@@ -48,7 +48,8 @@ ParticleFilter::ParticleFilter(const ParticleFilterOptions& options)
       likelihood_field_(options.likelihood_field),
       occupied_mask_(options.correlation.occupied_threshold),
       refiner_(options.refiner),
-      rng_(options.seed) {
+      rng_(options.seed),
+      calibration_(options.odometry_calibration) {
   SLAMRIG_CHECK(options_.Validate().empty(), "invalid ParticleFilterOptions");
   if (options_.num_threads > 1) pool_ = std::make_unique<ThreadPool>(options_.num_threads);
   const int n = options_.num_particles;
@@ -445,14 +446,17 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
       std::abs(pending_motion_.theta()) >= options_.min_update_angle_rad;
   if (!moved_enough) {
     step = last_step_;
-    step.best_pose = last_step_.best_pose * pending_motion_;
-    step.mean_pose = last_step_.mean_pose * pending_motion_;
+    const Pose2 motion = calibration_.Correct(pending_motion_);
+    step.best_pose = last_step_.best_pose * motion;
+    step.mean_pose = last_step_.mean_pose * motion;
     step.resampled = false;
     step.updated = false;
     return step;
   }
-  Predict(pending_motion_);
-  if (candidate_) candidate_ = *candidate_ * pending_motion_;
+  const Pose2 raw_motion = pending_motion_;
+  const Pose2 motion = calibration_.Correct(raw_motion);
+  Predict(motion);
+  if (candidate_) candidate_ = *candidate_ * motion;
   pending_motion_ = Pose2();
   step.updated = true;
 
@@ -530,6 +534,12 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
     std::fill(log_weights_.begin(), log_weights_.end(), 0.0);
     step.resampled = true;
     ++resample_count_;
+  }
+  // The calibration learns from updates that tracked on both ends: a loss, a relocalisation or a
+  // slip correction moves the estimate by more than the odometry's error.
+  if (!points.empty() && !step.lost && !step.relocalised && !last_step_.lost &&
+      !last_step_.relocalised) {
+    calibration_.Observe(raw_motion, last_step_.best_pose.Inverse() * step.best_pose);
   }
   last_step_ = step;
   return step;

@@ -9,6 +9,7 @@
 #include "slam/matching/likelihood_field.h"
 #include "slam/matching/map_correlator.h"
 #include "slam/matching/scan_refiner.h"
+#include "slam/pf/odometry_calibration.h"
 #include "slam/pf/particle_filter_options.h"
 #include "slam/pf/solution_remapping.h"
 #include "slam/pf/thread_pool.h"
@@ -64,6 +65,8 @@ class ParticleFilter {
   int relocalisation_count() const { return relocalisation_count_; }
   /// Lost alarms that ended with the tracked hypothesis matching well again (no relocalisation).
   int resumed_count() const { return resumed_count_; }
+  /// The odometry's heading drift fitted so far (OdometryCalibrationOptions), rad per metre.
+  double odometry_drift_rad_per_m() const { return calibration_.drift_rad_per_m(); }
 
  private:
   void Predict(const Pose2& odometry_increment);
@@ -111,6 +114,7 @@ class ParticleFilter {
   std::vector<double> log_weights_;
   bool started_ = false;
   Pose2 pending_motion_;  // odometry since the last update
+  OdometryCalibration calibration_;
   ParticleFilterStep last_step_;
   int resample_count_ = 0;
   // Lost-filter detection (augmented MCL's averages) and relocalisation.

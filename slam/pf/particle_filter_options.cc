@@ -111,6 +111,7 @@ std::vector<std::string> ParticleFilterOptions::Validate() const {
   }
   if (num_threads < 1) errors.push_back(Rule("threads", num_threads, "must be >= 1"));
   Prefixed("rot_trans_rot", rot_trans_rot.Validate(), errors);
+  Prefixed("odometry_calibration", odometry_calibration.Validate(), errors);
   Prefixed("points", points.Validate(), errors);
   Prefixed("correlation", correlation.Validate(), errors);
   Prefixed("likelihood_field", likelihood_field.Validate(), errors);

@@ -10,6 +10,7 @@
 #include "slam/matching/scan_points.h"
 #include "slam/matching/scan_refiner.h"
 #include "slam/odometry/rot_trans_rot_model.h"
+#include "slam/pf/odometry_calibration.h"
 #include "slam/pf/resampling.h"
 
 namespace slamrig::slam {
@@ -124,6 +125,8 @@ struct ParticleFilterOptions {
   double sigma_xy_m = 0.01;      ///< kGaussianPerStep: per step, x and y (world frame)
   double sigma_yaw_rad = 0.005;  ///< kGaussianPerStep: per step, yaw
   RotTransRotNoise rot_trans_rot{0.02, 0.01, 0.01, 0.0005, 0.005, 0.003};  ///< kRotTransRot
+  /// The odometry's heading drift per metre, fitted online and taken out of the prediction.
+  OdometryCalibrationOptions odometry_calibration;
 
   ObservationModel observation = ObservationModel::kLikelihoodField;
   ScanPointsOptions points{0.1, 30.0, 1, 0.05};  ///< beams used for weighting (voxel-filtered)
@@ -205,6 +208,7 @@ void VisitFields(V& v, ParticleFilterOptions& o) {
   v("sigma_xy_m", o.sigma_xy_m);
   v("sigma_yaw_rad", o.sigma_yaw_rad);
   v.Struct("rot_trans_rot", o.rot_trans_rot);
+  v.Struct("odometry_calibration", o.odometry_calibration);
   v.Enum("observation", o.observation,
          {{ObservationModel::kMapCorrelation, "correlation"},
           {ObservationModel::kLikelihoodField, "likelihood_field"}});

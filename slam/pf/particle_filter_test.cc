@@ -311,3 +311,35 @@ TEST(ParticleFilterTest, WeightedMeanAveragesYawOnTheCircle) {
 
 }  // namespace
 }  // namespace slamrig::slam
+
+namespace slamrig::slam {
+namespace {
+
+// The synthetic robot's wheels are miscalibrated (testing::ShortOfficeRun): the odometry's heading
+// error per metre, measured against the truth, is what the online calibration must find from the
+// filter's own corrections.
+TEST(ParticleFilterTest, OdometryCalibrationFindsTheWheelsHeadingDrift) {
+  const ShortRun& run = GetShortRun();
+  ASSERT_EQ(run.scans.size(), run.run.truth.size());
+  double sum_error = 0.0, sum_distance = 0.0;
+  for (std::size_t i = 1; i < run.scans.size(); ++i) {
+    const Pose2 truth =
+        run.run.truth[i - 1].map_from_base.Inverse() * run.run.truth[i].map_from_base;
+    sum_error += NormalizeAngle(truth.theta() - run.scans[i].increment.theta());
+    sum_distance += run.scans[i].increment.translation().norm();
+  }
+  const double true_drift = sum_error / sum_distance;
+  ASSERT_GT(std::abs(true_drift), 0.005) << "the run's odometry should drift";
+  ParticleFilterOptions options = FastOptions();
+  options.odometry_calibration.enabled = true;
+  options.odometry_calibration.memory_m = 1e6;  // the whole run, as the truth's ratio above
+  options.odometry_calibration.prior_m = 0.5;
+  ParticleFilter filter(options);
+  for (const SyncedScan& s : run.scans) filter.AddScan(s.scan, s.increment);
+  RecordProperty("true_drift_rad_per_m", std::to_string(true_drift));
+  RecordProperty("fitted_drift_rad_per_m", std::to_string(filter.odometry_drift_rad_per_m()));
+  EXPECT_NEAR(filter.odometry_drift_rad_per_m(), true_drift, 0.25 * std::abs(true_drift));
+}
+
+}  // namespace
+}  // namespace slamrig::slam
