@@ -64,13 +64,18 @@ void TiledGrid::EnsureCells(const Eigen::Array2i& lo, const Eigen::Array2i& hi) 
   const int h = y1 - y0 + 1;
   SLAMRIG_CHECK(static_cast<double>(w) * h < 1e8, "tiled grid too large");
   std::vector<std::shared_ptr<Tile>> grown(static_cast<std::size_t>(w) * h);
+  std::vector<std::shared_ptr<HitTile>> grown_hits(record_hit_means_ ? grown.size() : 0);
   for (int row = 0; row < tiles_h_; ++row) {
     for (int col = 0; col < tiles_w_; ++col) {
-      grown[static_cast<std::size_t>(row + tile_y0_ - y0) * w + (col + tile_x0_ - x0)] =
-          std::move(tiles_[static_cast<std::size_t>(row) * tiles_w_ + col]);
+      const std::size_t to =
+          static_cast<std::size_t>(row + tile_y0_ - y0) * w + (col + tile_x0_ - x0);
+      const std::size_t from = static_cast<std::size_t>(row) * tiles_w_ + col;
+      grown[to] = std::move(tiles_[from]);
+      if (record_hit_means_) grown_hits[to] = std::move(hit_tiles_[from]);
     }
   }
   tiles_ = std::move(grown);
+  hit_tiles_ = std::move(grown_hits);
   tile_x0_ = x0;
   tile_y0_ = y0;
   tiles_w_ = w;
@@ -87,6 +92,23 @@ TiledGrid::Tile& TiledGrid::MutableTile(int tx, int ty) {
     // Shared with another grid: this grid takes its own copy. Only grid copies raise the count and
     // they never overlap a write, so a count of 1 read here cannot be stale.
     slot = std::make_shared<Tile>(*slot);
+  }
+  return *slot;
+}
+
+void TiledGrid::RecordHitMeans(bool record) {
+  SLAMRIG_CHECK(num_tiles() == 0, "TiledGrid::RecordHitMeans on a grid already written");
+  record_hit_means_ = record;
+  hit_tiles_.assign(record ? tiles_.size() : 0, nullptr);
+}
+
+TiledGrid::HitTile& TiledGrid::MutableHitTile(int tx, int ty) {
+  std::shared_ptr<HitTile>& slot =
+      hit_tiles_[static_cast<std::size_t>(ty - tile_y0_) * tiles_w_ + (tx - tile_x0_)];
+  if (!slot) {
+    slot = std::make_shared<HitTile>();
+  } else if (slot.use_count() > 1) {
+    slot = std::make_shared<HitTile>(*slot);  // as MutableTile: shared only by copies of grids
   }
   return *slot;
 }
@@ -150,6 +172,16 @@ int TiledGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_base) {
     if (!hit) continue;
     const Eigen::Array2i cell = WorldToCell(end);
     ++hits;
+    if (record_hit_means_) {
+      // Every hit counts, also one that update_once_per_scan keeps from the log-odds: the mean
+      // is of where the wall was seen.
+      HitMean& m =
+          MutableHitTile(cell.x() >> kTileBits, cell.y() >> kTileBits)[Offset(cell.x(), cell.y())];
+      const Eigen::Vector2d offset = end - CellCenter(cell);
+      m.count += 1.0f;
+      m.dx += (static_cast<float>(offset.x()) - m.dx) / m.count;
+      m.dy += (static_cast<float>(offset.y()) - m.dy) / m.count;
+    }
     std::uint32_t& stamp = stamps.At(cell.x(), cell.y());
     if (once && stamp == now) continue;
     stamp = now;

@@ -28,6 +28,15 @@ class TiledGrid {
   static constexpr int kTileBits = 6;
   static constexpr int kTileSize = 1 << kTileBits;  ///< cells per tile side
   using Tile = std::array<float, kTileSize * kTileSize>;
+  /// Where in a cell its scan end points fell: their mean as an offset from the cell's centre, and
+  /// how many there were (GMapping's PointAccumulator). A matcher that measures distances to the
+  /// mean, not to the centre, sees a wall where it was observed instead of on the cell lattice.
+  struct HitMean {
+    float dx = 0.0f;
+    float dy = 0.0f;
+    float count = 0.0f;
+  };
+  using HitTile = std::array<HitMean, kTileSize * kTileSize>;
 
   /// An empty grid on the lattice whose cell (0, 0) has its lower-left corner at `origin`.
   explicit TiledGrid(const OccupancyGridOptions& options,
@@ -62,6 +71,25 @@ class TiledGrid {
     if (col < 0 || row < 0 || col >= tiles_w_ || row >= tiles_h_) return nullptr;
     return tiles_[static_cast<std::size_t>(row) * tiles_w_ + col].get();
   }
+  /// Makes InsertScan record every hit's position in its cell (HitMean); call it on an empty grid.
+  /// Copies share these tiles as they share the log-odds ones. Off by default.
+  void RecordHitMeans(bool record);
+  bool records_hit_means() const { return record_hit_means_; }
+  /// The hit means of tile (tx, ty), laid out as FindTile's cells; null where none was recorded.
+  const HitTile* FindHitTile(int tx, int ty) const {
+    const int col = tx - tile_x0_;
+    const int row = ty - tile_y0_;
+    if (!record_hit_means_ || col < 0 || row < 0 || col >= tiles_w_ || row >= tiles_h_) {
+      return nullptr;
+    }
+    return hit_tiles_[static_cast<std::size_t>(row) * tiles_w_ + col].get();
+  }
+  /// The hit mean of cell (ix, iy); zero offset and count where none was recorded.
+  HitMean HitMeanAt(int ix, int iy) const {
+    const HitTile* tile = FindHitTile(ix >> kTileBits, iy >> kTileBits);
+    return tile ? (*tile)[Offset(ix, iy)] : HitMean{};
+  }
+
   /// Adds `delta` to `cell` with OccupancyGrid::Update's clamping (copying its tile if shared).
   void Update(const Eigen::Array2i& cell, float delta);
 
@@ -87,6 +115,7 @@ class TiledGrid {
   void EnsureCells(const Eigen::Array2i& lo, const Eigen::Array2i& hi);
   /// The writable tile (tx, ty), created or unshared first; the table must cover it.
   Tile& MutableTile(int tx, int ty);
+  HitTile& MutableHitTile(int tx, int ty);
 
   OccupancyGridOptions options_;
   Eigen::Vector2d origin_;
@@ -95,6 +124,8 @@ class TiledGrid {
   int tiles_w_ = 0;
   int tiles_h_ = 0;
   std::vector<std::shared_ptr<Tile>> tiles_;  // row-major over the table, null = never written
+  bool record_hit_means_ = false;
+  std::vector<std::shared_ptr<HitTile>> hit_tiles_;  // as tiles_; empty unless recorded
 };
 
 }  // namespace slamrig::slam

@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <map>
 #include <numbers>
 #include <random>
 
@@ -79,6 +81,73 @@ TEST(TiledGridTest, InsertScanMatchesOccupancyGridCellForCellOnRandomScans) {
     }
     EXPECT_EQ(converted_mismatches, 0);
   }
+}
+
+// The hit means against an independent accumulation of the scans' end points per cell; recording
+// them leaves the log-odds as they were, and a copy's writes do not reach the original's means.
+TEST(TiledGridTest, HitMeansAreTheMeanOfEachCellsEndPoints) {
+  const Eigen::Vector2d origin(-20.0, -20.0);
+  TiledGrid plain(Options(true), origin);
+  TiledGrid means(Options(true), origin);
+  means.RecordHitMeans(true);
+  EXPECT_TRUE(means.records_hit_means());
+  EXPECT_FALSE(plain.records_hit_means());
+  struct Sum {
+    double x = 0.0, y = 0.0;
+    int n = 0;
+  };
+  std::map<std::pair<int, int>, Sum> expected;
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 30; ++trial) {
+    const RandomScan r = MakeRandomScan(rng);
+    plain.InsertScan(r.scan, r.pose);
+    means.InsertScan(r.scan, r.pose);
+    const Pose2 laser = r.pose * r.scan.base_from_laser;
+    for (std::size_t i = 0; i < r.scan.ranges_m.size(); ++i) {
+      const double range = r.scan.ranges_m[i];
+      if (range < r.scan.range_min_m || range >= r.scan.range_max_m) continue;
+      const double a = laser.theta() + r.scan.BeamAngle(i);
+      const Eigen::Vector2d end =
+          laser.translation() + range * Eigen::Vector2d(std::cos(a), std::sin(a));
+      const int ix = static_cast<int>(std::floor((end.x() - origin.x()) / 0.05));
+      const int iy = static_cast<int>(std::floor((end.y() - origin.y()) / 0.05));
+      Sum& sum = expected[{ix, iy}];
+      sum.x += end.x() - (origin.x() + (ix + 0.5) * 0.05);
+      sum.y += end.y() - (origin.y() + (iy + 0.5) * 0.05);
+      ++sum.n;
+    }
+  }
+  ASSERT_GT(expected.size(), 1000u);
+  int repeated = 0;
+  for (const auto& [cell, sum] : expected) {
+    const TiledGrid::HitMean m = means.HitMeanAt(cell.first, cell.second);
+    ASSERT_EQ(m.count, static_cast<float>(sum.n));
+    EXPECT_NEAR(m.dx, sum.x / sum.n, 1e-5);
+    EXPECT_NEAR(m.dy, sum.y / sum.n, 1e-5);
+    repeated += sum.n > 1;
+  }
+  EXPECT_GT(repeated, 10);  // the running mean is exercised, not only single hits
+  for (int iy = -400; iy < 400; iy += 3) {
+    for (int ix = -400; ix < 400; ix += 3) {
+      ASSERT_EQ(means.LogOdds(ix, iy), plain.LogOdds(ix, iy));
+      if (!expected.count({ix, iy})) {
+        ASSERT_EQ(means.HitMeanAt(ix, iy).count, 0.0f);
+      }
+    }
+  }
+  // Copy-on-write: the copy's new hits stay out of the original's means.
+  TiledGrid copy = means;
+  std::mt19937 more(12);
+  for (int trial = 0; trial < 5; ++trial) {
+    const RandomScan r = MakeRandomScan(more);
+    copy.InsertScan(r.scan, r.pose);
+  }
+  int changed = 0;
+  for (const auto& [cell, sum] : expected) {
+    EXPECT_EQ(means.HitMeanAt(cell.first, cell.second).count, static_cast<float>(sum.n));
+    changed += copy.HitMeanAt(cell.first, cell.second).count != static_cast<float>(sum.n);
+  }
+  EXPECT_GT(changed, 0);
 }
 
 TEST(TiledGridTest, CellsOutsideWrittenTilesAreUnknownIncludingNegativeIndices) {

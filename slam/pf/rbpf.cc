@@ -102,7 +102,7 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
     covariance.diagonal().array() += 1e-12;
     const Eigen::Matrix3d l = covariance.llt().matrixL();
     const Eigen::Vector3d z(StandardNormal(rng), StandardNormal(rng), StandardNormal(rng));
-    const Eigen::Vector3d d = mean + l * z;
+    const Eigen::Vector3d d = mean + options_.proposal_spread * Eigen::Vector3d(l * z);
     drawn = Pose2(match.pose.x() + d.x(), match.pose.y() + d.y(), match.pose.theta() + d.z());
   }
   particle.pose = drawn;
@@ -247,6 +247,7 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
     started_ = true;
     RbpfParticle first{Pose2(), 0.0, 0.0, TiledGrid(options_.map),
                        std::make_shared<RbpfPoseNode>(Pose2(), nullptr)};
+    first.map.RecordHitMeans(options_.cell_hit_means);
     first.map.InsertScan(scan, Pose2());
     particles_.assign(static_cast<std::size_t>(options_.num_particles), first);
     update_count_ = 1;

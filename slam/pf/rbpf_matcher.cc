@@ -101,6 +101,7 @@ MatchFit RbpfMatcher::Fit(const TiledGrid& map, std::span<const MatchPoint> poin
   const double res = map.resolution();
   const double inv_res = 1.0 / res;
   const Eigen::Vector2d origin = map.origin();
+  const bool records_means = map.records_hit_means();
   MatchFit fit;
   for (const MatchPoint& p : points) {
     const Eigen::Vector2d hit(t.x() + c * p.hit.x() - s * p.hit.y(),
@@ -113,10 +114,16 @@ MatchFit RbpfMatcher::Fit(const TiledGrid& map, std::span<const MatchPoint> poin
                                                FloorToInt((free.y() - origin.y()) * inv_res)) -
                                 ih;
     double best = std::numeric_limits<double>::infinity();
-    auto consider = [&](int x, int y, float cell, float behind) {
+    // The distance to the wall cell's hit mean where the map records one (TiledGrid::HitMean),
+    // else to its centre.
+    auto consider = [&](int x, int y, float cell, float behind, const TiledGrid::HitMean* mean) {
       if (!(cell > 0.0f) || (free_test && behind > 0.0f)) return;
-      const double ex = hit.x() - (origin.x() + (x + 0.5) * res);
-      const double ey = hit.y() - (origin.y() + (y + 0.5) * res);
+      double ex = hit.x() - (origin.x() + (x + 0.5) * res);
+      double ey = hit.y() - (origin.y() + (y + 0.5) * res);
+      if (mean) {
+        ex -= mean->dx;
+        ey -= mean->dy;
+      }
       best = std::min(best, ex * ex + ey * ey);
     };
     // Most kernels lie inside one tile: one tile lookup, then plain indexing.
@@ -129,10 +136,16 @@ MatchFit RbpfMatcher::Fit(const TiledGrid& map, std::span<const MatchPoint> poin
       if (tile) {
         const float* centre = tile->data() + ly * kSize + lx;
         const int behind = back.y() * kSize + back.x();
+        const TiledGrid::HitTile* means =
+            records_means
+                ? map.FindHitTile(ih.x() >> TiledGrid::kTileBits, ih.y() >> TiledGrid::kTileBits)
+                : nullptr;
+        const TiledGrid::HitMean* mean_centre = means ? means->data() + ly * kSize + lx : nullptr;
         for (int dy = -k; dy <= k; ++dy) {
           for (int dx = -k; dx <= k; ++dx) {
             const float* cell = centre + dy * kSize + dx;
-            consider(ih.x() + dx, ih.y() + dy, cell[0], cell[behind]);
+            consider(ih.x() + dx, ih.y() + dy, cell[0], cell[behind],
+                     mean_centre ? mean_centre + dy * kSize + dx : nullptr);
           }
         }
       }
@@ -141,7 +154,10 @@ MatchFit RbpfMatcher::Fit(const TiledGrid& map, std::span<const MatchPoint> poin
         for (int dx = -k; dx <= k; ++dx) {
           const int x = ih.x() + dx;
           const int y = ih.y() + dy;
-          consider(x, y, map.LogOdds(x, y), map.LogOdds(x + back.x(), y + back.y()));
+          const TiledGrid::HitMean mean =
+              records_means ? map.HitMeanAt(x, y) : TiledGrid::HitMean{};
+          consider(x, y, map.LogOdds(x, y), map.LogOdds(x + back.x(), y + back.y()),
+                   records_means ? &mean : nullptr);
         }
       }
     }

@@ -63,6 +63,38 @@ TEST(RbpfMatcherTest, ClimbRecoversRandomOffsetsWithinReach) {
 
 // A wall cell counts only when its counterpart one cell back along the beam is not occupied: a
 // point reaching a two-cell-thick wall from behind matches the back cell, not the front one.
+// With the map's hit means the scan that built the map fits it closer than with the cells'
+// centres: every point is compared with where it (and its cell's other hits) fell, not with the
+// lattice. The walls sit at x = +-3, y = +-2, so the hits of the wall x = 3 land on either side
+// of a cell edge and a centre is 2.5 cm from them.
+TEST(RbpfMatcherTest, HitMeansBringTheWallsOffTheLattice) {
+  OccupancyGridOptions map_options;
+  const Pose2 pose(0.3, -0.2, 0.1);
+  const LaserScan scan = RoomScan(pose);
+  TiledGrid centres(map_options);
+  TiledGrid means(map_options);
+  means.RecordHitMeans(true);
+  centres.InsertScan(scan, pose);
+  means.InsertScan(scan, pose);
+  const std::vector<MatchPoint> points =
+      MakeMatchPoints(scan, ScanPointsOptions{0.1, 30.0, 1, 0.0}, map_options.resolution_m);
+  const RbpfMatcher matcher(RbpfMatcherOptions{});
+  const MatchFit with_centres = matcher.Evaluate(centres, points, pose);
+  const MatchFit with_means = matcher.Evaluate(means, points, pose);
+  EXPECT_EQ(with_means.matched, with_centres.matched);
+  ASSERT_GT(with_means.matched, static_cast<int>(points.size()) / 2);
+  // The matched points' part of the log-likelihood (each unmatched one adds no_match, -2): with
+  // the centres a point costs on average more than (2.5 cm)^2 / (2 (5 cm)^2) = 0.125 (the
+  // distance across the wall's cell edge and along the wall); with the means less than half that.
+  auto matched_part = [&](const MatchFit& fit) {
+    return fit.log_likelihood - RbpfMatcherOptions{}.no_match_log_likelihood *
+                                    static_cast<double>(points.size() - fit.matched);
+  };
+  EXPECT_LT(matched_part(with_centres), -0.125 * with_centres.matched);
+  EXPECT_GT(matched_part(with_means), 0.5 * matched_part(with_centres));
+  EXPECT_GT(with_means.score, with_centres.score);
+}
+
 TEST(RbpfMatcherTest, MatchesWallsOnlyFromTheSideTheBeamCameFrom) {
   OccupancyGridOptions map_options;  // 0.05 m cells
   TiledGrid map(map_options);

@@ -40,6 +40,9 @@ std::vector<std::string> RbpfOptions::Validate() const {
   AppendErrors(&errors, PrefixErrors("motion", motion.Validate()));
   Positive("proposal_xy_step_m", proposal_xy_step_m, errors);
   Positive("proposal_yaw_step_rad", proposal_yaw_step_rad, errors);
+  if (!(proposal_spread >= 0.0 && proposal_spread <= 1.0)) {
+    errors.push_back(Rule("proposal_spread", proposal_spread, "must be in [0, 1]"));
+  }
   Positive("observation_scale", observation_scale, errors);
   if (!(weight_exponent > 0.0 && weight_exponent <= 1.0)) {
     errors.push_back(Rule("weight_exponent", weight_exponent, "must be in (0, 1]"));

@@ -49,6 +49,11 @@ struct RbpfOptions {
   /// llsamplestep, lasamplestep), weighted by likelihood times motion prior.
   double proposal_xy_step_m = 0.01;
   double proposal_yaw_step_rad = 0.005;
+  /// The new pose is the proposal's mean plus proposal_spread times a draw of its covariance:
+  /// 1 samples the Gaussian (the paper's Eq. 17), 0 takes its mean (the openslam gmapping code
+  /// keeps the matched pose). Every draw is inserted into the particle's map, so the spread is
+  /// noise the map keeps.
+  double proposal_spread = 1.0;
   /// p(z | m, x) = exp(observation_scale * log-likelihood): below 1 the beams count as
   /// correlated (GMapping flattens its weights in the same way).
   double observation_scale = 0.2;
@@ -85,6 +90,11 @@ struct RbpfOptions {
   double resample_neff_ratio = 0.5;
 
   OccupancyGridOptions map;  ///< every particle's map
+  /// Every particle's map records where in each cell its hits fell (TiledGrid::HitMean, GMapping's
+  /// PointAccumulator), and the matcher measures a point's distance to that mean, not to the
+  /// cell's centre: a wall seen at a sub-cell offset is matched there, not on the 5 cm lattice.
+  /// Costs three floats per cell.
+  bool cell_hit_means = false;
 
   /// Filter only after the robot moved this far or turned this much since the last update; in
   /// between, poses follow the odometry and the maps are left alone.
@@ -107,6 +117,7 @@ void VisitFields(V& v, RbpfOptions& o) {
   v.Struct("motion", o.motion);
   v("proposal_xy_step_m", o.proposal_xy_step_m);
   v("proposal_yaw_step_rad", o.proposal_yaw_step_rad);
+  v("proposal_spread", o.proposal_spread);
   v("observation_scale", o.observation_scale);
   v("weight_exponent", o.weight_exponent);
   v("odometry_failure_probability", o.odometry_failure_probability);
@@ -119,6 +130,7 @@ void VisitFields(V& v, RbpfOptions& o) {
           {ResamplingScheme::kStratified, "stratified"}});
   v("resample_neff_ratio", o.resample_neff_ratio);
   v.Struct("map", o.map);
+  v("cell_hit_means", o.cell_hit_means);
   v("min_update_distance_m", o.min_update_distance_m);
   v("min_update_angle_rad", o.min_update_angle_rad);
   v("threads", o.num_threads);

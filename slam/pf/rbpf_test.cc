@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "slam/odometry/scan_sync.h"
@@ -125,6 +126,42 @@ TEST(RbpfTest, TemperedWeightsResampleLessOften) {
   EXPECT_GT(full.resamples, 0);
   EXPECT_LT(tempered.resamples, full.resamples * 3 / 4) << "full " << full.resamples;
   EXPECT_LT(PositionRmse(tempered.online, run.run.truth), 0.1);
+}
+
+// proposal_spread scales the draw around the proposal's mean and nothing else: the same seed gives
+// the same climb and the same Gaussian, so the half-spread pose lies halfway between the mean
+// (spread 0) and the full draw (spread 1), particle for particle.
+TEST(RbpfTest, ProposalSpreadScalesTheDrawAroundTheProposalMean) {
+  const ShortRun& run = GetShortRun();
+  auto first_update = [&](double spread) {
+    RbpfOptions options = FastOptions();
+    options.proposal_spread = spread;
+    options.resample_neff_ratio = 0.0;  // keeps particle i in slot i
+    Rbpf filter(options);
+    filter.AddScan(run.scans[0].scan, Pose2());
+    Pose2 motion;
+    for (std::size_t i = 1; i < run.scans.size(); ++i) {
+      motion = motion * run.scans[i].increment;
+      if (filter.AddScan(run.scans[i].scan, run.scans[i].increment).updated) break;
+    }
+    EXPECT_EQ(filter.update_count(), 2);
+    std::vector<Pose2> poses;
+    for (const RbpfParticle& p : filter.particles()) poses.push_back(p.pose);
+    return poses;
+  };
+  const std::vector<Pose2> mean = first_update(0.0);
+  const std::vector<Pose2> half = first_update(0.5);
+  const std::vector<Pose2> full = first_update(1.0);
+  ASSERT_EQ(mean.size(), full.size());
+  double largest_draw = 0.0;
+  for (std::size_t i = 0; i < mean.size(); ++i) {
+    EXPECT_NEAR(half[i].x(), 0.5 * (mean[i].x() + full[i].x()), 1e-9) << i;
+    EXPECT_NEAR(half[i].y(), 0.5 * (mean[i].y() + full[i].y()), 1e-9) << i;
+    EXPECT_NEAR(half[i].theta(), 0.5 * (mean[i].theta() + full[i].theta()), 1e-9) << i;
+    largest_draw = std::max(largest_draw, (full[i].translation() - mean[i].translation()).norm());
+  }
+  // The draw is not degenerate: at full spread the particles leave their means.
+  EXPECT_GT(largest_draw, 1e-4);
 }
 
 TEST(RbpfTest, SameSeedSameTrajectoryWhateverTheThreadCount) {
