@@ -14,6 +14,14 @@ std::string MarkString(const std::string& file, const YAML::Mark& mark) {
   return file + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
 }
 
+// True when key path `path` is `ancestor` or lies below it ("a.b" and "a.b[2].c" below "a.b";
+// "a.bc" not).
+bool IsAtOrBelow(const std::string& path, const std::string& ancestor) {
+  return path == ancestor ||
+         (path.size() > ancestor.size() && path.compare(0, ancestor.size(), ancestor) == 0 &&
+          (path[ancestor.size()] == '.' || path[ancestor.size()] == '['));
+}
+
 }  // namespace
 
 YamlNode YamlNode::LoadFile(const std::string& path) {
@@ -43,10 +51,7 @@ std::string YamlNode::ChildPath(const std::string& key) const {
 std::string YamlNode::Where() const {
   // A value set by an override (or inside one) is located by the override, not the file.
   for (const auto& [path, origin] : usage_->overridden) {
-    if (path_ == path || (path_.size() > path.size() && path_.compare(0, path.size(), path) == 0 &&
-                          (path_[path.size()] == '.' || path_[path.size()] == '['))) {
-      return origin + ": " + path_;
-    }
+    if (IsAtOrBelow(path_, path)) return origin + ": " + path_;
   }
   const std::string location = MarkString(usage_->file, node_.Mark());
   return path_.empty() ? location : location + ": " + path_;
@@ -60,11 +65,7 @@ std::string YamlNode::ResolvePath(const std::string& text) const {
     const std::string* base = nullptr;
     std::size_t matched = 0;
     for (const auto& [set_path, dir] : usage_->path_base) {
-      const bool covers =
-          path_ == set_path ||
-          (path_.size() > set_path.size() && path_.compare(0, set_path.size(), set_path) == 0 &&
-           (path_[set_path.size()] == '.' || path_[set_path.size()] == '['));
-      if (covers && (base == nullptr || set_path.size() > matched)) {
+      if (IsAtOrBelow(path_, set_path) && (base == nullptr || set_path.size() > matched)) {
         base = &dir;
         matched = set_path.size();
       }
@@ -258,10 +259,7 @@ void YamlNode::CheckUsedRecursive(const YAML::Node& node, const std::string& pat
         // located by the override.
         std::string where = MarkString(usage_->file, kv.first.Mark());
         for (const auto& [set_path, origin] : usage_->overridden) {
-          if (set_path == child_path ||
-              (set_path.size() > child_path.size() &&
-               set_path.compare(0, child_path.size(), child_path) == 0 &&
-               (set_path[child_path.size()] == '.' || set_path[child_path.size()] == '['))) {
+          if (IsAtOrBelow(set_path, child_path)) {
             where = origin;
             break;
           }
