@@ -53,7 +53,8 @@ void VisitFields(V& v, OdometryCalibrationOptions& o) {
   v("min_significance", o.min_significance);
 }
 
-/// The running fit of OdometryCalibrationOptions. Deterministic, no state but two sums.
+/// The running fit of OdometryCalibrationOptions. Deterministic; its state is the forgotten sums
+/// below.
 class OdometryCalibration {
  public:
   explicit OdometryCalibration(const OdometryCalibrationOptions& options) : options_(options) {}
