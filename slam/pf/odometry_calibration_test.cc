@@ -136,6 +136,39 @@ TEST(OdometryCalibrationTest, StandardErrorMatchesTheSpreadOverRuns) {
   EXPECT_NEAR(sum_se / runs, spread, 0.15 * spread);
 }
 
+// The corrections are serially correlated: the estimate's heading error at an update enters that
+// update's correction and, with the opposite sign, the next one's (intel-corrected's residuals have
+// a lag-1 autocorrelation of -0.10). The sum then telescopes, so the fit scatters less than
+// independent residuals suggest: the standard error from them errs on the safe side, and a robot
+// without drift is not corrected.
+TEST(OdometryCalibrationTest, StandardErrorIsConservativeForAnEstimatesHeadingNoise) {
+  OdometryCalibrationOptions o = Enabled();
+  RandomEngine rng(19);
+  const double estimate_noise = 0.01, matcher_noise = 0.005;
+  double sum = 0.0, sum_sq = 0.0, sum_se = 0.0;
+  int applied = 0;
+  const int runs = 400;
+  for (int r = 0; r < runs; ++r) {
+    OdometryCalibration c(o);
+    double previous = estimate_noise * StandardNormal(rng);
+    for (int i = 0; i < 300; ++i) {
+      const double d = 0.25 + 0.1 * Uniform01(rng);
+      const double current = estimate_noise * StandardNormal(rng);
+      const double error = current - previous + matcher_noise * StandardNormal(rng);
+      previous = current;
+      c.Observe(Pose2(d, 0.0, 0.0), Pose2(d, 0.0, error));
+    }
+    sum += c.drift_rad_per_m();
+    sum_sq += c.drift_rad_per_m() * c.drift_rad_per_m();
+    sum_se += c.standard_error_rad_per_m();
+    if (c.applied_drift_rad_per_m() != 0.0) ++applied;
+  }
+  const double mean = sum / runs;
+  const double spread = std::sqrt(sum_sq / runs - mean * mean);
+  EXPECT_GT(sum_se / runs, spread);
+  EXPECT_EQ(applied, 0);
+}
+
 // A drift well clear of its standard error is applied; the matcher's noise about zero is not.
 TEST(OdometryCalibrationTest, OnlyASignificantDriftIsApplied) {
   const OdometryCalibrationOptions o = Enabled();
