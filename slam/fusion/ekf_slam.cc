@@ -129,8 +129,9 @@ void EkfSlam::PredictGyro(double rate_rad_s, double dt_s) {
 }
 
 void EkfSlam::PredictWheels(double right_m, double left_m, double track_width_m,
-                            std::optional<double> gyro_yaw_rad) {
-  Predict([&](PoseEkf& f) { f.PredictWheels(right_m, left_m, track_width_m, gyro_yaw_rad); });
+                            std::optional<double> gyro_yaw_rad, double slip_m2) {
+  Predict(
+      [&](PoseEkf& f) { f.PredictWheels(right_m, left_m, track_width_m, gyro_yaw_rad, slip_m2); });
 }
 
 void EkfSlam::PredictIncrement(const Pose2& increment, double distance_m, double turn_rad) {

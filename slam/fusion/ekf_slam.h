@@ -61,7 +61,7 @@ class EkfSlam {
   /// PoseEkf's motion model (see there), the landmarks' cross-covariances carried along.
   void PredictGyro(double rate_rad_s, double dt_s);
   void PredictWheels(double right_m, double left_m, double track_width_m,
-                     std::optional<double> gyro_yaw_rad);
+                     std::optional<double> gyro_yaw_rad, double slip_m2 = 0.0);
   void PredictIncrement(const Pose2& increment, double distance_m, double turn_rad);
   /// A gyro sample at standstill measures the bias (b = rate), over the whole state.
   double UpdateZeroRate(double rate_rad_s);

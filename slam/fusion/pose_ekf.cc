@@ -61,7 +61,7 @@ void PoseEkf::PredictGyro(double rate_rad_s, double dt_s) {
 }
 
 void PoseEkf::PredictWheels(double right_m, double left_m, double track_width_m,
-                            std::optional<double> gyro_yaw_rad) {
+                            std::optional<double> gyro_yaw_rad, double slip_m2) {
   const double distance = 0.5 * (right_m + left_m);
   double encoder_yaw = 0.0;
   if (!gyro_yaw_rad) {
@@ -86,8 +86,11 @@ void PoseEkf::PredictWheels(double right_m, double left_m, double track_width_m,
   p_(3, 4) += c * s * (along - lateral);
   p_(4, 3) = p_(3, 4);
   const double skid = Squared(options_.encoder_skid_sigma_m_per_sqrt_rad) * std::abs(turned);
-  p_(3, 3) += skid;
-  p_(4, 4) += skid;
+  // Slip moves the base by an unknown share of it, in any direction (a slipping turn in place
+  // drifts sideways as much as along).
+  const double slip = Squared(options_.encoder_slip_share) * std::max(0.0, slip_m2);
+  p_(3, 3) += skid + slip;
+  p_(4, 4) += skid + slip;
   if (!gyro_yaw_rad) {
     p_(kYaw, kYaw) += Squared(options_.encoder_yaw_sigma_rel *
                               (std::abs(right_m) + std::abs(left_m)) / track_width_m);

@@ -44,9 +44,11 @@ class PoseEkf {
   void PredictGyro(double rate_rad_s, double dt_s);
   /// One encoder interval: the wheels rolled `right_m` and `left_m`; `gyro_yaw_rad` is the yaw the
   /// gyro added since the previous interval (the translation follows the mean heading), or
-  /// nullopt when no gyro sample came, and the yaw comes from the wheel difference.
+  /// nullopt when no gyro sample came, and the yaw comes from the wheel difference; `slip_m2` is
+  /// the wheel slip the gyro saw in the interval (WheelSlipStep::coherent_m2), position variance
+  /// encoder_slip_share^2 times that.
   void PredictWheels(double right_m, double left_m, double track_width_m,
-                     std::optional<double> gyro_yaw_rad);
+                     std::optional<double> gyro_yaw_rad, double slip_m2 = 0.0);
   /// A robot-frame increment from odometry poses, `distance_m` travelled and `turn_rad` turned.
   void PredictIncrement(const Pose2& increment, double distance_m, double turn_rad);
   /// Measures clone^-1 * pose = `z` with covariance `r` (x, y, yaw in the clone's frame). With

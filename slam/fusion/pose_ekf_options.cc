@@ -13,6 +13,7 @@ std::vector<std::string> PoseEkfOptions::Validate() const {
       {"encoder_lateral_sigma_rel", encoder_lateral_sigma_rel},
       {"encoder_yaw_sigma_rel", encoder_yaw_sigma_rel},
       {"encoder_skid_sigma_m_per_sqrt_rad", encoder_skid_sigma_m_per_sqrt_rad},
+      {"encoder_slip_share", encoder_slip_share},
       {"gyro_sigma_rad_s", gyro_sigma_rad_s},
       {"gyro_bias_sigma_rad_s", gyro_bias_sigma_rad_s},
       {"gyro_bias_walk_rad_s_sqrt_s", gyro_bias_walk_rad_s_sqrt_s},

@@ -70,6 +70,27 @@ TEST(PoseEkfTest, SkidNoiseGrowsWithTheYawTurnedNotWithTheIntervals) {
   }
 }
 
+// The slip the gyro saw adds share^2 * slip_m2 to x and to y, on top of the distance terms, and
+// nothing with share = 0.
+TEST(PoseEkfTest, SlipAddsPositionVarianceInProportionToTheSlip) {
+  for (const double sigma : {0.29, 0.0}) {
+    PoseEkfOptions options;
+    options.encoder_slip_share = sigma;
+    PoseEkf with(options), without(options);
+    with.ResetPose(Pose2());
+    without.ResetPose(Pose2());
+    for (int i = 0; i < 10; ++i) {
+      with.PredictWheels(0.01, 0.01, 0.4, 0.0, 0.003);
+      without.PredictWheels(0.01, 0.01, 0.4, 0.0, 0.0);
+    }
+    const Eigen::Matrix3d added = with.PoseCovariance() - without.PoseCovariance();
+    EXPECT_NEAR(added(0, 0), sigma * sigma * 0.03, 1e-15);
+    EXPECT_NEAR(added(1, 1), sigma * sigma * 0.03, 1e-15);
+    EXPECT_NEAR(added(0, 1), 0.0, 1e-15);
+    EXPECT_NEAR(added(2, 2), 0.0, 1e-15);
+  }
+}
+
 TEST(PoseEkfOptionsTest, RejectsANegativeSkidNoiseByItsKey) {
   PoseEkfOptions options;
   options.encoder_skid_sigma_m_per_sqrt_rad = -0.1;

@@ -208,6 +208,8 @@ std::map<std::string, double> EkfEstimator::Statistics() const {
           {"keyframes", keyframes_},
           {"anchors", anchors_},
           {"match_covariance_factor", MatchScale()},
+          {"wheel_slip_m", feed_.slip().total_slip_m()},
+          {"skid_ratio", feed_.slip().skid_ratio()},
           {"mean_nis", scan_updates_ > 0 ? nis_sum_ / scan_updates_ : 0.0}};
 }
 

@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "slam/fusion/pose_ekf_options.h"
+#include "slam/fusion/wheel_slip.h"
 #include "slam/odometry/odometry_interval.h"
 #include "slam/odometry/wheel_odometry.h"
 #include "slam/types/records.h"
@@ -14,14 +15,18 @@ namespace slamrig::slam {
 /// (PoseEkf, EkfSlam) at their own rates: the gyro predicts the heading between tick intervals
 /// (zero-order hold), the ticks predict the motion with the gyro's yaw since the last interval
 /// when there was one, and a run of still intervals turns gyro samples into zero-rate updates of
-/// the bias. `Filter` has gyro_bias(), gyro_bias_variance(), PredictGyro(rate, dt),
-/// PredictWheels(right_m, left_m, track_m, optional gyro yaw) and UpdateZeroRate(rate).
+/// the bias, and the wheels' differential against the gyro's yaw gives the slip the gyro sees
+/// (WheelSlipDetector). `Filter` has gyro_bias(), gyro_bias_variance(), PredictGyro(rate, dt),
+/// PredictWheels(right_m, left_m, track_m, optional gyro yaw, slip_m2) and UpdateZeroRate(rate).
 template <typename Filter>
 class WheelGyroFeed {
  public:
   /// `use_gyro` false (odometry.use_gyro) leaves the heading to the encoders.
   WheelGyroFeed(const DiffDriveParams& robot, bool use_gyro, const PoseEkfOptions& motion)
-      : robot_(robot), use_gyro_(use_gyro), motion_(motion) {}
+      : robot_(robot),
+        use_gyro_(use_gyro),
+        motion_(motion),
+        slip_(robot.track_width_m, robot.MetresPerTick(), motion.encoder_sigma_rel) {}
 
   void AddImu(const ImuSample& imu, Filter& filter) {
     if (!use_gyro_) return;
@@ -54,9 +59,17 @@ class WheelGyroFeed {
     const double metres_per_tick = robot_.MetresPerTick();
     const double right_m = MeanTicks(ticks.right_ticks) * metres_per_tick;
     const double left_m = MeanTicks(ticks.left_ticks) * metres_per_tick;
+    // The interval's length for the slip's window (0 at the first ticks: no slip reported).
+    const double interval_s =
+        last_ticks_time_ ? SecondsBetween(ticks.time, *last_ticks_time_) : 0.0;
+    last_ticks_time_ = ticks.time;
+    const WheelSlipStep slip = gyro_since_ticks_
+                                   ? slip_.Add(right_m, left_m, gyro_yaw_since_ticks_, interval_s)
+                                   : WheelSlipStep{};
     filter.PredictWheels(
         right_m, left_m, robot_.track_width_m,
-        gyro_since_ticks_ ? std::optional<double>(gyro_yaw_since_ticks_) : std::nullopt);
+        gyro_since_ticks_ ? std::optional<double>(gyro_yaw_since_ticks_) : std::nullopt,
+        slip.coherent_m2);
     still_intervals_ = right_m == 0.0 && left_m == 0.0 ? still_intervals_ + 1 : 0;
     saw_ticks_ = true;
     gyro_since_ticks_ = false;
@@ -66,6 +79,7 @@ class WheelGyroFeed {
   /// Whether any ticks came: without them the estimators predict from odometry-pose increments.
   bool saw_ticks() const { return saw_ticks_; }
   int zero_rate_updates() const { return zero_rate_updates_; }
+  const WheelSlipDetector& slip() const { return slip_; }
 
  private:
   static constexpr int kStillIntervals = 10;
@@ -80,6 +94,8 @@ class WheelGyroFeed {
   bool gyro_since_ticks_ = false;
   double gyro_yaw_since_ticks_ = 0.0;
   int zero_rate_updates_ = 0;
+  WheelSlipDetector slip_;
+  std::optional<Time> last_ticks_time_;
 };
 
 }  // namespace slamrig::slam
