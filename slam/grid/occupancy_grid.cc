@@ -33,6 +33,12 @@ std::vector<std::string> OccupancyGridOptions::Validate() const {
   if (!(grow_margin_m >= 0.0)) {
     errors.push_back(RuleViolation("grow_margin_m", grow_margin_m, "must be >= 0"));
   }
+  if (!(range_stddev_m >= 0.0)) {
+    errors.push_back(RuleViolation("range_stddev_m", range_stddev_m, "must be >= 0"));
+  }
+  if (!(hit_window_sigmas >= 0.0)) {
+    errors.push_back(RuleViolation("hit_window_sigmas", hit_window_sigmas, "must be >= 0"));
+  }
   return errors;
 }
 
@@ -151,9 +157,13 @@ int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_bas
   const Eigen::Array2i start = WorldToCell(origin_world);
   int hits = 0;
   // Hits first, so that with update_once_per_scan a free ray cannot erase them.
-  for (const auto& [end, hit] : ends) {
+  std::vector<Eigen::Array2i>& cells = end_cells_;
+  cells.resize(ends.size());
+  for (std::size_t j = 0; j < ends.size(); ++j) {
+    const auto& [end, hit] = ends[j];
+    cells[j] = hit ? HitCell(origin_world, end) : WorldToCell(end);
     if (!hit) continue;
-    const Eigen::Array2i cell = WorldToCell(end);
+    const Eigen::Array2i cell = cells[j];
     ++hits;
     std::uint32_t& stamp = last_update_[Index(cell.x(), cell.y())];
     if (once && stamp == scan_count_) continue;
@@ -162,8 +172,9 @@ int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_bas
     Assign(index, std::clamp(log_odds_[index] + options_.hit_log_odds, options_.min_log_odds,
                              options_.max_log_odds));
   }
-  for (const auto& [end, hit] : ends) {
-    const Eigen::Array2i cell = WorldToCell(end);
+  for (std::size_t j = 0; j < ends.size(); ++j) {
+    const bool hit = ends[j].second;
+    const Eigen::Array2i cell = cells[j];
     TraceRay(start, cell, [&](int x, int y) {
       const std::size_t index = Index(x, y);
       if (once) {
@@ -182,6 +193,36 @@ int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_bas
     }
   }
   return hits;
+}
+
+Eigen::Array2i OccupancyGrid::HitCell(const Eigen::Vector2d& origin,
+                                      const Eigen::Vector2d& end) const {
+  const Eigen::Array2i end_cell = WorldToCell(end);
+  const double window = options_.range_stddev_m * options_.hit_window_sigmas;
+  if (!(window > 0.0)) return end_cell;
+  const Eigen::Vector2d ray = end - origin;
+  const double length = ray.norm();
+  if (!(length > 0.0)) return end_cell;
+  // Samples at most half a cell apart from the window's start to the end point. The cell with the
+  // most wall evidence wins, so a fringe cell that noise marked once does not take the hits of the
+  // wall behind it; on a tie (cells at the clamp) the one nearest the end point, so a hit stays
+  // where it fell unless a stronger wall stands before it. Ties to the sensor side let a saturated
+  // fringe cell in front take the wall's hits: on 5 cm cells the walls then sat 0.45 sigma in
+  // front of the surface.
+  const double reach = std::min(window, length);
+  const int samples = static_cast<int>(std::ceil(reach / (0.5 * options_.resolution_m)));
+  const double step = reach / samples;
+  Eigen::Array2i best = end_cell;
+  float best_log_odds = 0.0f;
+  for (int k = samples; k >= 0; --k) {
+    const Eigen::Array2i cell = k == 0 ? end_cell : WorldToCell(end - (k * step / length) * ray);
+    const float l = LogOdds(cell);
+    if (l >= best_log_odds && l > 0.0f) {
+      best = cell;
+      best_log_odds = l;
+    }
+  }
+  return best;
 }
 
 }  // namespace slamrig::slam

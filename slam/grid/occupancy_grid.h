@@ -31,6 +31,17 @@ struct OccupancyGridOptions {
   /// in the reports.
   bool update_once_per_scan = true;
   double grow_margin_m = 5.0;  ///< extra room added when the map grows
+  /// Standard deviation of the ranges (the lidar's noise); 0: every hit marks its end cell. Else a
+  /// hit marks the cell of most wall evidence (log-odds > 0) on its ray within hit_window_sigmas
+  /// of it before the end point, or the end cell, and its free ray stops there: the beam cannot
+  /// have passed a wall, an end point behind one lies there by noise. Why: a hit that noise puts
+  /// behind a wall marks a cell no later beam can clear (the wall stops them all), while one put in
+  /// front is cleared by the free rays of later beams, so each wall grows a fringe behind its
+  /// surface, its cells' centroid about one sigma behind it (slam/grid/wall_bias_test.cc), and
+  /// scans matched to them drift towards the walls (the office pf's corridors 1-2.6 cm too wide,
+  /// issue 11).
+  double range_stddev_m = 0.0;
+  double hit_window_sigmas = 2.5;  ///< the window before a hit searched for a wall, in sigmas
 
   /// One message per broken rule, e.g. "resolution_m = 0; must be > 0".
   std::vector<std::string> Validate() const;
@@ -48,6 +59,8 @@ void VisitFields(V& v, OccupancyGridOptions& o) {
   v("no_return_clear_range_m", o.no_return_clear_range_m);
   v("update_once_per_scan", o.update_once_per_scan);
   v("grow_margin_m", o.grow_margin_m);
+  v("range_stddev_m", o.range_stddev_m);
+  v("hit_window_sigmas", o.hit_window_sigmas);
 }
 
 /// Occupancy state of a cell after thresholding its probability.
@@ -156,8 +169,13 @@ class OccupancyGrid {
   bool records_flips_ = false;
   float wall_threshold_ = 0.0f;
   std::vector<Eigen::Array2i> flips_;
-  // Scratch buffer reused across scans: beam end points and whether each is a hit.
+  // The cell a hit from `origin` ending at `end` marks (see range_stddev_m).
+  Eigen::Array2i HitCell(const Eigen::Vector2d& origin, const Eigen::Vector2d& end) const;
+
+  // Scratch buffers reused across scans: beam end points and whether each is a hit; the cell each
+  // marks or stops at.
   std::vector<std::pair<Eigen::Vector2d, bool>> beam_ends_;
+  std::vector<Eigen::Array2i> end_cells_;
 };
 
 }  // namespace slamrig::slam

@@ -67,6 +67,35 @@ TEST(OccupancyGridTest, RespectsPoseAndLaserMount) {
   EXPECT_EQ(grid.LogOdds(grid.WorldToCell({3.05, 3.2})), 0.0f);  // behind the laser
 }
 
+TEST(OccupancyGridTest, HitBehindAWallWithinTheNoiseMarksTheWall) {
+  // The wall cell [2.0, 2.1) first; then a beam ending at 2.17, in [2.1, 2.2). With 5 cm range
+  // noise the window (2.5 sigma) reaches back to 2.045: the wall's cell takes the hit and the cell
+  // behind stays unknown. With exact ranges the cell behind takes it.
+  for (const double sigma : {0.0, 0.05}) {
+    OccupancyGridOptions options = Options();
+    options.range_stddev_m = sigma;
+    OccupancyGrid grid(options);
+    LaserScan scan = FanScan(1, 2.0f);
+    scan.angle_min_rad = 0.0;
+    grid.InsertScan(scan, Pose2(0.05, 0.05, 0.0));
+    scan.ranges_m[0] = 2.12f;
+    grid.InsertScan(scan, Pose2(0.05, 0.05, 0.0));
+    const float wall = grid.LogOdds(grid.WorldToCell({2.05, 0.05}));
+    const float behind = grid.LogOdds(grid.WorldToCell({2.15, 0.05}));
+    if (sigma > 0.0) {
+      EXPECT_FLOAT_EQ(wall, 2 * options.hit_log_odds);
+      EXPECT_EQ(behind, 0.0f);
+    } else {
+      EXPECT_FLOAT_EQ(wall, options.hit_log_odds + options.miss_log_odds);
+      EXPECT_FLOAT_EQ(behind, options.hit_log_odds);
+    }
+    // A reading beyond the window marks its own cell.
+    scan.ranges_m[0] = 2.25f;
+    grid.InsertScan(scan, Pose2(0.05, 0.05, 0.0));
+    EXPECT_GT(grid.LogOdds(grid.WorldToCell({2.35, 0.05})), 0.0f) << sigma;
+  }
+}
+
 TEST(OccupancyGridTest, ClampsLogOdds) {
   OccupancyGrid grid(Options());
   LaserScan scan = FanScan(1, 1.0f);
@@ -132,6 +161,11 @@ TEST(OccupancyGridOptionsTest, ValidateNamesFieldValueAndRule) {
   o.miss_log_odds = 0.5f;
   EXPECT_THAT(o.Validate(), ::testing::ElementsAre("resolution_m = 0; must be > 0",
                                                    "miss_log_odds = 0.5; must be < 0"));
+  o = OccupancyGridOptions();
+  o.range_stddev_m = -0.01;
+  o.hit_window_sigmas = -1.0;
+  EXPECT_THAT(o.Validate(), ::testing::ElementsAre("range_stddev_m = -0.01; must be >= 0",
+                                                   "hit_window_sigmas = -1; must be >= 0"));
   EXPECT_TRUE(OccupancyGridOptions().Validate().empty());
 }
 

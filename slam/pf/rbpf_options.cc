@@ -62,6 +62,10 @@ std::vector<std::string> RbpfOptions::Validate() const {
     errors.push_back(Rule("resample_neff_ratio", resample_neff_ratio, "must be in [0, 1]"));
   }
   AppendErrors(&errors, PrefixErrors("map", map.Validate()));
+  // The particles' tiled maps write every hit to its end cell (TiledGrid::InsertScan).
+  if (map.range_stddev_m != 0.0) {
+    errors.push_back(Rule("map.range_stddev_m", map.range_stddev_m, "must be 0 for the rbpf"));
+  }
   NonNegative("min_update_distance_m", min_update_distance_m, errors);
   NonNegative("min_update_angle_rad", min_update_angle_rad, errors);
   if (num_threads < 1) errors.push_back(Rule("threads", num_threads, "must be >= 1"));
