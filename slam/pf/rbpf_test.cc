@@ -254,5 +254,14 @@ TEST(RbpfTest, ValidateNamesFieldValueAndRule) {
   EXPECT_TRUE(RbpfOptions{}.Validate().empty());
 }
 
+// The particles' tiled maps write every hit to its end cell: the plain grid's range-noise model
+// (map.range_stddev_m) is refused rather than silently ignored.
+TEST(RbpfTest, RefusesTheMapRangeNoiseItDoesNotImplement) {
+  RbpfOptions options;
+  options.map.range_stddev_m = 0.01;
+  EXPECT_THAT(options.Validate(),
+              ::testing::ElementsAre("map.range_stddev_m = 0.01; must be 0 for the rbpf"));
+}
+
 }  // namespace
 }  // namespace slamrig::slam
