@@ -117,7 +117,16 @@ double CorrelativeMatcher::AngularStep(std::span<const Eigen::Vector2d> points_b
 
 std::optional<MatchResult> CorrelativeMatcher::Match(std::span<const Eigen::Vector2d> points_base,
                                                      const Pose2& initial) const {
-  if (points_base.empty()) return std::nullopt;
+  std::vector<MatchResult> best = MatchDistinct(points_base, initial, 1, 0.0, 0.0);
+  if (best.empty()) return std::nullopt;
+  return best.front();
+}
+
+std::vector<MatchResult> CorrelativeMatcher::MatchDistinct(
+    std::span<const Eigen::Vector2d> points_base, const Pose2& initial, int count,
+    double min_distance_m, double min_angle_rad) const {
+  std::vector<MatchResult> results;
+  if (points_base.empty() || count < 1) return results;
   const int n = static_cast<int>(points_base.size());
   const double step = AngularStep(points_base);
   const int wk = static_cast<int>(std::ceil(options_.angular_window_rad / step - 1e-9));
@@ -125,7 +134,6 @@ std::optional<MatchResult> CorrelativeMatcher::Match(std::span<const Eigen::Vect
   const int num_angles = 2 * wk + 1;
   const std::int64_t side = 2 * wxy + 1;
 
-  // The discretised scan at every yaw (cells relative to the raster's cell (0, 0)).
   // The discretised scan at every yaw (cells relative to the raster's cell (0, 0)), with the
   // cells' bounding box per yaw.
   std::vector<Eigen::Array2i> cells(static_cast<std::size_t>(num_angles) * n);
@@ -172,49 +180,6 @@ std::optional<MatchResult> CorrelativeMatcher::Match(std::span<const Eigen::Vect
     return (static_cast<std::int64_t>(k + wk) * side + (j + wxy)) * side + (i + wxy);
   };
 
-  // Best so far: the sum to beat (min_score until a pose reaches it) and its search index.
-  float best_sum = static_cast<float>(options_.min_score * n);
-  std::int64_t best_index = -1;
-  Node best;
-  std::int64_t nodes_scored = 0;
-  auto pruned = [&](const Node& node) {
-    return node.bound < best_sum ||
-           (best_index >= 0 && node.bound == best_sum && node.index >= best_index);
-  };
-
-  // Depth-first branch and bound (Hess 2016, Sec. V-A), recursive over the levels.
-  auto descend = [&](auto&& self, const Node& node, int level) -> void {
-    if (level == 0) {
-      if (node.bound > best_sum ||
-          (node.bound == best_sum && (best_index < 0 || node.index < best_index))) {
-        best_sum = node.bound;
-        best_index = node.index;
-        best = node;
-      }
-      return;
-    }
-    const int half = 1 << (level - 1);
-    Node children[4];
-    int count = 0;
-    for (const int dj : {0, half}) {
-      for (const int di : {0, half}) {
-        const int i = node.i + di, j = node.j + dj;
-        if (i > wxy || j > wxy) continue;
-        children[count++] =
-            Node{node.k, i, j, score(level - 1, node.k, i, j), index_of(node.k, i, j)};
-      }
-    }
-    nodes_scored += count;
-    for (int a = 1; a < count; ++a) {  // insertion sort of at most four
-      for (int b = a; b > 0 && BetterFirst(children[b], children[b - 1]); --b) {
-        std::swap(children[b], children[b - 1]);
-      }
-    }
-    for (int c = 0; c < count; ++c) {
-      if (!pruned(children[c])) self(self, children[c], level - 1);
-    }
-  };
-
   const int top = options_.branch_and_bound_depth - 1;
   const int block = 1 << top;
   std::vector<Node> roots;
@@ -225,48 +190,119 @@ std::optional<MatchResult> CorrelativeMatcher::Match(std::span<const Eigen::Vect
       }
     }
   }
-  nodes_scored += static_cast<std::int64_t>(roots.size());
   std::sort(roots.begin(), roots.end(), BetterFirst);
-  for (const Node& root : roots) {
-    if (root.bound < best_sum) break;  // sorted: every later root is bounded lower still
-    if (!pruned(root)) descend(descend, root, top);
+  // Greedy non-maximum suppression: each search is the exact branch and bound over the poses
+  // outside the neighbourhoods of the results before it.
+  std::vector<Node> found;
+  std::int64_t nodes_scored = static_cast<std::int64_t>(roots.size());
+  while (static_cast<int>(found.size()) < count) {
+    // Best so far: the sum to beat (min_score until a pose reaches it) and its search index.
+    float best_sum = static_cast<float>(options_.min_score * n);
+    std::int64_t best_index = -1;
+    Node best;
+    // A block of 2^level cells lies wholly within an earlier result's neighbourhood: its corners
+    // do (the neighbourhood is a disc in x and y), at a yaw within min_angle_rad of the result's.
+    auto excluded = [&](const Node& node, int level) {
+      const int last = (1 << level) - 1;
+      const int i1 = std::min(node.i + last, wxy), j1 = std::min(node.j + last, wxy);
+      for (const Node& e : found) {
+        if (std::abs(NormalizeAngle((node.k - e.k) * step)) > min_angle_rad) continue;
+        bool inside = true;
+        for (const int i : {node.i, i1}) {
+          for (const int j : {node.j, j1}) {
+            inside = inside &&
+                     std::hypot((i - e.i) * resolution_, (j - e.j) * resolution_) <= min_distance_m;
+          }
+        }
+        if (inside) return true;
+      }
+      return false;
+    };
+    auto pruned = [&](const Node& node, int level) {
+      return node.bound < best_sum ||
+             (best_index >= 0 && node.bound == best_sum && node.index >= best_index) ||
+             (!found.empty() && excluded(node, level));
+    };
+
+    // Depth-first branch and bound (Hess 2016, Sec. V-A), recursive over the levels.
+    auto descend = [&](auto&& self, const Node& node, int level) -> void {
+      if (level == 0) {
+        if (!found.empty() && excluded(node, 0)) return;
+        if (node.bound > best_sum ||
+            (node.bound == best_sum && (best_index < 0 || node.index < best_index))) {
+          best_sum = node.bound;
+          best_index = node.index;
+          best = node;
+        }
+        return;
+      }
+      const int half = 1 << (level - 1);
+      Node children[4];
+      int num_children = 0;
+      for (const int dj : {0, half}) {
+        for (const int di : {0, half}) {
+          const int i = node.i + di, j = node.j + dj;
+          if (i > wxy || j > wxy) continue;
+          children[num_children++] =
+              Node{node.k, i, j, score(level - 1, node.k, i, j), index_of(node.k, i, j)};
+        }
+      }
+      nodes_scored += num_children;
+      for (int a = 1; a < num_children; ++a) {  // insertion sort of at most four
+        for (int b = a; b > 0 && BetterFirst(children[b], children[b - 1]); --b) {
+          std::swap(children[b], children[b - 1]);
+        }
+      }
+      for (int c = 0; c < num_children; ++c) {
+        if (!pruned(children[c], level - 1)) self(self, children[c], level - 1);
+      }
+    };
+
+    for (const Node& root : roots) {
+      if (root.bound < best_sum) break;  // sorted: every later root is bounded lower still
+      if (!pruned(root, top)) descend(descend, root, top);
+    }
+
+    if (best_index < 0) break;
+    found.push_back(best);
   }
-  if (best_index < 0) return std::nullopt;
+  for (const Node& best : found) {
+    MatchResult result;
+    result.pose = Pose2(initial.x() + best.i * resolution_, initial.y() + best.j * resolution_,
+                        initial.theta() + best.k * step);
+    result.score = static_cast<double>(best.bound) / n;
+    result.iterations = static_cast<int>(std::min<std::int64_t>(nodes_scored, 1 << 30));
+    result.correspondences = n;
+    result.converged = true;
 
-  MatchResult result;
-  result.pose = Pose2(initial.x() + best.i * resolution_, initial.y() + best.j * resolution_,
-                      initial.theta() + best.k * step);
-  result.score = static_cast<double>(best_sum) / n;
-  result.iterations = static_cast<int>(std::min<std::int64_t>(nodes_scored, 1 << 30));
-  result.correspondences = n;
-  result.converged = true;
-
-  // Covariance from the score-weighted spread around the best (Olson 2009), with the
-  // offsets relative to the best pose so the sums stay well conditioned.
-  const int cc = options_.covariance_half_cells, cs = options_.covariance_half_steps;
-  Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  double total = 0.0;
-  for (int dk = -cs; dk <= cs; ++dk) {
-    const int k = best.k + dk;
-    if (k < -wk || k > wk) continue;
-    for (int dj = -cc; dj <= cc; ++dj) {
-      for (int di = -cc; di <= cc; ++di) {
-        const double s = static_cast<double>(score(0, k, best.i + di, best.j + dj)) / n;
-        const double w = std::exp((s - result.score) / options_.covariance_score_scale);
-        const Eigen::Vector3d x(di * resolution_, dj * resolution_, dk * step);
-        total += w;
-        mean += w * x;
-        moment += w * x * x.transpose();
+    // Covariance from the score-weighted spread around the best (Olson 2009), with the
+    // offsets relative to the best pose so the sums stay well conditioned.
+    const int cc = options_.covariance_half_cells, cs = options_.covariance_half_steps;
+    Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    double total = 0.0;
+    for (int dk = -cs; dk <= cs; ++dk) {
+      const int k = best.k + dk;
+      if (k < -wk || k > wk) continue;
+      for (int dj = -cc; dj <= cc; ++dj) {
+        for (int di = -cc; di <= cc; ++di) {
+          const double s = static_cast<double>(score(0, k, best.i + di, best.j + dj)) / n;
+          const double w = std::exp((s - result.score) / options_.covariance_score_scale);
+          const Eigen::Vector3d x(di * resolution_, dj * resolution_, dk * step);
+          total += w;
+          mean += w * x;
+          moment += w * x * x.transpose();
+        }
       }
     }
+    mean /= total;
+    result.covariance = moment / total - mean * mean.transpose();
+    result.covariance(0, 0) += resolution_ * resolution_ / 12.0;
+    result.covariance(1, 1) += resolution_ * resolution_ / 12.0;
+    result.covariance(2, 2) += step * step / 12.0;
+    results.push_back(result);
   }
-  mean /= total;
-  result.covariance = moment / total - mean * mean.transpose();
-  result.covariance(0, 0) += resolution_ * resolution_ / 12.0;
-  result.covariance(1, 1) += resolution_ * resolution_ / 12.0;
-  result.covariance(2, 2) += step * step / 12.0;
-  return result;
+  return results;
 }
 
 }  // namespace slamrig::slam

@@ -76,6 +76,14 @@ class CorrelativeMatcher {
   std::optional<MatchResult> Match(std::span<const Eigen::Vector2d> points_base,
                                    const Pose2& initial) const;
 
+  /// Up to `count` best poses of the window that are distinct places, best first (greedy
+  /// non-maximum suppression, each search exact): the first is Match's, and each next one is the
+  /// best pose farther than `min_distance_m` in x and y or `min_angle_rad` in yaw from every
+  /// earlier one. Fewer when fewer reach min_score. `iterations` counts the nodes of all searches.
+  std::vector<MatchResult> MatchDistinct(std::span<const Eigen::Vector2d> points_base,
+                                         const Pose2& initial, int count, double min_distance_m,
+                                         double min_angle_rad) const;
+
   /// The yaw step Match uses for `points_base`.
   double AngularStep(std::span<const Eigen::Vector2d> points_base) const;
 

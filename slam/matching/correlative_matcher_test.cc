@@ -17,11 +17,14 @@ using testing::SegmentWorld;
 
 // Independent exhaustive search over the window, as CorrelativeMatcher's header defines it: every
 // yaw k, every (j, i) in order, the float sum of the raster at the discretised points; the first
-// strictly better pose wins, so ties go to the smallest (k, j, i).
+// strictly better pose wins, so ties go to the smallest (k, j, i). Poses within `distance_m` and
+// `angle_rad` of one of `excluded` are skipped.
 std::optional<MatchResult> ExhaustiveSearch(const GridView& raster,
                                             const std::vector<Eigen::Vector2d>& points,
                                             const Pose2& initial, int wxy, int wk, double step,
-                                            double min_score) {
+                                            double min_score,
+                                            const std::vector<Pose2>& excluded = {},
+                                            double distance_m = 0.0, double angle_rad = 0.0) {
   const int n = static_cast<int>(points.size());
   std::optional<MatchResult> best;
   float best_sum = 0.0f;
@@ -40,10 +43,17 @@ std::optional<MatchResult> ExhaustiveSearch(const GridView& raster,
         for (const Eigen::Array2i& c : cells) sum += raster.At(c.x() + i, c.y() + j);
         if (static_cast<double>(sum) < min_score * n) continue;
         if (best && !(sum > best_sum)) continue;
+        const Pose2 pose(initial.x() + i * raster.resolution, initial.y() + j * raster.resolution,
+                         initial.theta() + k * step);
+        bool near = false;
+        for (const Pose2& e : excluded) {
+          near = near || ((pose.translation() - e.translation()).norm() <= distance_m &&
+                          std::abs(NormalizeAngle(pose.theta() - e.theta())) <= angle_rad);
+        }
+        if (near) continue;
         best_sum = sum;
         best = MatchResult{};
-        best->pose = Pose2(initial.x() + i * raster.resolution, initial.y() + j * raster.resolution,
-                           initial.theta() + k * step);
+        best->pose = pose;
         best->score = static_cast<double>(sum) / n;
       }
     }
@@ -106,6 +116,56 @@ TEST(CorrelativeMatcherTest, BranchAndBoundEqualsExhaustiveSearch) {
     EXPECT_EQ(fast->score, slow->score) << trial;
   }
   EXPECT_GT(found, 30);
+}
+
+// The distinct places are the greedy non-maximum suppression of the exhaustive search: each is
+// the best pose outside the neighbourhoods of those before it, on random rasters, at every depth.
+TEST(CorrelativeMatcherTest, DistinctPlacesAreTheExhaustiveSearchsSuppressedMaxima) {
+  RandomEngine rng(22);
+  int second = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const int width = 30 + static_cast<int>(20 * Uniform01(rng));
+    const int height = 30 + static_cast<int>(20 * Uniform01(rng));
+    std::vector<float> values(static_cast<std::size_t>(width) * height);
+    const bool ties = trial % 2 == 1;
+    for (float& v : values) {
+      const double u = Uniform01(rng);
+      v = ties ? static_cast<float>(std::floor(3.0 * u) / 2.0) : static_cast<float>(u * u);
+    }
+    const GridView raster{values.data(), width, height, Eigen::Vector2d(-1.0, -0.9), 0.05};
+    std::vector<Eigen::Vector2d> points;
+    for (int p = 0; p < 25; ++p)
+      points.emplace_back(1.6 * Uniform01(rng) - 0.8, 1.6 * Uniform01(rng) - 0.8);
+    CorrelativeMatcherOptions options;
+    options.linear_window_m = 0.3 + 0.2 * Uniform01(rng);
+    options.angular_window_rad = 0.2;
+    options.angular_step_rad = 0.04;
+    options.branch_and_bound_depth = 1 + trial % 6;
+    options.min_score = trial % 4 == 0 ? 0.7 : 0.0;
+    const CorrelativeMatcher matcher(options, raster);
+    const Pose2 initial(0.3 * Uniform01(rng), 0.3 * Uniform01(rng), 6.0 * Uniform01(rng));
+    const double distance_m = 0.12 + 0.1 * Uniform01(rng), angle_rad = trial % 3 == 0 ? 0.1 : 1.0;
+    const std::vector<MatchResult> fast =
+        matcher.MatchDistinct(points, initial, 4, distance_m, angle_rad);
+    const int wxy = static_cast<int>(std::ceil(options.linear_window_m / 0.05 - 1e-9));
+    std::vector<Pose2> earlier;
+    for (int r = 0; r < 4; ++r) {
+      const std::optional<MatchResult> slow = ExhaustiveSearch(
+          raster, points, initial, wxy, 5, 0.04, options.min_score, earlier, distance_m, angle_rad);
+      ASSERT_EQ(static_cast<int>(fast.size()) > r, slow.has_value()) << trial << " " << r;
+      if (!slow) break;
+      EXPECT_EQ(fast[static_cast<std::size_t>(r)].pose, slow->pose) << trial << " " << r;
+      EXPECT_EQ(fast[static_cast<std::size_t>(r)].score, slow->score) << trial << " " << r;
+      earlier.push_back(slow->pose);
+      second += r == 1;
+    }
+    const std::optional<MatchResult> single = matcher.Match(points, initial);
+    ASSERT_EQ(single.has_value(), !fast.empty());
+    if (single) {
+      EXPECT_EQ(single->pose, fast.front().pose);
+    }
+  }
+  EXPECT_GT(second, 20);
 }
 
 // On a map of the office, a decimated scan is found from an initial guess metres and up to pi off.
