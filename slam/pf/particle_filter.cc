@@ -187,8 +187,7 @@ bool ParticleFilter::TrackQuality(double quality, Time now) {
     lost_since_ = now;
     lost_pose_ = last_step_.best_pose;
     ++lost_count_;
-    candidate_.reset();
-    confirmations_ = 0;
+    ClearCandidates();
     unsupported_updates_ = 0;
     global_matcher_.reset();
     near_matcher_.reset();
@@ -225,29 +224,53 @@ bool ParticleFilter::Relocalise(const std::vector<Eigen::Vector2d>& points, cons
     return (a.translation() - b.translation()).norm() <= o.confirm_distance_m &&
            std::abs(NormalizeAngle(a.theta() - b.theta())) <= o.confirm_angle_rad;
   };
-  // The candidate of the previous updates, carried by the odometry (AddScan), must explain this
-  // scan where the odometry put it: matched locally, it stays within confirm_distance_m and
+  auto distinct = [&](const Pose2& a, const Pose2& b) {
+    return (a.translation() - b.translation()).norm() > o.distinct_radius_m ||
+           std::abs(NormalizeAngle(a.theta() - b.theta())) > o.distinct_angle_rad;
+  };
+  // The places of the previous updates, carried by the odometry (AddScan), must explain this scan
+  // where the odometry put them: matched locally, each stays within confirm_distance_m and
   // confirm_angle_rad of that prediction and fits as well as a place must. A wrong place that
   // happens to fit one scan (an aliased corridor) rarely fits the next ones at the same relative
-  // pose. Without a candidate the whole map is searched.
-  std::optional<ScoredPose> found;
-  if (candidate_) {
-    const ScoredPose followed = LocalMatch(points, *candidate_);
-    if (same_place(followed.pose, *candidate_) &&
-        followed.quality >= o.accept_ratio * quality_slow_) {
-      found = followed;
-    } else {
-      candidate_.reset();
-      confirmations_ = 0;
+  // pose. Two that converge on one place are one.
+  std::vector<Candidate> places;
+  for (const Candidate& c : candidates_) {
+    const ScoredPose followed = LocalMatch(points, c.pose);
+    if (!same_place(followed.pose, c.pose) || followed.quality < o.accept_ratio * quality_slow_) {
+      continue;
+    }
+    bool merged = false;
+    for (Candidate& p : places) {
+      if (distinct(p.pose, followed.pose)) continue;
+      merged = true;
+      if (followed.quality > p.quality) p = Candidate{followed.pose, followed.quality, c.wins};
+    }
+    if (!merged) places.push_back(Candidate{followed.pose, followed.quality, c.wins});
+  }
+  // The whole map is searched on every lost update for its best distinct places, so that a place
+  // is judged against the best other explanation of this scan, not only against the ones it
+  // was found with.
+  std::vector<Eigen::Vector2d> near;
+  for (const Eigen::Vector2d& p : points) {
+    if (p.norm() <= o.search_max_range_m) near.push_back(p);
+  }
+  if (near.size() >= 10) {
+    for (const ScoredPose& g : GlobalMatches(near, points)) {
+      bool known = false;
+      for (const Candidate& p : places) known = known || !distinct(p.pose, g.pose);
+      if (!known) places.push_back(Candidate{g.pose, g.quality, 0});
     }
   }
-  if (!found) {
-    std::vector<Eigen::Vector2d> near;
-    for (const Eigen::Vector2d& p : points) {
-      if (p.norm() <= o.search_max_range_m) near.push_back(p);
+  // The leading place, and the best of the others.
+  const Candidate* found = nullptr;
+  double rival_quality = 0.0;
+  for (const Candidate& p : places) {
+    if (!found || p.quality > found->quality) {
+      if (found) rival_quality = std::max(rival_quality, found->quality);
+      found = &p;
+    } else {
+      rival_quality = std::max(rival_quality, p.quality);
     }
-    if (near.size() >= 10) found = GlobalMatch(near, points);
-    confirmations_ = 0;
   }
   // The tracked hypothesis is the best explanation near the filter, not only at its pose: the
   // odometry may have slipped by more than the shift search covers (a wheel on a threshold,
@@ -271,8 +294,7 @@ bool ParticleFilter::Relocalise(const std::vector<Eigen::Vector2d>& points, cons
     return false;
   }
   if (!elsewhere) {
-    candidate_.reset();
-    confirmations_ = 0;
+    ClearCandidates();
     ++unsupported_updates_;
     // The test is sequential both ways: a place elsewhere must win on confirm_updates updates in
     // a row, and resume_updates updates in a row on which nothing elsewhere fits better keep the
@@ -289,32 +311,44 @@ bool ParticleFilter::Relocalise(const std::vector<Eigen::Vector2d>& points, cons
     GiveUpWhenLostTooLong(scan, step);
     return true;
   }
-  ++confirmations_;
   unsupported_updates_ = 0;
-  candidate_ = found->pose;
-  if (confirmations_ < o.confirm_updates) {
+  // A place elsewhere wins, but it wins outright only when no other distinct place fits nearly
+  // as well: aliased bays keep the filter lost, every place still followed, until the scans
+  // tell them apart.
+  const bool clear = found->quality >= rival_quality + o.ambiguity_margin * quality_slow_;
+  const Candidate winner = *found;
+  for (Candidate& p : places) p.wins = 0;
+  candidates_ = std::move(places);
+  if (!clear) {
+    GiveUpWhenLostTooLong(scan, step);
+    return true;
+  }
+  const int wins = winner.wins + 1;
+  for (Candidate& p : candidates_) {
+    if (p.pose == winner.pose) p.wins = wins;
+  }
+  if (wins < o.confirm_updates) {
     GiveUpWhenLostTooLong(scan, step);
     return true;
   }
   const double uniform = 1.0 / options_.num_particles;
   for (Particle& p : particles_) {
-    p.pose = Pose2(found->pose.x() + o.reset_sigma_xy_m * StandardNormal(rng_),
-                   found->pose.y() + o.reset_sigma_xy_m * StandardNormal(rng_),
-                   found->pose.theta() + o.reset_sigma_yaw_rad * StandardNormal(rng_));
+    p.pose = Pose2(winner.pose.x() + o.reset_sigma_xy_m * StandardNormal(rng_),
+                   winner.pose.y() + o.reset_sigma_xy_m * StandardNormal(rng_),
+                   winner.pose.theta() + o.reset_sigma_yaw_rad * StandardNormal(rng_));
     p.weight = uniform;
   }
   std::fill(log_weights_.begin(), log_weights_.end(), 0.0);
   lost_ = false;
-  candidate_.reset();
-  confirmations_ = 0;
+  ClearCandidates();
   global_matcher_.reset();
   near_matcher_.reset();
   quality_fast_ = quality_slow_;
   ++relocalisation_count_;
   step->lost = false;
   step->relocalised = true;
-  step->best_pose = found->pose;
-  step->mean_pose = found->pose;
+  step->best_pose = winner.pose;
+  step->mean_pose = winner.pose;
   step->neff = static_cast<double>(options_.num_particles);
   return true;
 }
@@ -338,10 +372,11 @@ double ParticleFilter::ObservedFraction(const std::vector<Eigen::Vector2d>& poin
   return static_cast<double>(known) / static_cast<double>(points.size());
 }
 
+void ParticleFilter::ClearCandidates() { candidates_.clear(); }
+
 void ParticleFilter::ResumeTracking() {
   lost_ = false;
-  candidate_.reset();
-  confirmations_ = 0;
+  ClearCandidates();
   global_matcher_.reset();
   near_matcher_.reset();
   quality_fast_ = quality_slow_;
@@ -352,8 +387,7 @@ void ParticleFilter::GiveUpWhenLostTooLong(const LaserScan& scan, ParticleFilter
   if (SecondsBetween(scan.time, lost_since_) <= options_.relocalisation.max_lost_s) return;
   // Nowhere on the map fits: the robot is somewhere new, map on from the odometry.
   lost_ = false;
-  candidate_.reset();
-  confirmations_ = 0;
+  ClearCandidates();
   global_matcher_.reset();
   near_matcher_.reset();
   tracked_updates_ = 0;
@@ -377,7 +411,7 @@ ParticleFilter::ScoredPose ParticleFilter::LocalMatch(const std::vector<Eigen::V
   return {refined.pose, Quality(static_cast<float>(refined.score), points.size())};
 }
 
-std::optional<ParticleFilter::ScoredPose> ParticleFilter::GlobalMatch(
+std::vector<ParticleFilter::ScoredPose> ParticleFilter::GlobalMatches(
     const std::vector<Eigen::Vector2d>& near, const std::vector<Eigen::Vector2d>& points) {
   const RelocalisationOptions& o = options_.relocalisation;
   if (!global_matcher_) {
@@ -395,10 +429,15 @@ std::optional<ParticleFilter::ScoredPose> ParticleFilter::GlobalMatch(
     m.min_score = 0.0;
     global_matcher_ = std::make_unique<CorrelativeMatcher>(m, map_);
   }
-  const std::optional<MatchResult> match =
-      global_matcher_->Match(near, Pose2(search_centre_.x(), search_centre_.y(), 0.0));
-  if (!match) return std::nullopt;
-  return AcceptedPlace(points, match->pose);
+  std::vector<ScoredPose> places;
+  for (const MatchResult& match : global_matcher_->MatchDistinct(
+           near, Pose2(search_centre_.x(), search_centre_.y(), 0.0), o.global_candidates,
+           o.distinct_radius_m, o.distinct_angle_rad)) {
+    if (const std::optional<ScoredPose> place = AcceptedPlace(points, match.pose)) {
+      places.push_back(*place);
+    }
+  }
+  return places;
 }
 
 std::optional<ParticleFilter::ScoredPose> ParticleFilter::NearMatch(
@@ -456,7 +495,7 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
   const Pose2 raw_motion = pending_motion_;
   const Pose2 motion = calibration_.Correct(raw_motion);
   Predict(motion);
-  if (candidate_) candidate_ = *candidate_ * motion;
+  for (Candidate& c : candidates_) c.pose = c.pose * motion;
   pending_motion_ = Pose2();
   step.updated = true;
 

@@ -80,6 +80,8 @@ class ParticleFilter {
     Pose2 pose;
     double quality = 0.0;
   };
+  // Forgets the places followed while lost.
+  void ClearCandidates();
   // One update while lost; false when tracking resumes and the scan is to be filtered as usual.
   bool Relocalise(const std::vector<Eigen::Vector2d>& points, const LaserScan& scan,
                   ParticleFilterStep* step);
@@ -93,7 +95,8 @@ class ParticleFilter {
   // must (accept_ratio).
   std::optional<ScoredPose> NearMatch(const std::vector<Eigen::Vector2d>& points,
                                       const Pose2& pose);
-  std::optional<ScoredPose> GlobalMatch(const std::vector<Eigen::Vector2d>& near,
+  // Up to global_candidates distinct places on the whole map, each accepted as a place.
+  std::vector<ScoredPose> GlobalMatches(const std::vector<Eigen::Vector2d>& near,
                                         const std::vector<Eigen::Vector2d>& points);
   // `pose` refined on the likelihood field with all `points`, when it fits as a place must
   // (accept_ratio x the long-term quality): the judgement of both searches above.
@@ -125,9 +128,14 @@ class ParticleFilter {
   Time lost_since_;
   Pose2 lost_pose_;  // the best pose at the last update before the loss
   Eigen::Vector2d search_centre_ = Eigen::Vector2d::Zero();
-  std::optional<Pose2> candidate_;  // the last global match, carried by the odometry
-  int confirmations_ = 0;           // lost updates in a row whose global matches agree
-  int unsupported_updates_ = 0;     // lost updates in a row with no place elsewhere winning
+  // A place elsewhere on the map, carried by the odometry from update to update.
+  struct Candidate {
+    Pose2 pose;
+    double quality = 0.0;  // on the latest update
+    int wins = 0;          // lost updates in a row on which it won clearly
+  };
+  std::vector<Candidate> candidates_;  // distinct places, followed while lost
+  int unsupported_updates_ = 0;        // lost updates in a row with no place elsewhere winning
   std::unique_ptr<CorrelativeMatcher> global_matcher_;
   std::unique_ptr<CorrelativeMatcher> near_matcher_;  // within slip_radius_m of the filter
   int lost_count_ = 0;

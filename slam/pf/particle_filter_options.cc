@@ -40,6 +40,14 @@ std::vector<std::string> RelocalisationOptions::Validate() const {
   if (confirm_updates < 1) {
     errors.push_back(Rule("confirm_updates", confirm_updates, "must be >= 1"));
   }
+  if (global_candidates < 1) {
+    errors.push_back(Rule("global_candidates", global_candidates, "must be >= 1"));
+  }
+  positive("distinct_radius_m", distinct_radius_m);
+  positive("distinct_angle_rad", distinct_angle_rad);
+  if (!(ambiguity_margin >= 0.0)) {
+    errors.push_back(Rule("ambiguity_margin", ambiguity_margin, "must be >= 0"));
+  }
   if (resume_updates < 1) errors.push_back(Rule("resume_updates", resume_updates, "must be >= 1"));
   positive("search_max_range_m", search_max_range_m);
   positive("search_window_m", search_window_m);

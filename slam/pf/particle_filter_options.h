@@ -66,6 +66,17 @@ struct RelocalisationOptions {
   /// is put there. 2 updates relocalise the kidnapped office within 1.8 s.
   double win_margin = 0.1;
   int confirm_updates = 2;
+  /// The global search returns this many distinct places (non-maximum suppression: apart by more
+  /// than distinct_radius_m in x and y or distinct_angle_rad in heading), and each is followed
+  /// through the odometry like the one before: in a building whose rooms repeat, the best place
+  /// on a frozen map may be the neighbouring bay by a few per cent.
+  int global_candidates = 3;
+  double distinct_radius_m = 1.0;
+  double distinct_angle_rad = 0.5;
+  /// The winning place must also beat every other distinct place of the update (followed or just
+  /// found) by this fraction of the long-term quality; while two fit alike the filter stays lost
+  /// and waits for a scan that tells them apart (or for max_lost_s).
+  double ambiguity_margin = 0.05;
   /// Lost updates in a row on which no place elsewhere wins after which tracking resumes where
   /// the filter is, however poorly it fits there: no evidence for a kidnapping came. Intel,
   /// falsely lost once at 2263 s: 0.186 m ATE with 4, 0.171 with 2 (0.174 with relocalisation off).
@@ -102,6 +113,10 @@ void VisitFields(V& v, RelocalisationOptions& o) {
   v("confirm_angle_rad", o.confirm_angle_rad);
   v("win_margin", o.win_margin);
   v("confirm_updates", o.confirm_updates);
+  v("global_candidates", o.global_candidates);
+  v("distinct_radius_m", o.distinct_radius_m);
+  v("distinct_angle_rad", o.distinct_angle_rad);
+  v("ambiguity_margin", o.ambiguity_margin);
   v("resume_updates", o.resume_updates);
   v("slip_radius_m", o.slip_radius_m);
   v("slip_angle_rad", o.slip_angle_rad);
