@@ -34,7 +34,7 @@ Rbpf::Rbpf(const RbpfOptions& options)
 
 void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
                           const std::vector<MatchPoint>& points, const LaserScan& scan,
-                          std::uint64_t seed, bool* failed) const {
+                          double weight_exponent, std::uint64_t seed, bool* failed) const {
   RandomEngine rng(seed);
   const Pose2 predicted = particle.pose * motion;
   // Not a structured binding: clang 14 (the fuzz build) refuses one captured by a lambda.
@@ -106,10 +106,19 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
     drawn = Pose2(match.pose.x() + d.x(), match.pose.y() + d.y(), match.pose.theta() + d.z());
   }
   particle.pose = drawn;
-  particle.log_weight += options_.weight_exponent * log_eta;
+  particle.log_weight += weight_exponent * log_eta;
   particle.path_log_likelihood += log_eta;
   particle.map.InsertScan(scan, drawn);
   particle.history = std::make_shared<RbpfPoseNode>(drawn, std::move(particle.history));
+}
+
+double Rbpf::WeightExponent(const std::vector<MatchPoint>& points) const {
+  const double length = options_.weight_correlation_length_m;
+  if (!(length > 0.0) || points.empty()) return options_.weight_exponent;
+  // The same factor for every particle (the points are in the base frame): it rescales every
+  // log-weight increment alike, so the particles' order by weight is unchanged.
+  const double independent = CountIndependentPoints(points, length);
+  return options_.weight_exponent * std::min(1.0, independent / static_cast<double>(points.size()));
 }
 
 std::pair<double, double> Rbpf::MotionSigmas(const Pose2& motion) const {
@@ -283,12 +292,14 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
     motion = CheckOdometry(pending, points, &step.odometry_rejected);
     odometry_rejections_ += step.odometry_rejected;
   }
+  const double weight_exponent = WeightExponent(points);
+  step.weight_exponent = weight_exponent;
   std::vector<char> failed(static_cast<std::size_t>(n), 0);
   auto update_block = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
       const auto k = static_cast<std::size_t>(i);
       bool f = false;
-      UpdateParticle(particles_[k], motion, points, scan, seeds[k], &f);
+      UpdateParticle(particles_[k], motion, points, scan, weight_exponent, seeds[k], &f);
       failed[k] = f;
     }
   };

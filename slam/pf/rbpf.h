@@ -50,6 +50,9 @@ struct RbpfStep {
   double matched_fraction = 0.0;  ///< of the best particle's scan points, at its new pose
   /// The odometry check replaced the increment by the best particle's wide match.
   bool odometry_rejected = false;
+  /// The exponent the weights took this update (weight_exponent times the independent-point
+  /// factor of weight_correlation_length_m).
+  double weight_exponent = 1.0;
 };
 
 /// A Rao-Blackwellised particle filter with per-particle maps, GMapping's method (Grisetti,
@@ -86,7 +89,7 @@ class Rbpf {
   /// Moves particle `i` by `motion`, draws its pose from the proposal, updates its map.
   void UpdateParticle(RbpfParticle& particle, const Pose2& motion,
                       const std::vector<MatchPoint>& points, const LaserScan& scan,
-                      std::uint64_t seed, bool* failed) const;
+                      double weight_exponent, std::uint64_t seed, bool* failed) const;
   void Resample(const std::vector<double>& weights);
   /// The odometry check: `motion`, or the increment the best particle's wide match gives where
   /// the mixture model finds that more likely (then `*rejected` is set).
@@ -96,6 +99,8 @@ class Rbpf {
   /// cannot place the robot (odometry_degenerate_ratio).
   Pose2 RemapDegenerate(const TiledGrid& map, const std::vector<MatchPoint>& points,
                         const Pose2& near, const Pose2& far) const;
+  /// weight_exponent times min(1, independent points / points) (weight_correlation_length_m).
+  double WeightExponent(const std::vector<MatchPoint>& points) const;
   /// The motion model's standard deviations (x, y each; yaw) for an increment.
   std::pair<double, double> MotionSigmas(const Pose2& motion) const;
 

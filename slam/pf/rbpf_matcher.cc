@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <unordered_map>
 
 #include "slam/types/validation.h"
 
@@ -64,6 +66,40 @@ std::vector<MatchPoint> MakeMatchPoints(const LaserScan& scan, const ScanPointsO
     out.push_back({hit, hit - along * (free_offset_m / length)});
   }
   return out;
+}
+
+int CountIndependentPoints(std::span<const MatchPoint> points, double length_m) {
+  if (!(length_m > 0.0)) return static_cast<int>(points.size());
+  // The kept points hashed by their cell of side length_m: a point within length_m of a kept one
+  // has it in its own cell or one of the eight around it.
+  const double inv = 1.0 / length_m;
+  const double l2 = length_m * length_m;
+  auto key = [](std::int64_t x, std::int64_t y) {
+    return static_cast<std::uint64_t>(x) * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint64_t>(y);
+  };
+  std::unordered_map<std::uint64_t, std::vector<Eigen::Vector2d>> kept;
+  int count = 0;
+  for (const MatchPoint& p : points) {
+    const auto cx = static_cast<std::int64_t>(std::floor(p.hit.x() * inv));
+    const auto cy = static_cast<std::int64_t>(std::floor(p.hit.y() * inv));
+    bool near = false;
+    for (std::int64_t dy = -1; dy <= 1 && !near; ++dy) {
+      for (std::int64_t dx = -1; dx <= 1 && !near; ++dx) {
+        const auto it = kept.find(key(cx + dx, cy + dy));
+        if (it == kept.end()) continue;
+        for (const Eigen::Vector2d& q : it->second) {
+          if ((q - p.hit).squaredNorm() < l2) {
+            near = true;
+            break;
+          }
+        }
+      }
+    }
+    if (near) continue;
+    kept[key(cx, cy)].push_back(p.hit);
+    ++count;
+  }
+  return count;
 }
 
 RbpfMatcher::RbpfMatcher(const RbpfMatcherOptions& options)

@@ -76,6 +76,14 @@ struct MatchPoint {
 std::vector<MatchPoint> MakeMatchPoints(const LaserScan& scan, const ScanPointsOptions& points,
                                         double free_offset_m);
 
+/// How many of `points`' end points are independent evidence at correlation length `length_m`:
+/// the size of the subset kept when, in beam order, a point is kept if it is at least `length_m`
+/// from every point kept before it (a maximal `length_m`-separated subset, the packing number of
+/// the end points at that scale). Dense beams along a wall of length l give about l / length_m + 1,
+/// points farther apart than `length_m` count one each. 0 for no points; all of them for
+/// `length_m` <= 0. Invariant under rotations and translations of the scan; deterministic.
+int CountIndependentPoints(std::span<const MatchPoint> points, double length_m);
+
 /// A scan evaluated at one pose against one map.
 struct MatchFit {
   double score = 0.0;           ///< sum of exp(-d^2 / (2 score_sigma^2)) over matched points

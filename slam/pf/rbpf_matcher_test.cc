@@ -127,5 +127,94 @@ TEST(RbpfMatcherTest, MatchesWallsOnlyFromTheSideTheBeamCameFrom) {
   EXPECT_DOUBLE_EQ(none.log_likelihood, options.no_match_log_likelihood);
 }
 
+// The rule of CountIndependentPoints, without its hashing: in order, keep a point at least
+// `length` from every kept one.
+int BruteForceIndependent(const std::vector<MatchPoint>& points, double length) {
+  std::vector<Eigen::Vector2d> kept;
+  for (const MatchPoint& p : points) {
+    bool near = false;
+    for (const Eigen::Vector2d& q : kept) near = near || (q - p.hit).norm() < length;
+    if (!near) kept.push_back(p.hit);
+  }
+  return static_cast<int>(kept.size());
+}
+
+// Dense beams along one straight wall: along a line the rule keeps the first point at least
+// `length` past the last kept one, so the count is 1 + floor(l / (m d)) with m = ceil(length / d)
+// points between kept ones, about l / length + 1, whatever the wall's direction and place.
+TEST(RbpfMatcherTest, DenseWallPointsCountAsWallLengthOverCorrelationLength) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    const double length = 0.1 + 0.1 * (u(rng) + 1.0);  // 0.1 - 0.3 m
+    const double spacing = 0.013 + 0.005 * u(rng);
+    const int n = 60 + static_cast<int>(100 * (u(rng) + 1.0));
+    const double a = 3.2 * u(rng);
+    const Eigen::Vector2d start(5.0 * u(rng), 5.0 * u(rng));
+    const Eigen::Vector2d dir(std::cos(a), std::sin(a));
+    std::vector<MatchPoint> points;
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector2d hit = start + i * spacing * dir;
+      points.push_back({hit, hit});
+    }
+    const double wall = (n - 1) * spacing;
+    // The first multiple of the spacing at or beyond `length` (away from rounding edges).
+    const int step = static_cast<int>(std::ceil(length / spacing - 1e-9));
+    const int expected = 1 + (n - 1) / step;
+    EXPECT_EQ(CountIndependentPoints(points, length), expected) << trial;
+    EXPECT_NEAR(CountIndependentPoints(points, length), wall / length + 1.0,
+                wall / length * spacing / length + 1.0)
+        << trial;
+  }
+}
+
+TEST(RbpfMatcherTest, ScatteredPointsFartherApartThanTheLengthCountOneEach) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  const double length = 0.1;
+  std::vector<MatchPoint> points;
+  while (points.size() < 40) {
+    const Eigen::Vector2d p(u(rng), u(rng));
+    bool near = false;
+    for (const MatchPoint& q : points) near = near || (q.hit - p).norm() < 1.5 * length;
+    if (!near) points.push_back({p, p});
+  }
+  EXPECT_EQ(CountIndependentPoints(points, length), 40);
+  EXPECT_EQ(CountIndependentPoints(points, 0.0), 40);
+  EXPECT_EQ(CountIndependentPoints({}, length), 0);
+  // All in one spot: one piece of evidence.
+  std::vector<MatchPoint> pile(25, MatchPoint{{1.0, 2.0}, {1.0, 2.0}});
+  EXPECT_EQ(CountIndependentPoints(pile, length), 1);
+}
+
+// Random clusters of points, against the rule computed pair by pair, and the same after a rigid
+// motion of the whole scan.
+TEST(RbpfMatcherTest, IndependentCountMatchesThePairwiseRuleAndIgnoresRigidMotion) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 30; ++trial) {
+    const double length = 0.05 + 0.1 * (u(rng) + 1.0);
+    std::vector<MatchPoint> points;
+    const int clusters = 1 + trial % 7;
+    for (int c = 0; c < clusters; ++c) {
+      const Eigen::Vector2d centre(4.0 * u(rng), 4.0 * u(rng));
+      const double spread = 0.5 * (u(rng) + 1.0);
+      for (int i = 0; i < 40; ++i) {
+        const Eigen::Vector2d p = centre + spread * Eigen::Vector2d(u(rng), u(rng));
+        points.push_back({p, p});
+      }
+    }
+    const int count = CountIndependentPoints(points, length);
+    EXPECT_EQ(count, BruteForceIndependent(points, length)) << trial;
+    const Pose2 motion(10.0 * u(rng), 10.0 * u(rng), 3.1 * u(rng));
+    std::vector<MatchPoint> moved;
+    for (const MatchPoint& p : points) {
+      const Eigen::Vector2d q = motion * p.hit;
+      moved.push_back({q, q});
+    }
+    EXPECT_EQ(CountIndependentPoints(moved, length), count) << trial;
+  }
+}
+
 }  // namespace
 }  // namespace slamrig::slam

@@ -47,6 +47,7 @@ std::vector<std::string> RbpfOptions::Validate() const {
   if (!(weight_exponent > 0.0 && weight_exponent <= 1.0)) {
     errors.push_back(Rule("weight_exponent", weight_exponent, "must be in (0, 1]"));
   }
+  NonNegative("weight_correlation_length_m", weight_correlation_length_m, errors);
   if (!(odometry_failure_probability >= 0.0 && odometry_failure_probability < 1.0)) {
     errors.push_back(
         Rule("odometry_failure_probability", odometry_failure_probability, "must be in [0, 1)"));

@@ -128,6 +128,50 @@ TEST(RbpfTest, TemperedWeightsResampleLessOften) {
   EXPECT_LT(PositionRmse(tempered.online, run.run.truth), 0.1);
 }
 
+// Tempering from the independent points scales every particle's log-weight increment by one
+// factor, min(1, independent / points) for the scan: the proposals (same seed) and the particles'
+// order by weight are those of the untempered filter, and the factor is the one counted
+// independently from the scan's match points.
+TEST(RbpfTest, IndependentPointTemperingScalesEveryWeightAlike) {
+  const ShortRun& run = GetShortRun();
+  RbpfOptions options = FastOptions();
+  options.resample_neff_ratio = 0.0;  // no resampling: the particles stay in step
+  Rbpf full(options);
+  options.weight_correlation_length_m = 0.1;
+  Rbpf tempered(options);
+  int updates = 0;
+  for (const SyncedScan& s : run.scans) {
+    const RbpfStep a = full.AddScan(s.scan, s.increment);
+    const RbpfStep b = tempered.AddScan(s.scan, s.increment);
+    if (!a.updated || updates++ == 0) continue;  // the first scan only starts the maps
+    const std::vector<MatchPoint> points =
+        MakeMatchPoints(s.scan, options.points, options.map.resolution_m);
+    const double expected = std::min(1.0, static_cast<double>(CountIndependentPoints(points, 0.1)) /
+                                              static_cast<double>(points.size()));
+    EXPECT_DOUBLE_EQ(b.weight_exponent, expected);
+    EXPECT_DOUBLE_EQ(a.weight_exponent, 1.0);
+    // The office's walls are sampled densely: tempered, but not to nothing.
+    EXPECT_LT(b.weight_exponent, 0.9);
+    EXPECT_GT(b.weight_exponent, 0.1);
+    const std::vector<RbpfParticle>& pa = full.particles();
+    const std::vector<RbpfParticle>& pb = tempered.particles();
+    ASSERT_EQ(pa.size(), pb.size());
+    for (std::size_t i = 0; i < pa.size(); ++i) {
+      EXPECT_EQ(pa[i].pose.x(), pb[i].pose.x());
+      EXPECT_EQ(pa[i].pose.theta(), pb[i].pose.theta());
+      for (std::size_t j = 0; j < pa.size(); ++j) {
+        // The normalised log-weights differ by a constant: their differences scale by the factor.
+        EXPECT_NEAR(pb[i].log_weight - pb[j].log_weight,
+                    expected * (pa[i].log_weight - pa[j].log_weight),
+                    1e-9 * (1.0 + std::abs(pa[i].log_weight - pa[j].log_weight)));
+        EXPECT_EQ(pa[i].log_weight < pa[j].log_weight, pb[i].log_weight < pb[j].log_weight);
+      }
+    }
+    break;  // one update: later ones add increments with different factors
+  }
+  EXPECT_EQ(updates, 2);
+}
+
 // proposal_spread scales the draw around the proposal's mean and nothing else: the same seed gives
 // the same climb and the same Gaussian, so the half-spread pose lies halfway between the mean
 // (spread 0) and the full draw (spread 1), particle for particle.

@@ -22,6 +22,7 @@ ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
   neff_sum_ += step.neff;
   updates_ += step.updated;
   failed_matches_ += step.failed_matches;
+  if (step.updated) exponent_sum_ += step.weight_exponent;
   return {step.best_pose,
           step.mean_pose,
           {{"neff", step.neff}, {"matched_fraction", step.matched_fraction}},
@@ -56,6 +57,7 @@ std::map<std::string, double> RbpfEstimator::Statistics() const {
           {"updates", updates_},
           {"failed_matches", failed_matches_},
           {"odometry_rejections", filter_.odometry_rejections()},
+          {"mean_weight_exponent", updates_ > 0 ? exponent_sum_ / updates_ : 0.0},
           {"map_tiles", tiles},
           {"map_tiles_per_particle",
            filter_.particles().empty()

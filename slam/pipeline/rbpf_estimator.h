@@ -24,6 +24,7 @@ class RbpfEstimator final : public Estimator {
   const OccupancyGrid& map() const override;
   /// mean_neff, resamples, updates, failed_matches (particle matches that fell back on the
   /// odometry), odometry_rejections (updates whose increment the odometry check replaced),
+  /// mean_weight_exponent (the weights' exponent, RbpfStep::weight_exponent, over updates),
   /// map_tiles (distinct tiles over all particles at the end) and map_tiles_per_particle.
   std::map<std::string, double> Statistics() const override;
   EstimatorView View() const override;
@@ -37,6 +38,7 @@ class RbpfEstimator final : public Estimator {
   Pose2 offset_;
   double neff_sum_ = 0.0;
   int updates_ = 0;
+  double exponent_sum_ = 0.0;
   int failed_matches_ = 0;
   mutable OccupancyGrid map_;
   mutable int map_version_ = -1;  // update count the map was converted at
