@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "slam/matching/map_frame_drift.h"
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
@@ -96,6 +97,31 @@ double EkfEstimator::MatchScale() const {
   return std::max(1.0, std::exp(log_match_scale_));
 }
 
+Eigen::Matrix3d EkfEstimator::DerivedDrift(const IcpOdometryStep& step, const Eigen::Matrix3d& r,
+                                           bool place) {
+  keyframe_covariance_[step.keyframe_id] = r;
+  std::vector<KeyframeShare> shares;
+  shares.reserve(step.frame_weights.size());
+  for (const KeyframeWeight& w : step.frame_weights) {
+    if (place && w.id == step.keyframe_id) continue;
+    const auto it = keyframe_covariance_.find(w.id);
+    const Eigen::Matrix3d c =
+        it == keyframe_covariance_.end() ? Eigen::Matrix3d::Zero() : it->second;
+    shares.push_back(
+        {.before = w.before,
+         .after = w.after,
+         .covariance = CovarianceAtRobot(c, w.pose.translation(), step.pose.translation())});
+  }
+  // Keyframes that left the map no longer move it.
+  for (auto it = keyframe_covariance_.begin(); it != keyframe_covariance_.end();) {
+    const bool in_map = std::any_of(
+        step.frame_weights.begin(), step.frame_weights.end(),
+        [&](const KeyframeWeight& w) { return w.id == it->first && !w.after.isZero(); });
+    it = in_map ? std::next(it) : keyframe_covariance_.erase(it);
+  }
+  return FrameDriftCovariance(shares);
+}
+
 ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
   const bool first = scans_ == 0;
   ++scans_;
@@ -175,11 +201,20 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
     }
     if (feed_.saw_ticks() && (first || step.keyframe)) {
       ++keyframes_;
+      // The first keyframe is the frame itself; every other joins with its match's error.
+      const bool place = options_.place_keyframes && !first && usable;
+      const Eigen::Matrix3d drift =
+          options_.derived_map_drift
+              ? DerivedDrift(step, first ? Eigen::Matrix3d::Zero() : r, place)
+              : options_.map_drift_share * options_.map_drift_share * r;
       if (!first && !usable) {
         // The keyframe joins the map where the prior put it, along its weak direction at least.
         anchored_ = false;
       } else if (!first) {
-        ekf_.DriftMatcherFrame(options_.map_drift_share * options_.map_drift_share * r);
+        if (place && !step.frame_weights.empty()) {
+          ekf_.PlaceKeyframe(step.pose, step.frame_weights.back().after);
+        }
+        ekf_.DriftMatcherFrame(drift);
       }
       ekf_.Clone();
     }

@@ -38,6 +38,16 @@ struct EkfOptions {
   /// The local map's frame drifts as keyframes join it, each placed with its match's error: the
   /// map's pose moves by this share of that error (standard deviations) per keyframe.
   double map_drift_share = 0.45;
+  /// Instead of map_drift_share: the drift the matcher's local map composition implies
+  /// (slam/matching/map_frame_drift.h): each keyframe's share in the map's frame, from the
+  /// point-to-line information of its points the joining scan pairs with, before and after it
+  /// joins, with each keyframe's error covariance that of the match that placed it, taken as
+  /// independent. Off: on the office loop it is pessimistic (README, "EKF").
+  bool derived_map_drift = false;
+  /// With derived_map_drift: the joining keyframe's part is not noise but known, the keyframe
+  /// sits where its match put it (PoseEkf::PlaceKeyframe); only the others' shares add noise.
+  /// Off: measured with the all-points shares only, optimistic (README, "EKF").
+  bool place_keyframes = false;
   /// Also update on matches IcpOdometry calls degenerate (the prior fills their weak direction).
   bool update_on_degenerate = false;
   /// Update once per ICP keyframe; false: at every matched scan (consecutive scans meet the same
@@ -72,6 +82,8 @@ void VisitFields(V& v, EkfOptions& o) {
   v("increment_sigma_floor_yaw_rad", o.increment_sigma_floor_yaw_rad);
   v("adaptive_match_covariance", o.adaptive_match_covariance);
   v("map_drift_share", o.map_drift_share);
+  v("derived_map_drift", o.derived_map_drift);
+  v("place_keyframes", o.place_keyframes);
   v("update_on_degenerate", o.update_on_degenerate);
   v("keyframe_updates", o.keyframe_updates);
   v("slip_gate", o.slip_gate);
@@ -107,6 +119,10 @@ class EkfEstimator final : public Estimator {
  private:
   /// Matches `scan` at the filter's current pose, updates, clones; the estimate at the scan.
   ScanEstimate Correct(const LaserScan& scan);
+  /// The derived drift of the matcher's frame as the keyframe of `step` (matched with covariance
+  /// `r`) joins its map; keeps every keyframe's covariance while it is in the map.
+  /// `place`: the joining keyframe is left out (PlaceKeyframe states its part).
+  Eigen::Matrix3d DerivedDrift(const IcpOdometryStep& step, const Eigen::Matrix3d& r, bool place);
   /// The factor applied to the match covariance (the adapted one, at least 1).
   double MatchScale() const;
 
@@ -127,6 +143,8 @@ class EkfEstimator final : public Estimator {
   double log_match_scale_ = 0.0;  // the estimate of log(factor on the match covariance)
   double nis_sum_ = 0.0;
   double last_nis_ = 0.0;
+  // The match covariance (matcher frame, at its pose) each keyframe in the local map joined with.
+  std::map<int, Eigen::Matrix3d> keyframe_covariance_;
 };
 
 }  // namespace slamrig::slam

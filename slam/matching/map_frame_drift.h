@@ -1,0 +1,69 @@
+// The drift of a local map's frame as keyframes join and leave it. A scan matched against a map
+// built from K keyframes, each placed with its own error, lands where the map's points put it: to
+// first order at the information-weighted mean of the keyframes' errors, weighted by what each
+// keyframe's surviving points tell a point-to-line match (Censi, "An accurate closed-form
+// estimate of ICP's covariance", ICRA 2007: the pose's sensitivity to the reference points is
+// (J^T J)^-1 J^T, so a rigid shift of one keyframe's points moves the pose by
+// (sum_i H_i)^-1 H_j times that shift). When the map's composition changes from weights W_j to
+// W'_j the frame moves by sum_j (W'_j - W_j) e_j; as sum_j W_j = sum_j W'_j = I, a shift common
+// to all keyframes cancels and only their errors against one another remain.
+#pragma once
+
+#include <Eigen/Core>
+#include <span>
+#include <vector>
+
+namespace slamrig::slam {
+
+/// A local map's points and the keyframe each came from.
+struct LocalMapPoints {
+  std::vector<Eigen::Vector2d> points;
+  std::vector<int> keyframe;  ///< index into the keyframes the map was composed of
+};
+
+/// The points of `keyframes` (oldest first, one fixed frame), newest first and thinned to the first
+/// (so the newest) point per `voxel_m` square (0: none), as IcpOdometry's local map.
+LocalMapPoints ComposeLocalMap(std::span<const std::vector<Eigen::Vector2d>> keyframes,
+                               double voxel_m);
+
+/// The point-to-line information (PointToLineInformation) each of `keyframes` keyframes gives a
+/// match of `scan` (points in the map's frame, at the pose at `robot_xy`): the map points that
+/// are the nearest neighbour of a scan point within `max_distance_m`, once per pairing, as the
+/// match's sum runs; `map` with `normals` (one per point, or empty for point-to-point ICP: all
+/// zero). What the scan does not see carries no share.
+std::vector<Eigen::Matrix3d> KeyframeInformations(
+    const LocalMapPoints& map, std::span<const Eigen::Vector2d> normals, int keyframes,
+    std::span<const Eigen::Vector2d> scan, double max_distance_m, const Eigen::Vector2d& robot_xy);
+
+/// The information a point-to-line match of a pose at `robot_xy` gets from reference `points`
+/// with unit `normals` ((0, 0): none, skipped): sum of J^T J over the points, J = (n^T,
+/// n . perp(p - robot_xy)), in the (x, y, yaw) of that pose (IcpMatcher's parametrisation).
+Eigen::Matrix3d PointToLineInformation(std::span<const Eigen::Vector2d> points,
+                                       std::span<const Eigen::Vector2d> normals,
+                                       const Eigen::Vector2d& robot_xy);
+
+/// The share of each keyframe in the map's frame: W_j = H^-1 H_j with H = sum_j H_j, the
+/// eigenvalues of H below 1e-9 of its largest raised to that floor (IcpMatcher's rule). Sums to
+/// the identity where H is regular; all zero where H is.
+std::vector<Eigen::Matrix3d> FrameWeights(std::span<const Eigen::Matrix3d> informations);
+
+/// A keyframe pose's error covariance `covariance` (x, y, yaw at the keyframe's position
+/// `keyframe_xy`) as the error it causes in a pose at `robot_xy`: a yaw error about the keyframe
+/// moves points at the robot by yaw times the lever.
+Eigen::Matrix3d CovarianceAtRobot(const Eigen::Matrix3d& covariance,
+                                  const Eigen::Vector2d& keyframe_xy,
+                                  const Eigen::Vector2d& robot_xy);
+
+/// One keyframe's part in a change of the map: its share before and after (zero where it was
+/// not or is no longer in the map) and its error covariance at the robot.
+struct KeyframeShare {
+  Eigen::Matrix3d before = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d after = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+};
+
+/// The covariance of the frame's move, sum_j (W'_j - W_j) C_j (W'_j - W_j)^T, with the
+/// keyframes' errors independent.
+Eigen::Matrix3d FrameDriftCovariance(std::span<const KeyframeShare> shares);
+
+}  // namespace slamrig::slam
