@@ -59,6 +59,7 @@ struct KeyframeWeight {
   Pose2 pose;  ///< odom_from_base of the keyframe
   Eigen::Matrix3d before = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d after = Eigen::Matrix3d::Zero();
+  bool stays = false;  ///< still in the map after (its share may be zero: the scan missed it)
 };
 
 /// How IcpOdometry placed one scan.

@@ -66,4 +66,41 @@ struct KeyframeShare {
 /// keyframes' errors independent.
 Eigen::Matrix3d FrameDriftCovariance(std::span<const KeyframeShare> shares);
 
+/// One keyframe's share in the map's frame before and after a keyframe joined (at the robot),
+/// and whether it is still in the map after.
+struct KeyframeShareChange {
+  int id = 0;
+  Eigen::Matrix3d before = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d after = Eigen::Matrix3d::Zero();
+  bool stays = false;
+};
+
+/// The errors of the local map's keyframes, jointly. A keyframe is placed by a match against the
+/// map as it is: its error is the map's frame error then, F = sum_j W_j e_j, plus the match's own
+/// error n. Keyframes placed against nearly the same map share most of their error, and as the
+/// shares change the frame moves by sum_j (W'_j - W_j) e_j, where a shift common to all cancels:
+/// taken as independent (FrameDriftCovariance), the keyframes' errors overstate that move. This
+/// keeps the joint covariance of the errors of the keyframes in the map (each a rigid motion
+/// about the matcher frame's origin, so one keyframe's error moves every point as it moves the
+/// keyframe) and states the frame's move given the frame before, the part a filter that tracks
+/// the frame sees as new noise (the conditional covariance of a joint Gaussian).
+class KeyframeErrors {
+ public:
+  /// Keyframe `id` joins at `robot_xy`, placed with match error covariance `r` (x, y, yaw at the
+  /// robot): the shares of every keyframe before and after (`changes`, the new one's with zero
+  /// `before`). Returns the covariance of the frame's move at the robot given the frame before;
+  /// `placed`: also given the new keyframe's own error (a filter that puts the keyframe where its
+  /// match measured it states that part itself). Keyframes that leave are marginalised out. The
+  /// first keyframe defines the frame: join it with `r` zero and no other keyframe.
+  Eigen::Matrix3d Join(int id, const Eigen::Matrix3d& r,
+                       std::span<const KeyframeShareChange> changes,
+                       const Eigen::Vector2d& robot_xy, bool placed);
+
+  int size() const { return static_cast<int>(ids_.size()); }
+
+ private:
+  std::vector<int> ids_;        // the keyframes in the map, in the order of covariance_'s blocks
+  Eigen::MatrixXd covariance_;  // 3 ids_.size() square: their errors about the origin
+};
+
 }  // namespace slamrig::slam

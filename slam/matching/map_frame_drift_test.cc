@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
 
 #include "slam/matching/icp_matcher.h"
 #include "slam/matching/icp_odometry.h"
@@ -218,6 +220,113 @@ TEST(MapFrameDriftTest, CovarianceAtRobotIsTheRigidMotionsLever) {
       EXPECT_NEAR(std::sqrt(c(i, i)), std::abs(robot_error(i)), 1e-9) << trial << " " << i;
     }
   }
+}
+
+// A random information of a keyframe's points for a match (five random point-to-line rows).
+Eigen::Matrix3d RandomInformation(RandomEngine& rng) {
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < 5; ++i) {
+    const Eigen::Vector3d row(StandardNormal(rng), StandardNormal(rng), StandardNormal(rng));
+    h += row * row.transpose();
+  }
+  return h;
+}
+
+// The covariance of a sample's residual after its least-squares regression on `given`.
+Eigen::Matrix3d ResidualCovariance(const std::vector<Eigen::Vector3d>& samples,
+                                   const std::vector<Eigen::VectorXd>& given) {
+  const auto count = static_cast<Eigen::Index>(samples.size());
+  const Eigen::Index dimension = given.front().size();
+  Eigen::MatrixXd x(count, dimension);
+  Eigen::MatrixXd y(count, 3);
+  for (Eigen::Index i = 0; i < count; ++i) {
+    x.row(i) = given[static_cast<std::size_t>(i)].transpose();
+    y.row(i) = samples[static_cast<std::size_t>(i)].transpose();
+  }
+  const Eigen::MatrixXd coefficients = x.colPivHouseholderQr().solve(y);
+  const Eigen::MatrixXd residual = y - x * coefficients;
+  return residual.transpose() * residual / static_cast<double>(count - dimension);
+}
+
+// In a chain of keyframes each placed at the map's frame then plus an independent match error
+// (the linear model KeyframeErrors keeps), the frame's move given the frame before (and given the
+// new keyframe's error, when placed) is what is left of the move after regressing it on those,
+// over many Monte Carlo chains of the same shares.
+TEST(MapFrameDriftTest, KeyframeErrorsStateTheFramesMoveGivenTheFrameBefore) {
+  constexpr int kMapSize = 4, kJoins = 9, kChains = 20000;
+  RandomEngine rng(5);
+  KeyframeErrors model, placed_model;
+  std::vector<int> map;  // ids in the map, oldest first
+  // Each chain's keyframe errors (x, y, yaw about the origin), by id.
+  std::vector<std::vector<Eigen::Vector3d>> chains(kChains);
+  int compared = 0;
+  for (int id = 0; id < kJoins; ++id) {
+    const Eigen::Vector2d robot(0.5 * id, 2.0 * std::sin(0.7 * id));
+    Eigen::Matrix3d r = Eigen::Vector3d(1e-4, 2e-4, 1e-5).asDiagonal();
+    r *= 1.0 + std::abs(StandardNormal(rng));
+    if (id == 0) r.setZero();
+    std::vector<Eigen::Matrix3d> before_informations, after_informations;
+    for (std::size_t j = 0; j < map.size(); ++j)
+      before_informations.push_back(RandomInformation(rng));
+    std::vector<int> next = map;
+    next.push_back(id);
+    if (static_cast<int>(next.size()) > kMapSize) next.erase(next.begin());
+    for (std::size_t j = 0; j < next.size(); ++j)
+      after_informations.push_back(RandomInformation(rng));
+    const std::vector<Eigen::Matrix3d> before = FrameWeights(before_informations);
+    const std::vector<Eigen::Matrix3d> after = FrameWeights(after_informations);
+    std::vector<KeyframeShareChange> changes;
+    for (std::size_t j = 0; j < map.size(); ++j) {
+      changes.push_back({.id = map[j], .before = before[j]});
+    }
+    changes.push_back({.id = id});
+    for (KeyframeShareChange& c : changes) {
+      const auto it = std::find(next.begin(), next.end(), c.id);
+      if (it != next.end()) {
+        c.after = after[static_cast<std::size_t>(it - next.begin())];
+        c.stays = true;
+      }
+    }
+    const Eigen::Matrix3d q = model.Join(id, r, changes, robot, false);
+    const Eigen::Matrix3d q_placed = placed_model.Join(id, r, changes, robot, true);
+
+    // The chains: the frame before, the new keyframe's error and the frame's move, at the robot.
+    const Eigen::Matrix3d l = r.llt().matrixL();
+    const auto at_robot = [&](const Eigen::Vector3d& e) {
+      return Eigen::Vector3d(e.x() - e.z() * robot.y(), e.y() + e.z() * robot.x(), e.z());
+    };
+    std::vector<Eigen::Vector3d> moves;
+    std::vector<Eigen::VectorXd> frames, frames_and_errors;
+    for (std::vector<Eigen::Vector3d>& chain : chains) {
+      Eigen::Vector3d frame = Eigen::Vector3d::Zero();
+      for (std::size_t j = 0; j < map.size(); ++j) frame += before[j] * at_robot(chain[map[j]]);
+      const Eigen::Vector3d noise(StandardNormal(rng), StandardNormal(rng), StandardNormal(rng));
+      const Eigen::Vector3d error =
+          frame + (id == 0 ? Eigen::Vector3d::Zero() : (l * noise).eval());
+      // Back about the origin: the inverse lever.
+      chain.push_back(Eigen::Vector3d(error.x() + error.z() * robot.y(),
+                                      error.y() - error.z() * robot.x(), error.z()));
+      Eigen::Vector3d frame_after = Eigen::Vector3d::Zero();
+      for (std::size_t j = 0; j < next.size(); ++j)
+        frame_after += after[j] * at_robot(chain[next[j]]);
+      moves.push_back(frame_after - frame);
+      frames.push_back(frame);
+      Eigen::VectorXd both(6);
+      both << frame, error;
+      frames_and_errors.push_back(both);
+    }
+    map = next;
+    if (id < 3) continue;  // the frame is still nearly the first keyframe's (exactly known)
+    ++compared;
+    const Eigen::Matrix3d sampled = ResidualCovariance(moves, frames);
+    const Eigen::Matrix3d sampled_placed = ResidualCovariance(moves, frames_and_errors);
+    EXPECT_LT((q - sampled).norm(), 0.05 * sampled.norm()) << id << "\n" << q << "\n" << sampled;
+    EXPECT_LT((q_placed - sampled_placed).norm(), 0.05 * sampled_placed.norm()) << id << "\n"
+                                                                                << q_placed << "\n"
+                                                                                << sampled_placed;
+  }
+  EXPECT_EQ(compared, kJoins - 3);
+  EXPECT_EQ(model.size(), kMapSize);
 }
 
 }  // namespace

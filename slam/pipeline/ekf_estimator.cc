@@ -94,32 +94,18 @@ double EkfEstimator::MatchScale() const {
   // The estimate moves both ways (held at >= 1 it would drift upward, the NIS's spread reflected
   // there); the factor applied only ever inflates the Hessian's covariance, a lower bound on the
   // match's spread.
-  return std::max(1.0, std::exp(log_match_scale_));
+  return options_.match_scale_below_one ? std::exp(log_match_scale_)
+                                        : std::max(1.0, std::exp(log_match_scale_));
 }
 
 Eigen::Matrix3d EkfEstimator::DerivedDrift(const IcpOdometryStep& step, const Eigen::Matrix3d& r,
                                            bool place) {
-  keyframe_covariance_[step.keyframe_id] = r;
-  std::vector<KeyframeShare> shares;
-  shares.reserve(step.frame_weights.size());
+  std::vector<KeyframeShareChange> changes;
+  changes.reserve(step.frame_weights.size());
   for (const KeyframeWeight& w : step.frame_weights) {
-    if (place && w.id == step.keyframe_id) continue;
-    const auto it = keyframe_covariance_.find(w.id);
-    const Eigen::Matrix3d c =
-        it == keyframe_covariance_.end() ? Eigen::Matrix3d::Zero() : it->second;
-    shares.push_back(
-        {.before = w.before,
-         .after = w.after,
-         .covariance = CovarianceAtRobot(c, w.pose.translation(), step.pose.translation())});
+    changes.push_back({.id = w.id, .before = w.before, .after = w.after, .stays = w.stays});
   }
-  // Keyframes that left the map no longer move it.
-  for (auto it = keyframe_covariance_.begin(); it != keyframe_covariance_.end();) {
-    const bool in_map = std::any_of(
-        step.frame_weights.begin(), step.frame_weights.end(),
-        [&](const KeyframeWeight& w) { return w.id == it->first && !w.after.isZero(); });
-    it = in_map ? std::next(it) : keyframe_covariance_.erase(it);
-  }
-  return FrameDriftCovariance(shares);
+  return keyframe_errors_.Join(step.keyframe_id, r, changes, step.pose.translation(), place);
 }
 
 ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {

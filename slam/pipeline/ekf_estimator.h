@@ -8,6 +8,7 @@
 #include "slam/fusion/pose_ekf.h"
 #include "slam/grid/occupancy_grid.h"
 #include "slam/matching/icp_odometry.h"
+#include "slam/matching/map_frame_drift.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
 #include "slam/pipeline/wheel_gyro_feed.h"
@@ -44,6 +45,8 @@ struct EkfOptions {
   /// joins, with each keyframe's error covariance that of the match that placed it, taken as
   /// independent. Off: on the office loop it is pessimistic (README, "EKF").
   bool derived_map_drift = false;
+  bool match_scale_below_one =
+      false;  ///< experiment: the adaptive factor may shrink the Hessian covariance
   /// With derived_map_drift: the joining keyframe's part is not noise but known, the keyframe
   /// sits where its match put it (PoseEkf::PlaceKeyframe); only the others' shares add noise.
   /// Off: measured with the all-points shares only, optimistic (README, "EKF").
@@ -83,6 +86,7 @@ void VisitFields(V& v, EkfOptions& o) {
   v("adaptive_match_covariance", o.adaptive_match_covariance);
   v("map_drift_share", o.map_drift_share);
   v("derived_map_drift", o.derived_map_drift);
+  v("match_scale_below_one", o.match_scale_below_one);
   v("place_keyframes", o.place_keyframes);
   v("update_on_degenerate", o.update_on_degenerate);
   v("keyframe_updates", o.keyframe_updates);
@@ -143,8 +147,8 @@ class EkfEstimator final : public Estimator {
   double log_match_scale_ = 0.0;  // the estimate of log(factor on the match covariance)
   double nis_sum_ = 0.0;
   double last_nis_ = 0.0;
-  // The match covariance (matcher frame, at its pose) each keyframe in the local map joined with.
-  std::map<int, Eigen::Matrix3d> keyframe_covariance_;
+  // The joint errors of the keyframes in the matcher's local map (derived_map_drift).
+  KeyframeErrors keyframe_errors_;
 };
 
 }  // namespace slamrig::slam
