@@ -201,51 +201,25 @@ Eigen::Matrix3d PoseEkf::MatcherPoseJacobianPose() const {
 }
 
 void PoseEkf::AnchorMatcherFrame(const Pose2& z, const Eigen::Matrix3d& r) {
-  // m's rows become a function of the pose's (its old correlations are dropped) plus the match's
-  // own noise.
-  const FrameJacobians j = SetFrameFrom(z);
-  Eigen::Matrix<double, 3, kN> j_state = Eigen::Matrix<double, 3, kN>::Zero();
-  j_state.middleCols<3>(3) = j.pose;
-  const Eigen::Matrix<double, 3, kN> cross = j_state * p_;
-  p_.middleRows<3>(kFrame) = cross;
-  p_.middleCols<3>(kFrame) = cross.transpose();
-  p_.block<3, 3>(kFrame, kFrame) =
-      j.pose * p_.block<3, 3>(3, 3) * j.pose.transpose() + j.z * r * j.z.transpose();
-  p_ = 0.5 * (p_ + p_.transpose()).eval();
-}
-
-PoseEkf::FrameJacobians PoseEkf::SetFrameFrom(const Pose2& z) {
   const Pose2 frame = z * pose().Inverse();
   x_.segment<3>(kFrame) << frame.x(), frame.y(), frame.theta();
   // m = z * pose^-1: m_yaw = z_yaw - pose_yaw, m_xy = z_xy - R(m_yaw) pose_xy. Its Jacobians with
-  // respect to the pose and to z.
+  // respect to the pose and to z; m's rows become that function of the pose's (its old
+  // correlations are dropped) plus the match's own noise.
   const Eigen::Vector2d lever = RotatedDerivative(frame.theta(), x_.segment<2>(3));
-  FrameJacobians j;
-  j.pose = -Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d j_pose = -Eigen::Matrix3d::Identity();
   const double c = std::cos(frame.theta()), s = std::sin(frame.theta());
-  j.pose.topLeftCorner<2, 2>() << -c, s, -s, -c;
-  j.pose.block<2, 1>(0, 2) = lever;
-  j.z = Eigen::Matrix3d::Identity();
-  j.z.block<2, 1>(0, 2) = -lever;
-  return j;
-}
-
-void PoseEkf::PlaceKeyframe(const Pose2& z, const Eigen::Matrix3d& share) {
-  // y = m * pose moves to y' = y + W (z - y): a function of the state alone.
-  const Pose2 y = matcher_frame() * pose();
-  const Eigen::Vector3d d(z.x() - y.x(), z.y() - y.y(), NormalizeAngle(z.theta() - y.theta()));
-  const Eigen::Vector3d moved = Eigen::Vector3d(y.x(), y.y(), y.theta()) + share * d;
-  Eigen::Matrix<double, 3, kN> h = Eigen::Matrix<double, 3, kN>::Zero();
-  h.middleCols<3>(3) = MatcherPoseJacobianPose();
-  h.middleCols<3>(kFrame) = MatcherPoseJacobianFrame();
-  // m' = y' * pose^-1, with dy'/dstate = (I - W) H.
-  const FrameJacobians j = SetFrameFrom(Pose2(moved.x(), moved.y(), moved.z()));
-  Eigen::Matrix<double, 3, kN> j_state = j.z * (Eigen::Matrix3d::Identity() - share) * h;
-  j_state.middleCols<3>(3) += j.pose;
-  const Eigen::Matrix<double, 3, kN> cross = j_state * p_;
+  j_pose.topLeftCorner<2, 2>() << -c, s, -s, -c;
+  j_pose.block<2, 1>(0, 2) = lever;
+  Eigen::Matrix3d j_z = Eigen::Matrix3d::Identity();
+  j_z.block<2, 1>(0, 2) = -lever;
+  Eigen::Matrix<double, 3, kN> j = Eigen::Matrix<double, 3, kN>::Zero();
+  j.middleCols<3>(3) = j_pose;
+  const Eigen::Matrix<double, 3, kN> cross = j * p_;
   p_.middleRows<3>(kFrame) = cross;
   p_.middleCols<3>(kFrame) = cross.transpose();
-  p_.block<3, 3>(kFrame, kFrame) = cross * j_state.transpose();
+  p_.block<3, 3>(kFrame, kFrame) =
+      j_pose * p_.block<3, 3>(3, 3) * j_pose.transpose() + j_z * r * j_z.transpose();
   p_ = 0.5 * (p_ + p_.transpose()).eval();
 }
 

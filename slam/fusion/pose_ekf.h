@@ -67,10 +67,6 @@ class PoseEkf {
   /// The matcher's frame drifts: its pose of the robot moves by a perturbation of covariance `q`
   /// (matcher frame, at the robot), as when a keyframe joins its map with an error.
   void DriftMatcherFrame(const Eigen::Matrix3d& q);
-  /// A keyframe joins the matcher's map where its match put it, `z` (matcher frame), with
-  /// `share` its share in the map's frame (FrameWeights, at the robot): the matcher's pose of
-  /// the robot m * pose moves by share * (z - m * pose), a function of the state (no new noise).
-  void PlaceKeyframe(const Pose2& z, const Eigen::Matrix3d& share);
   /// A gyro sample taken at standstill measures the bias: b = rate.
   EkfUpdate UpdateZeroRate(double rate_rad_s);
   /// The clone becomes the current pose (the next relative measurement starts here).
@@ -109,13 +105,6 @@ class PoseEkf {
   /// d(m * pose)/d(m) and d(m * pose)/d(pose) at the current state, 3 x 3 each.
   Eigen::Matrix3d MatcherPoseJacobianFrame() const;
   Eigen::Matrix3d MatcherPoseJacobianPose() const;
-  /// d(m)/d(pose) and d(m)/d(z) of m = z * pose^-1.
-  struct FrameJacobians {
-    Eigen::Matrix3d pose;
-    Eigen::Matrix3d z;
-  };
-  /// Sets m = z * pose^-1; its Jacobians.
-  FrameJacobians SetFrameFrom(const Pose2& z);
 
   PoseEkfOptions options_;
   Eigen::Matrix<double, kStateSize, 1> x_ = Eigen::Matrix<double, kStateSize, 1>::Zero();

@@ -273,45 +273,5 @@ TEST(PoseEkfTest, MatcherPoseUpdatesAreConsistentOverMonteCarloRuns) {
   EXPECT_NEAR(nis_sum / updates, 3.0, 0.3);
 }
 
-// A keyframe placed where its match put it moves the matcher's pose of the robot by its share of
-// the match's error: after PlaceKeyframe(z, I) the filter's m * pose is z, and in general the
-// covariance of m * pose becomes (I - W) S (I - W)^T.
-TEST(PoseEkfTest, PlaceKeyframeMovesTheMatcherPoseByItsShare) {
-  PoseEkf ekf{PoseEkfOptions{}};
-  ekf.ResetPose(Pose2(1.0, -2.0, 0.7));
-  ekf.AnchorMatcherFrame(Pose2(4.0, 3.0, -0.4), Eigen::Matrix3d::Zero());
-  for (int i = 0; i < 20; ++i) ekf.PredictWheels(0.1, 0.09, 0.4, 0.02);
-  ekf.DriftMatcherFrame(Eigen::Vector3d(1e-4, 2e-4, 1e-5).asDiagonal());
-  // The covariance of m * pose, J P J^T with J by central differences on the state.
-  const auto matcher_pose_covariance = [](const PoseEkf& f) {
-    const auto relation = [](const Eigen::Matrix<double, 11, 1>& x) {
-      const Pose2 y = Pose2(x(8), x(9), x(10)) * Pose2(x(3), x(4), x(5));
-      return Eigen::Vector3d(y.x(), y.y(), y.theta());
-    };
-    Eigen::Matrix<double, 3, 11> j;
-    for (int k = 0; k < 11; ++k) {
-      Eigen::Matrix<double, 11, 1> step = Eigen::Matrix<double, 11, 1>::Zero();
-      step(k) = 1e-6;
-      j.col(k) = (relation(f.state() + step) - relation(f.state() - step)) / 2e-6;
-    }
-    return Eigen::Matrix3d(j * f.covariance() * j.transpose());
-  };
-  const Eigen::Matrix3d before = matcher_pose_covariance(ekf);
-  const Pose2 z = ekf.matcher_frame() * ekf.pose() * Pose2(0.01, -0.02, 0.004);
-  PoseEkf whole = ekf;
-  whole.PlaceKeyframe(z, Eigen::Matrix3d::Identity());
-  const Pose2 placed = whole.matcher_frame() * whole.pose();
-  EXPECT_NEAR(placed.x(), z.x(), 1e-12);
-  EXPECT_NEAR(placed.y(), z.y(), 1e-12);
-  EXPECT_NEAR(placed.theta(), z.theta(), 1e-12);
-  EXPECT_LT(matcher_pose_covariance(whole).norm(), 1e-9 * before.norm());
-  Eigen::Matrix3d w;
-  w << 0.5, 0.1, 0.0, -0.05, 0.3, 0.02, 0.0, 0.0, 0.4;
-  ekf.PlaceKeyframe(z, w);
-  const Eigen::Matrix3d expected =
-      (Eigen::Matrix3d::Identity() - w) * before * (Eigen::Matrix3d::Identity() - w).transpose();
-  EXPECT_LT((matcher_pose_covariance(ekf) - expected).norm(), 1e-3 * expected.norm());
-}
-
 }  // namespace
 }  // namespace slamrig::slam

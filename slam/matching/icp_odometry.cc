@@ -95,9 +95,7 @@ std::pair<int, std::vector<KeyframeWeight>> IcpOdometry::AddKeyframe(
   weights.push_back({.id = keyframes_.back().id, .pose = pose_});
   for (std::size_t j = 0; j < keyframes_.size(); ++j) {
     for (KeyframeWeight& w : weights) {
-      if (w.id != keyframes_[j].id) continue;
-      w.after = after[j];
-      w.stays = true;
+      if (w.id == keyframes_[j].id) w.after = after[j];
     }
   }
   if (matcher_->normals().empty()) weights.clear();

@@ -59,7 +59,6 @@ struct KeyframeWeight {
   Pose2 pose;  ///< odom_from_base of the keyframe
   Eigen::Matrix3d before = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d after = Eigen::Matrix3d::Zero();
-  bool stays = false;  ///< still in the map after (its share may be zero: the scan missed it)
 };
 
 /// How IcpOdometry placed one scan.
@@ -82,7 +81,7 @@ struct IcpOdometryStep {
   bool keyframe = false;  ///< the scan joined the local map
   int keyframe_id = -1;   ///< its number as a keyframe (0, 1, ...); -1 when it did not join
   /// When it joined: every keyframe's share in the map's frame before and after (the new one's
-  /// last); what moves the frame (FrameDriftCovariance). Empty for point-to-point ICP.
+  /// last); what moves the frame (KeyframeErrors). Empty for point-to-point ICP.
   std::vector<KeyframeWeight> frame_weights;
 };
 

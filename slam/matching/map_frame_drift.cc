@@ -129,81 +129,75 @@ Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& s) {
 
 }  // namespace
 
-Eigen::Matrix3d KeyframeErrors::Join(int id, const Eigen::Matrix3d& r,
-                                     std::span<const KeyframeShareChange> changes,
-                                     const Eigen::Vector2d& robot_xy, bool placed) {
-  // A keyframe that joined unseen (before the filter followed the map) is taken as the frame's
-  // definition: no error.
-  for (const KeyframeShareChange& c : changes) {
-    if (c.id == id || std::find(ids_.begin(), ids_.end(), c.id) != ids_.end()) continue;
-    ids_.push_back(c.id);
+Eigen::Matrix3d KeyframeErrors::See(std::span<const KeyframeShareOf> shares,
+                                    const Eigen::Vector2d& robot_xy) {
+  for (const KeyframeShareOf& s : shares) {
+    if (std::find(ids_.begin(), ids_.end(), s.id) != ids_.end()) continue;
+    ids_.push_back(s.id);
     covariance_.conservativeResize(3 * size(), 3 * size());
     covariance_.rightCols(3).setZero();
     covariance_.bottomRows(3).setZero();
   }
-  const Eigen::Index k = static_cast<Eigen::Index>(ids_.size());
-  const Eigen::Index n = 3 * (k + 1);
+  const Eigen::Index n = 3 * size();
   const Eigen::Matrix3d g = LeverFromOrigin(robot_xy);
-  // The errors of the keyframes in the map and of the new one, about the robot.
-  Eigen::MatrixXd joint = Eigen::MatrixXd::Zero(n, n);
-  for (Eigen::Index a = 0; a < k; ++a) {
-    for (Eigen::Index b = 0; b < k; ++b) {
-      joint.block<3, 3>(3 * a, 3 * b) = g * covariance_.block<3, 3>(3 * a, 3 * b) * g.transpose();
-    }
+  const Eigen::Matrix3d g_inverse = LeverFromOrigin(-robot_xy);
+  // The frame now and before as functions of the errors, about the origin.
+  Eigen::MatrixXd now = Eigen::MatrixXd::Zero(3, n);
+  std::vector<bool> in_map(ids_.size(), false);
+  for (const KeyframeShareOf& s : shares) {
+    const auto block = std::find(ids_.begin(), ids_.end(), s.id) - ids_.begin();
+    now.middleCols<3>(3 * block) = g_inverse * s.share * g;
+    in_map[static_cast<std::size_t>(block)] = true;
   }
   Eigen::MatrixXd before = Eigen::MatrixXd::Zero(3, n);
-  Eigen::MatrixXd after = Eigen::MatrixXd::Zero(3, n);
-  std::vector<bool> stays(static_cast<std::size_t>(k + 1), false);
-  stays.back() = true;
-  for (const KeyframeShareChange& c : changes) {
-    Eigen::Index block = k;
-    if (c.id != id) {
-      block = std::find(ids_.begin(), ids_.end(), c.id) - ids_.begin();
-      stays[static_cast<std::size_t>(block)] = c.stays;
-    }
-    before.middleCols<3>(3 * block) = c.before;
-    after.middleCols<3>(3 * block) = c.after;
-  }
-  // The new keyframe's error: the frame's then plus its match's.
-  const Eigen::MatrixXd frame = before.leftCols(3 * k);
-  const Eigen::MatrixXd frame_cross = frame * joint.topLeftCorner(3 * k, 3 * k);
-  joint.block(3 * k, 0, 3, 3 * k) = frame_cross;
-  joint.block(0, 3 * k, 3 * k, 3) = frame_cross.transpose();
-  joint.block<3, 3>(3 * k, 3 * k) = frame_cross * frame.transpose() + r;
-
-  // The frame's move, given the frame before (and the new keyframe's error).
-  const Eigen::MatrixXd move = after - before;
-  Eigen::MatrixXd given = Eigen::MatrixXd::Zero(placed ? 6 : 3, n);
-  given.topRows(3) = before;
-  if (placed) given.block<3, 3>(3, 3 * k).setIdentity();
-  const Eigen::MatrixXd cross = move * joint * given.transpose();
+  before.leftCols(seen_.cols()) = seen_;
+  const Eigen::MatrixXd move = now - before;
+  const Eigen::MatrixXd cross = move * covariance_ * before.transpose();
   const Eigen::MatrixXd conditional =
-      move * joint * move.transpose() -
-      cross * PseudoInverse(given * joint * given.transpose()) * cross.transpose();
+      move * covariance_ * move.transpose() -
+      cross * PseudoInverse(before * covariance_ * before.transpose()) * cross.transpose();
+  const Eigen::Matrix3d at_robot = g * conditional * g.transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(
-      Eigen::Matrix3d(0.5 * (conditional + conditional.transpose())));
+      Eigen::Matrix3d(0.5 * (at_robot + at_robot.transpose())));
   const Eigen::Matrix3d q = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
                             eig.eigenvectors().transpose();
 
-  // Those that leave are marginalised out (their rows dropped); back about the origin.
-  const Eigen::Matrix3d g_inverse = LeverFromOrigin(-robot_xy);
+  // Those that left are marginalised out (their rows dropped).
   std::vector<Eigen::Index> kept;
   std::vector<int> ids;
-  for (Eigen::Index a = 0; a <= k; ++a) {
-    if (!stays[static_cast<std::size_t>(a)]) continue;
-    kept.push_back(a);
-    ids.push_back(a == k ? id : ids_[static_cast<std::size_t>(a)]);
+  for (std::size_t a = 0; a < ids_.size(); ++a) {
+    if (!in_map[a]) continue;
+    kept.push_back(static_cast<Eigen::Index>(a));
+    ids.push_back(ids_[a]);
   }
   const auto m = static_cast<Eigen::Index>(kept.size());
-  covariance_.setZero(3 * m, 3 * m);
+  Eigen::MatrixXd covariance(3 * m, 3 * m);
+  seen_.setZero(3, 3 * m);
   for (Eigen::Index a = 0; a < m; ++a) {
+    seen_.middleCols<3>(3 * a) = now.middleCols<3>(3 * kept[a]);
     for (Eigen::Index b = 0; b < m; ++b) {
-      covariance_.block<3, 3>(3 * a, 3 * b) =
-          g_inverse * joint.block<3, 3>(3 * kept[a], 3 * kept[b]) * g_inverse.transpose();
+      covariance.block<3, 3>(3 * a, 3 * b) = covariance_.block<3, 3>(3 * kept[a], 3 * kept[b]);
     }
   }
+  covariance_ = std::move(covariance);
   ids_ = std::move(ids);
   return q;
+}
+
+void KeyframeErrors::Join(int id, const Eigen::Matrix3d& r, const Eigen::Vector2d& robot_xy) {
+  const Eigen::Index k = 3 * size();
+  const Eigen::Matrix3d g_inverse = LeverFromOrigin(-robot_xy);
+  Eigen::MatrixXd seen = Eigen::MatrixXd::Zero(3, k);
+  seen.leftCols(seen_.cols()) = seen_;
+  const Eigen::MatrixXd cross = seen * covariance_;  // 3 x k
+  covariance_.conservativeResize(k + 3, k + 3);
+  covariance_.block(k, 0, 3, k) = cross;
+  covariance_.block(0, k, k, 3) = cross.transpose();
+  covariance_.block<3, 3>(k, k) = cross * seen.transpose() + g_inverse * r * g_inverse.transpose();
+  ids_.push_back(id);
+  seen_.conservativeResize(3, k + 3);
+  seen_.leftCols(k) = seen;
+  seen_.rightCols(3).setZero();
 }
 
 }  // namespace slamrig::slam

@@ -63,44 +63,45 @@ struct KeyframeShare {
 };
 
 /// The covariance of the frame's move, sum_j (W'_j - W_j) C_j (W'_j - W_j)^T, with the
-/// keyframes' errors independent.
+/// keyframes' errors independent (as when each was placed by an outside reference; a map built
+/// by its own matches has them correlated: KeyframeErrors).
 Eigen::Matrix3d FrameDriftCovariance(std::span<const KeyframeShare> shares);
 
-/// One keyframe's share in the map's frame before and after a keyframe joined (at the robot),
-/// and whether it is still in the map after.
-struct KeyframeShareChange {
+/// One keyframe's share in the map's frame as a scan sees it (FrameWeights, at the robot).
+struct KeyframeShareOf {
   int id = 0;
-  Eigen::Matrix3d before = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d after = Eigen::Matrix3d::Zero();
-  bool stays = false;
+  Eigen::Matrix3d share = Eigen::Matrix3d::Zero();
 };
 
-/// The errors of the local map's keyframes, jointly. A keyframe is placed by a match against the
-/// map as it is: its error is the map's frame error then, F = sum_j W_j e_j, plus the match's own
-/// error n. Keyframes placed against nearly the same map share most of their error, and as the
-/// shares change the frame moves by sum_j (W'_j - W_j) e_j, where a shift common to all cancels:
-/// taken as independent (FrameDriftCovariance), the keyframes' errors overstate that move. This
-/// keeps the joint covariance of the errors of the keyframes in the map (each a rigid motion
-/// about the matcher frame's origin, so one keyframe's error moves every point as it moves the
-/// keyframe) and states the frame's move given the frame before, the part a filter that tracks
-/// the frame sees as new noise (the conditional covariance of a joint Gaussian).
+/// The errors of the local map's keyframes, jointly, and the frame the matches see. A scan
+/// matched against the map lands at its frame as that scan sees it, G = sum_j W_j e_j with the
+/// shares of the points it pairs with; a keyframe placed by that match has the error G plus the
+/// match's own. Keyframes placed against nearly the same map share most of their error, and
+/// the frame moves by the change of the shares, where a shift common to all cancels. The shares
+/// that matter are those of the scans that use the map: the joining scan sees almost nothing but
+/// its own points (the map keeps the newest point of each voxel), the next ones see the older
+/// keyframes too. This keeps the joint covariance of the errors of the keyframes in the map (each
+/// a rigid motion about the matcher frame's origin) and states each move of the seen frame given
+/// the frame before, the part a filter that tracks the frame takes as new noise (the conditional
+/// covariance of a joint Gaussian).
 class KeyframeErrors {
  public:
-  /// Keyframe `id` joins at `robot_xy`, placed with match error covariance `r` (x, y, yaw at the
-  /// robot): the shares of every keyframe before and after (`changes`, the new one's with zero
-  /// `before`). Returns the covariance of the frame's move at the robot given the frame before;
-  /// `placed`: also given the new keyframe's own error (a filter that puts the keyframe where its
-  /// match measured it states that part itself). Keyframes that leave are marginalised out. The
-  /// first keyframe defines the frame: join it with `r` zero and no other keyframe.
-  Eigen::Matrix3d Join(int id, const Eigen::Matrix3d& r,
-                       std::span<const KeyframeShareChange> changes,
-                       const Eigen::Vector2d& robot_xy, bool placed);
+  /// A scan at `robot_xy` sees the frame through `shares` (the keyframes in the map). Returns the
+  /// covariance of that frame's move since the last scan that saw it (x, y, yaw at the robot),
+  /// given the frame then; keyframes not in `shares` have left the map and are marginalised out.
+  /// A keyframe never joined is taken as the frame's definition (no error).
+  Eigen::Matrix3d See(std::span<const KeyframeShareOf> shares, const Eigen::Vector2d& robot_xy);
+  /// Keyframe `id` joins, placed by the last scan that saw the frame with a match error of
+  /// covariance `r` (x, y, yaw at `robot_xy`): its error is that frame's plus its own. The first
+  /// keyframe defines the frame: `r` zero.
+  void Join(int id, const Eigen::Matrix3d& r, const Eigen::Vector2d& robot_xy);
 
   int size() const { return static_cast<int>(ids_.size()); }
 
  private:
   std::vector<int> ids_;        // the keyframes in the map, in the order of covariance_'s blocks
   Eigen::MatrixXd covariance_;  // 3 ids_.size() square: their errors about the origin
+  Eigen::MatrixXd seen_;        // 3 x 3 ids_.size(): the last seen frame, about the origin
 };
 
 }  // namespace slamrig::slam

@@ -36,21 +36,19 @@ struct EkfOptions {
   /// dimension (Mehra 1972's covariance matching, a stochastic-approximation step on the log of
   /// the factor per update; updates whose motion was inflated for a slip are left out).
   bool adaptive_match_covariance = true;
-  /// The local map's frame drifts as keyframes join it, each placed with its match's error: the
-  /// map's pose moves by this share of that error (standard deviations) per keyframe.
+  /// The local map's frame drifts as keyframes join it, each placed with its match's error. With
+  /// the matcher's shares (point-to-line ICP) the drift is derived (derived_map_drift); without
+  /// them (point-to-point ICP) or with derived_map_drift off, the map's pose moves by this share
+  /// of each keyframe's match error (standard deviations), a fitted constant: 0.45 leaves the
+  /// office loop optimistic (README, "EKF").
   double map_drift_share = 0.45;
-  /// Instead of map_drift_share: the drift the matcher's local map composition implies
-  /// (slam/matching/map_frame_drift.h): each keyframe's share in the map's frame, from the
-  /// point-to-line information of its points the joining scan pairs with, before and after it
-  /// joins, with each keyframe's error covariance that of the match that placed it, taken as
-  /// independent. Off: on the office loop it is pessimistic (README, "EKF").
-  bool derived_map_drift = false;
-  bool match_scale_below_one =
-      false;  ///< experiment: the adaptive factor may shrink the Hessian covariance
-  /// With derived_map_drift: the joining keyframe's part is not noise but known, the keyframe
-  /// sits where its match put it (PoseEkf::PlaceKeyframe); only the others' shares add noise.
-  /// Off: measured with the all-points shares only, optimistic (README, "EKF").
-  bool place_keyframes = false;
+  /// The frame's drift from the local map's composition (KeyframeErrors,
+  /// slam/matching/map_frame_drift.h): a match lands at the information-weighted mean of its
+  /// keyframes' errors, weighted by the points it pairs with; every keyframe was placed at the
+  /// frame its own match saw plus that match's error, so their errors are kept jointly, and the
+  /// frame seen by each keyframe's match moves from the last one's by the change of the shares,
+  /// given the frame before.
+  bool derived_map_drift = true;
   /// Also update on matches IcpOdometry calls degenerate (the prior fills their weak direction).
   bool update_on_degenerate = false;
   /// Update once per ICP keyframe; false: at every matched scan (consecutive scans meet the same
@@ -86,8 +84,6 @@ void VisitFields(V& v, EkfOptions& o) {
   v("adaptive_match_covariance", o.adaptive_match_covariance);
   v("map_drift_share", o.map_drift_share);
   v("derived_map_drift", o.derived_map_drift);
-  v("match_scale_below_one", o.match_scale_below_one);
-  v("place_keyframes", o.place_keyframes);
   v("update_on_degenerate", o.update_on_degenerate);
   v("keyframe_updates", o.keyframe_updates);
   v("slip_gate", o.slip_gate);
@@ -123,10 +119,9 @@ class EkfEstimator final : public Estimator {
  private:
   /// Matches `scan` at the filter's current pose, updates, clones; the estimate at the scan.
   ScanEstimate Correct(const LaserScan& scan);
-  /// The derived drift of the matcher's frame as the keyframe of `step` (matched with covariance
-  /// `r`) joins its map; keeps every keyframe's covariance while it is in the map.
-  /// `place`: the joining keyframe is left out (PlaceKeyframe states its part).
-  Eigen::Matrix3d DerivedDrift(const IcpOdometryStep& step, const Eigen::Matrix3d& r, bool place);
+  /// The covariance of the move of the matcher's frame as the keyframe scan of `step` sees it,
+  /// since the last keyframe's scan saw it (KeyframeErrors::See).
+  Eigen::Matrix3d SeenFrameDrift(const IcpOdometryStep& step);
   /// The factor applied to the match covariance (the adapted one, at least 1).
   double MatchScale() const;
 
