@@ -3,32 +3,13 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <unordered_set>
+#include <tuple>
 
+#include "slam/matching/map_frame_drift.h"
 #include "slam/types/check.h"
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
-namespace {
-
-// The first point of each voxel in the given order, in that order.
-std::vector<Eigen::Vector2d> VoxelThin(const std::vector<Eigen::Vector2d>& points, double voxel_m) {
-  if (voxel_m <= 0.0) return points;
-  std::unordered_set<std::int64_t> seen;
-  seen.reserve(points.size());
-  std::vector<Eigen::Vector2d> kept;
-  kept.reserve(points.size());
-  for (const Eigen::Vector2d& p : points) {
-    const auto vx = static_cast<std::int64_t>(std::floor(p.x() / voxel_m));
-    const auto vy = static_cast<std::int64_t>(std::floor(p.y() / voxel_m));
-    if (seen.insert(vx * 4000003 + vy).second) kept.push_back(p);
-  }
-  return kept;
-}
-
-}  // namespace
-
 std::vector<std::string> IcpOdometryOptions::Validate() const {
   std::vector<std::string> errors = icp.Validate();
   for (std::string& e : points.Validate()) errors.push_back(std::move(e));
@@ -78,19 +59,47 @@ Eigen::Matrix3d IcpOdometry::IncrementCovariance(const Pose2& increment) const {
   return Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
 }
 
-void IcpOdometry::AddKeyframe(const std::vector<Eigen::Vector2d>& points_base) {
-  std::vector<Eigen::Vector2d> odom_points;
-  odom_points.reserve(points_base.size());
-  for (const Eigen::Vector2d& p : points_base) odom_points.push_back(pose_ * p);
-  keyframes_.push_back(std::move(odom_points));
+std::vector<Eigen::Matrix3d> IcpOdometry::Informations(
+    const std::vector<Eigen::Vector2d>& scan) const {
+  if (!matcher_) return {};
+  return KeyframeInformations(map_, matcher_->normals(), static_cast<int>(keyframes_.size()), scan,
+                              options_.icp.max_correspondence_distance_m, pose_.translation());
+}
+
+std::pair<int, std::vector<KeyframeWeight>> IcpOdometry::AddKeyframe(
+    const std::vector<Eigen::Vector2d>& points_base) {
+  // The shares before and after, for the new keyframe's own scan at its pose.
+  std::vector<Eigen::Vector2d> scan;
+  scan.reserve(points_base.size());
+  for (const Eigen::Vector2d& p : points_base) scan.push_back(pose_ * p);
+  const std::vector<Eigen::Matrix3d> before = FrameWeights(Informations(scan));
+  std::vector<KeyframeWeight> weights;
+  for (std::size_t j = 0; j < keyframes_.size(); ++j) {
+    weights.push_back({.id = keyframes_[j].id, .pose = keyframes_[j].pose, .before = before[j]});
+  }
+
+  Keyframe keyframe{.id = next_keyframe_id_++, .pose = pose_, .points = {}};
+  keyframe.points = scan;
+  keyframes_.push_back(std::move(keyframe));
   while (static_cast<int>(keyframes_.size()) > options_.local_map_keyframes) keyframes_.pop_front();
   // Newest first, so the thinning keeps the newest point of each voxel.
-  std::vector<Eigen::Vector2d> all;
-  for (auto it = keyframes_.rbegin(); it != keyframes_.rend(); ++it) {
-    all.insert(all.end(), it->begin(), it->end());
-  }
-  matcher_.emplace(options_.icp, VoxelThin(all, options_.local_map_voxel_m));
+  std::vector<std::vector<Eigen::Vector2d>> points;
+  points.reserve(keyframes_.size());
+  for (const Keyframe& k : keyframes_) points.push_back(k.points);
+  map_ = ComposeLocalMap(points, options_.local_map_voxel_m);
+  matcher_.emplace(options_.icp, map_.points);
   last_keyframe_ = pose_;
+
+  // The shares after, matched to the keyframes by number (the newest joins last).
+  const std::vector<Eigen::Matrix3d> after = FrameWeights(Informations(scan));
+  weights.push_back({.id = keyframes_.back().id, .pose = pose_});
+  for (std::size_t j = 0; j < keyframes_.size(); ++j) {
+    for (KeyframeWeight& w : weights) {
+      if (w.id == keyframes_[j].id) w.after = after[j];
+    }
+  }
+  if (matcher_->normals().empty()) weights.clear();
+  return {keyframes_.back().id, std::move(weights)};
 }
 
 IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_increment) {
@@ -102,7 +111,7 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_in
     step.pose = pose_;
     step.outcome = IcpOdometryOutcome::kFirstScan;
     if (!points.empty()) {
-      AddKeyframe(points);
+      step.keyframe_id = AddKeyframe(points).first;
       step.keyframe = true;
     }
     return step;
@@ -181,7 +190,7 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_in
   const Pose2 since = last_keyframe_.Between(pose_);
   if (!points.empty() && (!matcher_ || since.translation().norm() >= options_.keyframe_distance_m ||
                           std::abs(since.theta()) >= options_.keyframe_angle_rad)) {
-    AddKeyframe(points);
+    std::tie(step.keyframe_id, step.frame_weights) = AddKeyframe(points);
     step.keyframe = true;
   }
   return step;

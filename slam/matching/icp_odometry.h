@@ -4,9 +4,11 @@
 #include <deque>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "slam/matching/icp_matcher.h"
+#include "slam/matching/map_frame_drift.h"
 #include "slam/matching/scan_points.h"
 #include "slam/types/pose2.h"
 #include "slam/types/records.h"
@@ -49,6 +51,16 @@ struct IcpOdometryOptions {
   std::vector<std::string> Validate() const;
 };
 
+/// One keyframe's share in the local map's frame (FrameWeights, slam/matching/map_frame_drift.h)
+/// before and after a keyframe joined the map, both at the new keyframe's pose; zero where the
+/// keyframe was not, or is no longer, in the map.
+struct KeyframeWeight {
+  int id = 0;  ///< the keyframe's number (IcpOdometryStep::keyframe_id when it joined)
+  Pose2 pose;  ///< odom_from_base of the keyframe
+  Eigen::Matrix3d before = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d after = Eigen::Matrix3d::Zero();
+};
+
 /// How IcpOdometry placed one scan.
 enum class IcpOdometryOutcome {
   kFirstScan,    ///< the first scan: the origin, the first keyframe
@@ -67,6 +79,10 @@ struct IcpOdometryStep {
   IcpOdometryOutcome outcome = IcpOdometryOutcome::kFirstScan;
   double score = 0.0;     ///< the match's score (IcpMatcher's inlier share) when it was used
   bool keyframe = false;  ///< the scan joined the local map
+  int keyframe_id = -1;   ///< its number as a keyframe (0, 1, ...); -1 when it did not join
+  /// When it joined: every keyframe's share in the map's frame before and after (the new one's
+  /// last); what moves the frame (KeyframeErrors). Empty for point-to-point ICP.
+  std::vector<KeyframeWeight> frame_weights;
 };
 
 /// How many scans ended in each outcome.
@@ -98,14 +114,26 @@ class IcpOdometry {
   const std::vector<Eigen::Vector2d>& local_map() const;
 
  private:
-  void AddKeyframe(const std::vector<Eigen::Vector2d>& points_base);
+  struct Keyframe {
+    int id = 0;
+    Pose2 pose;
+    std::vector<Eigen::Vector2d> points;  // odom frame
+  };
+  /// Adds a keyframe at pose_; its number and the shares in the frame before and after.
+  std::pair<int, std::vector<KeyframeWeight>> AddKeyframe(
+      const std::vector<Eigen::Vector2d>& points_base);
+  /// The point-to-line information each keyframe's points in the current map give a match of
+  /// `scan` (odom frame) at the pose, in keyframes_ order (empty before the first map).
+  std::vector<Eigen::Matrix3d> Informations(const std::vector<Eigen::Vector2d>& scan) const;
   Eigen::Matrix3d IncrementCovariance(const Pose2& increment) const;
 
   IcpOdometryOptions options_;
   Pose2 pose_;
   Pose2 last_keyframe_;
   bool started_ = false;
-  std::deque<std::vector<Eigen::Vector2d>> keyframes_;  // odom frame, oldest first
+  std::deque<Keyframe> keyframes_;  // oldest first
+  LocalMapPoints map_;              // the matcher's reference, with each point's keyframe
+  int next_keyframe_id_ = 0;
   std::optional<IcpMatcher> matcher_;
   IcpOdometryCounts counts_;
 };

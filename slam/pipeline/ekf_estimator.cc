@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "slam/matching/map_frame_drift.h"
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
@@ -96,6 +97,15 @@ double EkfEstimator::MatchScale() const {
   return std::max(1.0, std::exp(log_match_scale_));
 }
 
+Eigen::Matrix3d EkfEstimator::SeenFrameDrift(const IcpOdometryStep& step) {
+  std::vector<KeyframeShareOf> shares;
+  shares.reserve(step.frame_weights.size());
+  for (const KeyframeWeight& w : step.frame_weights) {
+    if (w.id != step.keyframe_id) shares.push_back({.id = w.id, .share = w.before});
+  }
+  return keyframe_errors_.See(shares, step.pose.translation());
+}
+
 ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
   const bool first = scans_ == 0;
   ++scans_;
@@ -104,6 +114,12 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
   if (options_.scan_matching) {
     const Pose2 prior = previous_pose_.Between(ekf_.pose());
     const IcpOdometryStep step = icp_.Add(scan, prior);
+    // The derived drift needs the matcher's shares (point-to-line ICP).
+    const bool derived_drift = options_.derived_map_drift && !step.frame_weights.empty();
+    const bool joins = feed_.saw_ticks() && (first || step.keyframe);
+    // The frame this keyframe's match sees moved since the last keyframe's saw it.
+    const Eigen::Matrix3d seen_drift =
+        derived_drift && joins && !first ? SeenFrameDrift(step) : Eigen::Matrix3d::Zero().eval();
     const bool usable =
         step.outcome == IcpOdometryOutcome::kMatched ||
         (options_.update_on_degenerate && step.outcome == IcpOdometryOutcome::kDegenerate);
@@ -154,6 +170,7 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
         ekf_.Clone();
       }
     } else if (usable && (step.keyframe || !options_.keyframe_updates)) {
+      if (anchored_ && derived_drift && joins) ekf_.DriftMatcherFrame(seen_drift);
       if (anchored_) {
         const EkfUpdate update = ekf_.UpdateMatcherPose(
             step.pose, r,
@@ -173,12 +190,17 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
         ++anchors_;
       }
     }
-    if (feed_.saw_ticks() && (first || step.keyframe)) {
+    if (joins) {
       ++keyframes_;
+      // The first keyframe is the frame itself; every other joins with its match's error.
+      if (derived_drift) {
+        keyframe_errors_.Join(step.keyframe_id, first ? Eigen::Matrix3d::Zero() : r,
+                              step.pose.translation());
+      }
       if (!first && !usable) {
         // The keyframe joins the map where the prior put it, along its weak direction at least.
         anchored_ = false;
-      } else if (!first) {
+      } else if (!first && !derived_drift) {
         ekf_.DriftMatcherFrame(options_.map_drift_share * options_.map_drift_share * r);
       }
       ekf_.Clone();
