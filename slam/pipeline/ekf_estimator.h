@@ -61,9 +61,9 @@ struct EkfOptions {
   /// Where the source states its gyro's noise (a simulated robot's file), model that instead of
   /// gyro_sigma_rad_s and gyro_bias_walk_rad_s_sqrt_s: a sample's sigma is the noise density
   /// times sqrt(rate), the bias walk the file's random walk. Off by default: on the office loop
-  /// (one lap, 20 seeds) the honest gyro moves the final pose's ANEES from 4.5 to 5.5 and the
-  /// mean NIS from 3.6 to 4.3, because map_drift_share was fitted with the default's 6x gyro noise
-  /// standing in for unmodelled error (see README, "EKF").
+  /// (one lap, 20 seeds, with the fitted map_drift_share) the honest gyro moves the ANEES from 4.5
+  /// to 5.5 and the mean NIS from 3.6 to 4.3, because map_drift_share was fitted with the default's
+  /// 6x gyro noise standing in for unmodelled error (see README, "EKF").
   bool gyro_noise_from_robot = false;
   OccupancyGridOptions map;
 
