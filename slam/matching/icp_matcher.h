@@ -82,6 +82,8 @@ class IcpMatcher {
 
   const IcpOptions& options() const { return options_; }
   const std::vector<Eigen::Vector2d>& reference() const { return tree_.points(); }
+  /// The k-d tree over reference(), in its order.
+  const PointKdTree& tree() const { return tree_; }
   /// Unit normals of the reference points ((0, 0) where there is none); empty for point-to-point.
   const std::vector<Eigen::Vector2d>& normals() const { return normals_; }
 

@@ -59,28 +59,23 @@ Eigen::Matrix3d IcpOdometry::IncrementCovariance(const Pose2& increment) const {
   return Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
 }
 
-std::vector<Eigen::Matrix3d> IcpOdometry::Informations(
-    const std::vector<Eigen::Vector2d>& scan) const {
-  if (!matcher_) return {};
-  return KeyframeInformations(map_, matcher_->normals(), static_cast<int>(keyframes_.size()), scan,
-                              options_.icp.max_correspondence_distance_m, pose_.translation());
-}
-
-std::pair<int, std::vector<KeyframeWeight>> IcpOdometry::AddKeyframe(
+std::pair<int, std::vector<KeyframeShareOf>> IcpOdometry::AddKeyframe(
     const std::vector<Eigen::Vector2d>& points_base) {
-  // The shares before and after, for the new keyframe's own scan at its pose.
   std::vector<Eigen::Vector2d> scan;
   scan.reserve(points_base.size());
   for (const Eigen::Vector2d& p : points_base) scan.push_back(pose_ * p);
-  const std::vector<Eigen::Matrix3d> before = FrameWeights(Informations(scan));
-  std::vector<KeyframeWeight> weights;
-  for (std::size_t j = 0; j < keyframes_.size(); ++j) {
-    weights.push_back({.id = keyframes_[j].id, .pose = keyframes_[j].pose, .before = before[j]});
+  // The shares of the map this scan was matched against (none before the first map, none for
+  // point-to-point ICP).
+  std::vector<KeyframeShareOf> shares;
+  if (matcher_ && !matcher_->normals().empty()) {
+    const std::vector<Eigen::Matrix3d> weights = FrameWeights(KeyframeInformations(
+        map_, *matcher_, static_cast<int>(keyframes_.size()), scan, pose_.translation()));
+    for (std::size_t j = 0; j < keyframes_.size(); ++j) {
+      shares.push_back({.id = keyframes_[j].id, .share = weights[j]});
+    }
   }
 
-  Keyframe keyframe{.id = next_keyframe_id_++, .pose = pose_, .points = {}};
-  keyframe.points = scan;
-  keyframes_.push_back(std::move(keyframe));
+  keyframes_.push_back({.id = next_keyframe_id_++, .points = std::move(scan)});
   while (static_cast<int>(keyframes_.size()) > options_.local_map_keyframes) keyframes_.pop_front();
   // Newest first, so the thinning keeps the newest point of each voxel.
   std::vector<std::vector<Eigen::Vector2d>> points;
@@ -89,17 +84,7 @@ std::pair<int, std::vector<KeyframeWeight>> IcpOdometry::AddKeyframe(
   map_ = ComposeLocalMap(points, options_.local_map_voxel_m);
   matcher_.emplace(options_.icp, map_.points);
   last_keyframe_ = pose_;
-
-  // The shares after, matched to the keyframes by number (the newest joins last).
-  const std::vector<Eigen::Matrix3d> after = FrameWeights(Informations(scan));
-  weights.push_back({.id = keyframes_.back().id, .pose = pose_});
-  for (std::size_t j = 0; j < keyframes_.size(); ++j) {
-    for (KeyframeWeight& w : weights) {
-      if (w.id == keyframes_[j].id) w.after = after[j];
-    }
-  }
-  if (matcher_->normals().empty()) weights.clear();
-  return {keyframes_.back().id, std::move(weights)};
+  return {keyframes_.back().id, std::move(shares)};
 }
 
 IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_increment) {

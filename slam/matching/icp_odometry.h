@@ -51,16 +51,6 @@ struct IcpOdometryOptions {
   std::vector<std::string> Validate() const;
 };
 
-/// One keyframe's share in the local map's frame (FrameWeights, slam/matching/map_frame_drift.h)
-/// before and after a keyframe joined the map, both at the new keyframe's pose; zero where the
-/// keyframe was not, or is no longer, in the map.
-struct KeyframeWeight {
-  int id = 0;  ///< the keyframe's number (IcpOdometryStep::keyframe_id when it joined)
-  Pose2 pose;  ///< odom_from_base of the keyframe
-  Eigen::Matrix3d before = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d after = Eigen::Matrix3d::Zero();
-};
-
 /// How IcpOdometry placed one scan.
 enum class IcpOdometryOutcome {
   kFirstScan,    ///< the first scan: the origin, the first keyframe
@@ -80,9 +70,10 @@ struct IcpOdometryStep {
   double score = 0.0;     ///< the match's score (IcpMatcher's inlier share) when it was used
   bool keyframe = false;  ///< the scan joined the local map
   int keyframe_id = -1;   ///< its number as a keyframe (0, 1, ...); -1 when it did not join
-  /// When it joined: every keyframe's share in the map's frame before and after (the new one's
-  /// last); what moves the frame (KeyframeErrors). Empty for point-to-point ICP.
-  std::vector<KeyframeWeight> frame_weights;
+  /// When it joined: the share in the map's frame (FrameWeights, at the scan's pose) of every
+  /// keyframe in the map it was matched against, as this scan saw it; what moves the frame
+  /// (KeyframeErrors). Empty for point-to-point ICP.
+  std::vector<KeyframeShareOf> frame_weights;
 };
 
 /// How many scans ended in each outcome.
@@ -116,15 +107,12 @@ class IcpOdometry {
  private:
   struct Keyframe {
     int id = 0;
-    Pose2 pose;
     std::vector<Eigen::Vector2d> points;  // odom frame
   };
-  /// Adds a keyframe at pose_; its number and the shares in the frame before and after.
-  std::pair<int, std::vector<KeyframeWeight>> AddKeyframe(
+  /// Adds a keyframe at pose_; its number and the shares of the map it joined, as its scan saw
+  /// them (IcpOdometryStep::frame_weights).
+  std::pair<int, std::vector<KeyframeShareOf>> AddKeyframe(
       const std::vector<Eigen::Vector2d>& points_base);
-  /// The point-to-line information each keyframe's points in the current map give a match of
-  /// `scan` (odom frame) at the pose, in keyframes_ order (empty before the first map).
-  std::vector<Eigen::Matrix3d> Informations(const std::vector<Eigen::Vector2d>& scan) const;
   Eigen::Matrix3d IncrementCovariance(const Pose2& increment) const;
 
   IcpOdometryOptions options_;

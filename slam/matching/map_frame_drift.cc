@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <unordered_set>
 
-#include "slam/matching/point_kd_tree.h"
 #include "slam/types/check.h"
 
 namespace slamrig::slam {
@@ -29,18 +28,22 @@ LocalMapPoints ComposeLocalMap(std::span<const std::vector<Eigen::Vector2d>> key
   return map;
 }
 
-std::vector<Eigen::Matrix3d> KeyframeInformations(
-    const LocalMapPoints& map, std::span<const Eigen::Vector2d> normals, int keyframes,
-    std::span<const Eigen::Vector2d> scan, double max_distance_m, const Eigen::Vector2d& robot_xy) {
+std::vector<Eigen::Matrix3d> KeyframeInformations(const LocalMapPoints& map,
+                                                  const IcpMatcher& matcher, int keyframes,
+                                                  std::span<const Eigen::Vector2d> scan,
+                                                  const Eigen::Vector2d& robot_xy) {
   std::vector<Eigen::Matrix3d> informations(static_cast<std::size_t>(keyframes),
                                             Eigen::Matrix3d::Zero());
+  const std::span<const Eigen::Vector2d> normals = matcher.normals();
   if (normals.empty() || map.points.empty()) return informations;
   SLAMRIG_CHECK(normals.size() == map.points.size(), "one normal per point");
-  const PointKdTree tree(map.points);
+  const double max_distance_m = matcher.options().max_correspondence_distance_m;
   for (const Eigen::Vector2d& q : scan) {
     std::uint32_t i = 0;
     double distance2 = 0.0;
-    if (!tree.Nearest(q, &i, &distance2) || distance2 > max_distance_m * max_distance_m) continue;
+    if (!matcher.tree().Nearest(q, &i, &distance2) || distance2 > max_distance_m * max_distance_m) {
+      continue;
+    }
     informations[static_cast<std::size_t>(map.keyframe[i])] +=
         PointToLineInformation(std::span(&map.points[i], 1), normals.subspan(i, 1), robot_xy);
   }

@@ -13,6 +13,8 @@
 #include <span>
 #include <vector>
 
+#include "slam/matching/icp_matcher.h"
+
 namespace slamrig::slam {
 
 /// A local map's points and the keyframe each came from.
@@ -27,13 +29,15 @@ LocalMapPoints ComposeLocalMap(std::span<const std::vector<Eigen::Vector2d>> key
                                double voxel_m);
 
 /// The point-to-line information (PointToLineInformation) each of `keyframes` keyframes gives a
-/// match of `scan` (points in the map's frame, at the pose at `robot_xy`): the map points that
-/// are the nearest neighbour of a scan point within `max_distance_m`, once per pairing, as the
-/// match's sum runs; `map` with `normals` (one per point, or empty for point-to-point ICP: all
-/// zero). What the scan does not see carries no share.
-std::vector<Eigen::Matrix3d> KeyframeInformations(
-    const LocalMapPoints& map, std::span<const Eigen::Vector2d> normals, int keyframes,
-    std::span<const Eigen::Vector2d> scan, double max_distance_m, const Eigen::Vector2d& robot_xy);
+/// match of `scan` (points in the map's frame, at the pose at `robot_xy`) by `matcher`, built on
+/// `map`'s points: the map points that are the nearest neighbour of a scan point within the
+/// matcher's correspondence distance, once per pairing, as the match's sum runs, with the
+/// matcher's normals (all zero for point-to-point ICP). What the scan does not see carries no
+/// share.
+std::vector<Eigen::Matrix3d> KeyframeInformations(const LocalMapPoints& map,
+                                                  const IcpMatcher& matcher, int keyframes,
+                                                  std::span<const Eigen::Vector2d> scan,
+                                                  const Eigen::Vector2d& robot_xy);
 
 /// The information a point-to-line match of a pose at `robot_xy` gets from reference `points`
 /// with unit `normals` ((0, 0): none, skipped): sum of J^T J over the points, J = (n^T,

@@ -38,8 +38,7 @@ std::vector<Eigen::Matrix3d> Shares(const std::vector<std::vector<Eigen::Vector2
                                     const Pose2& robot) {
   const LocalMapPoints map = ComposeLocalMap(points, IcpOdometryOptions{}.local_map_voxel_m);
   const IcpMatcher matcher(icp, map.points);
-  return FrameWeights(KeyframeInformations(map, matcher.normals(), static_cast<int>(points.size()),
-                                           scan, icp.max_correspondence_distance_m,
+  return FrameWeights(KeyframeInformations(map, matcher, static_cast<int>(points.size()), scan,
                                            robot.translation()));
 }
 

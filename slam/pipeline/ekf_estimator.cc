@@ -97,15 +97,6 @@ double EkfEstimator::MatchScale() const {
   return std::max(1.0, std::exp(log_match_scale_));
 }
 
-Eigen::Matrix3d EkfEstimator::SeenFrameDrift(const IcpOdometryStep& step) {
-  std::vector<KeyframeShareOf> shares;
-  shares.reserve(step.frame_weights.size());
-  for (const KeyframeWeight& w : step.frame_weights) {
-    if (w.id != step.keyframe_id) shares.push_back({.id = w.id, .share = w.before});
-  }
-  return keyframe_errors_.See(shares, step.pose.translation());
-}
-
 ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
   const bool first = scans_ == 0;
   ++scans_;
@@ -119,7 +110,9 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
     const bool joins = feed_.saw_ticks() && (first || step.keyframe);
     // The frame this keyframe's match sees moved since the last keyframe's saw it.
     const Eigen::Matrix3d seen_drift =
-        derived_drift && joins && !first ? SeenFrameDrift(step) : Eigen::Matrix3d::Zero().eval();
+        derived_drift && joins && !first
+            ? keyframe_errors_.See(step.frame_weights, step.pose.translation())
+            : Eigen::Matrix3d::Zero().eval();
     const bool usable =
         step.outcome == IcpOdometryOutcome::kMatched ||
         (options_.update_on_degenerate && step.outcome == IcpOdometryOutcome::kDegenerate);

@@ -119,9 +119,6 @@ class EkfEstimator final : public Estimator {
  private:
   /// Matches `scan` at the filter's current pose, updates, clones; the estimate at the scan.
   ScanEstimate Correct(const LaserScan& scan);
-  /// The covariance of the move of the matcher's frame as the keyframe scan of `step` sees it,
-  /// since the last keyframe's scan saw it (KeyframeErrors::See).
-  Eigen::Matrix3d SeenFrameDrift(const IcpOdometryStep& step);
   /// The factor applied to the match covariance (the adapted one, at least 1).
   double MatchScale() const;
 
