@@ -52,19 +52,26 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
                         sigma_yaw * StandardNormal(rng));
   const ClimbResult match =
       matcher_.Climb(particle.map, points, start, PosePrior{predicted, sigma_xy, sigma_yaw});
+  // log_eta is the untempered normaliser (the path's likelihood); log_eta_weight the one the
+  // weight takes: per point tempered (weight_correlation_per_point), else log_eta.
+  const bool per_point = options_.weight_correlation_per_point;
   double log_eta = 0.0;
+  double log_eta_weight = 0.0;
   Pose2 drawn;
   if (points.empty() || match.fit.matched < options_.matcher.min_matched_fraction *
                                                 static_cast<double>(points.size())) {
     // No usable match: the odometry model is the proposal, the likelihood the weight.
     *failed = true;
     drawn = start;
-    log_eta = scale * matcher_.Evaluate(particle.map, points, drawn).log_likelihood;
+    const MatchFit fit = matcher_.Evaluate(particle.map, points, drawn);
+    log_eta = scale * fit.log_likelihood;
+    log_eta_weight = per_point ? scale * fit.weighted_log_likelihood : log_eta;
   } else {
     // K = 27 poses on a grid around the match, weighted by likelihood times motion prior.
     constexpr int kSamples = 27;
     std::array<Eigen::Vector3d, kSamples> offsets;
     std::array<double, kSamples> log_q;
+    std::array<double, kSamples> log_q_weight;
     int j = 0;
     for (int iy = -1; iy <= 1; ++iy) {
       for (int ix = -1; ix <= 1; ++ix) {
@@ -77,7 +84,9 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
           const Pose2 e = predicted.Between(x);
           const double log_prior = -0.5 * ((e.x() * e.x() + e.y() * e.y()) / (sigma_xy * sigma_xy) +
                                            e.theta() * e.theta() / (sigma_yaw * sigma_yaw));
-          log_q[j] = scale * matcher_.Evaluate(particle.map, points, x).log_likelihood + log_prior;
+          const MatchFit fit = matcher_.Evaluate(particle.map, points, x);
+          log_q[j] = scale * fit.log_likelihood + log_prior;
+          log_q_weight[j] = scale * fit.weighted_log_likelihood + log_prior;
         }
       }
     }
@@ -99,6 +108,13 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
     // The mean of the sample weights (not their sum) keeps eta on the scale of a failed match's
     // single likelihood.
     log_eta = max_log_q + std::log(sum / kSamples);
+    log_eta_weight = log_eta;
+    if (per_point) {
+      const double max_log_qw = *std::max_element(log_q_weight.begin(), log_q_weight.end());
+      double sum_w = 0.0;
+      for (const double q : log_q_weight) sum_w += std::exp(q - max_log_qw);
+      log_eta_weight = max_log_qw + std::log(sum_w / kSamples);
+    }
     covariance.diagonal().array() += 1e-12;
     const Eigen::Matrix3d l = covariance.llt().matrixL();
     const Eigen::Vector3d z(StandardNormal(rng), StandardNormal(rng), StandardNormal(rng));
@@ -106,7 +122,7 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
     drawn = Pose2(match.pose.x() + d.x(), match.pose.y() + d.y(), match.pose.theta() + d.z());
   }
   particle.pose = drawn;
-  particle.log_weight += weight_exponent * log_eta;
+  particle.log_weight += weight_exponent * log_eta_weight;
   particle.path_log_likelihood += log_eta;
   particle.map.InsertScan(scan, drawn);
   particle.history = std::make_shared<RbpfPoseNode>(drawn, std::move(particle.history));
@@ -114,7 +130,9 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
 
 double Rbpf::WeightExponent(const std::vector<MatchPoint>& points) const {
   const double length = options_.weight_correlation_length_m;
-  if (!(length > 0.0) || points.empty()) return options_.weight_exponent;
+  if (!(length > 0.0) || points.empty() || options_.weight_correlation_per_point) {
+    return options_.weight_exponent;
+  }
   // The same factor for every particle (the points are in the base frame): it rescales every
   // log-weight increment alike, so the particles' order by weight is unchanged.
   const double independent = CountIndependentPoints(points, length);
@@ -285,8 +303,11 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
   const int n = options_.num_particles;
   std::vector<std::uint64_t> seeds(static_cast<std::size_t>(n));
   for (std::uint64_t& s : seeds) s = rng_();
-  const std::vector<MatchPoint> points =
+  std::vector<MatchPoint> points =
       MakeMatchPoints(scan, options_.points, options_.map.resolution_m);
+  if (options_.weight_correlation_per_point) {
+    AssignIndependenceWeights(points, options_.weight_correlation_length_m);
+  }
   Pose2 motion = pending;
   if (options_.odometry_failure_probability > 0.0 && !points.empty()) {
     motion = CheckOdometry(pending, points, &step.odometry_rejected);
@@ -294,6 +315,12 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
   }
   const double weight_exponent = WeightExponent(points);
   step.weight_exponent = weight_exponent;
+  if (options_.weight_correlation_per_point && !points.empty()) {
+    // The mean per-point factor: the scan's exponent had it tempered as a whole.
+    double total = 0.0;
+    for (const MatchPoint& p : points) total += p.weight;
+    step.weight_exponent *= total / static_cast<double>(points.size());
+  }
   std::vector<char> failed(static_cast<std::size_t>(n), 0);
   auto update_block = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {

@@ -51,7 +51,7 @@ struct RbpfStep {
   /// The odometry check replaced the increment by the best particle's wide match.
   bool odometry_rejected = false;
   /// The exponent the weights took this update (weight_exponent times the independent-point
-  /// factor of weight_correlation_length_m).
+  /// factor of weight_correlation_length_m; per point, times the points' mean factor).
   double weight_exponent = 1.0;
 };
 
@@ -99,7 +99,8 @@ class Rbpf {
   /// cannot place the robot (odometry_degenerate_ratio).
   Pose2 RemapDegenerate(const TiledGrid& map, const std::vector<MatchPoint>& points,
                         const Pose2& near, const Pose2& far) const;
-  /// weight_exponent times min(1, independent points / points) (weight_correlation_length_m).
+  /// weight_exponent times min(1, independent points / points) (weight_correlation_length_m);
+  /// weight_exponent alone where the points carry the tempering (weight_correlation_per_point).
   double WeightExponent(const std::vector<MatchPoint>& points) const;
   /// The motion model's standard deviations (x, y each; yaw) for an increment.
   std::pair<double, double> MotionSigmas(const Pose2& motion) const;

@@ -102,6 +102,45 @@ int CountIndependentPoints(std::span<const MatchPoint> points, double length_m) 
   return count;
 }
 
+void AssignIndependenceWeights(std::span<MatchPoint> points, double length_m) {
+  for (MatchPoint& p : points) p.weight = 1.0;
+  if (!(length_m > 0.0)) return;
+  // The points hashed by their cell of side length_m: a point within length_m of another has it
+  // in its own cell or one of the eight around it.
+  const double inv = 1.0 / length_m;
+  const double l2 = length_m * length_m;
+  auto cell = [inv](const Eigen::Vector2d& v) {
+    return std::pair<std::int64_t, std::int64_t>(
+        static_cast<std::int64_t>(std::floor(v.x() * inv)),
+        static_cast<std::int64_t>(std::floor(v.y() * inv)));
+  };
+  // Both indices packed into one word, so that no two of the nine cells share a key (a
+  // multiplicative hash can map two of them to one bucket and count its points twice).
+  auto key = [](std::int64_t x, std::int64_t y) {
+    return static_cast<std::uint64_t>(static_cast<std::uint32_t>(x)) << 32 |
+           static_cast<std::uint32_t>(y);
+  };
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> buckets;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const auto [cx, cy] = cell(points[i].hit);
+    buckets[key(cx, cy)].push_back(i);
+  }
+  for (MatchPoint& p : points) {
+    const auto [cx, cy] = cell(p.hit);
+    int neighbours = 0;
+    for (std::int64_t dy = -1; dy <= 1; ++dy) {
+      for (std::int64_t dx = -1; dx <= 1; ++dx) {
+        const auto it = buckets.find(key(cx + dx, cy + dy));
+        if (it == buckets.end()) continue;
+        for (const std::size_t j : it->second) {
+          neighbours += (points[j].hit - p.hit).squaredNorm() < l2;
+        }
+      }
+    }
+    p.weight = 1.0 / neighbours;  // >= 1: the point itself
+  }
+}
+
 RbpfMatcher::RbpfMatcher(const RbpfMatcherOptions& options)
     : options_(options),
       likelihood_scale_(-0.5 / (options.likelihood_sigma_m * options.likelihood_sigma_m)) {
@@ -201,10 +240,13 @@ MatchFit RbpfMatcher::Fit(const TiledGrid& map, std::span<const MatchPoint> poin
       ++fit.matched;
       fit.score += ScoreOf(best);
       if constexpr (kLikelihood) {
-        fit.log_likelihood += std::max(likelihood_scale_ * best, options_.no_match_log_likelihood);
+        const double ll = std::max(likelihood_scale_ * best, options_.no_match_log_likelihood);
+        fit.log_likelihood += ll;
+        fit.weighted_log_likelihood += p.weight * ll;
       }
     } else if constexpr (kLikelihood) {
       fit.log_likelihood += options_.no_match_log_likelihood;
+      fit.weighted_log_likelihood += p.weight * options_.no_match_log_likelihood;
     }
   }
   return fit;

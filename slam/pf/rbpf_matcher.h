@@ -70,6 +70,9 @@ void VisitFields(V& v, RbpfMatcherOptions& o) {
 struct MatchPoint {
   Eigen::Vector2d hit;
   Eigen::Vector2d free;
+  /// The share of one independent piece of evidence this point is (IndependenceWeights): its
+  /// log-likelihood counts this much in MatchFit::weighted_log_likelihood.
+  double weight = 1.0;
 };
 
 /// The beams `points` selects, with their free points `free_offset_m` back along each beam.
@@ -84,11 +87,20 @@ std::vector<MatchPoint> MakeMatchPoints(const LaserScan& scan, const ScanPointsO
 /// `length_m` <= 0. Invariant under rotations and translations of the scan; deterministic.
 int CountIndependentPoints(std::span<const MatchPoint> points, double length_m);
 
+/// Sets every point's weight to 1 / (the number of end points closer than `length_m` to its own,
+/// itself included): a cluster of n points that read the same few map cells, and so share their
+/// errors, counts as one piece of evidence in total, a point with no neighbour that close counts
+/// fully. Per point, where CountIndependentPoints gives one factor for the whole scan. All weights
+/// 1 for `length_m` <= 0. Invariant under rotations and translations of the scan; deterministic.
+void AssignIndependenceWeights(std::span<MatchPoint> points, double length_m);
+
 /// A scan evaluated at one pose against one map.
 struct MatchFit {
   double score = 0.0;           ///< sum of exp(-d^2 / (2 score_sigma^2)) over matched points
   double log_likelihood = 0.0;  ///< sum of the per-point log-likelihoods
-  int matched = 0;              ///< points with a wall in their kernel
+  /// Sum of the per-point log-likelihoods times the points' weights (MatchPoint::weight).
+  double weighted_log_likelihood = 0.0;
+  int matched = 0;  ///< points with a wall in their kernel
 };
 
 /// A Gaussian motion prior on the pose: centred on `mean`, isotropic in x, y.

@@ -216,5 +216,98 @@ TEST(RbpfMatcherTest, IndependentCountMatchesThePairwiseRuleAndIgnoresRigidMotio
   }
 }
 
+// AssignIndependenceWeights against the rule computed pair by pair (1 / the points closer than the
+// length, itself included), on random clusters, and the same weights after a rigid motion.
+TEST(RbpfMatcherTest, IndependenceWeightsMatchThePairwiseRuleAndIgnoreRigidMotion) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 30; ++trial) {
+    const double length = 0.05 + 0.1 * (u(rng) + 1.0);
+    std::vector<MatchPoint> points;
+    for (int c = 0; c < 1 + trial % 5; ++c) {
+      const Eigen::Vector2d centre(4.0 * u(rng), 4.0 * u(rng));
+      const double spread = 0.5 * (u(rng) + 1.0);
+      for (int i = 0; i < 30; ++i) {
+        const Eigen::Vector2d p = centre + spread * Eigen::Vector2d(u(rng), u(rng));
+        points.push_back({p, p});
+      }
+    }
+    AssignIndependenceWeights(points, length);
+    const Pose2 motion(10.0 * u(rng), 10.0 * u(rng), 3.1 * u(rng));
+    std::vector<MatchPoint> moved;
+    for (const MatchPoint& p : points) moved.push_back({motion * p.hit, motion * p.free});
+    AssignIndependenceWeights(moved, length);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      int near = 0;
+      for (const MatchPoint& q : points) near += (q.hit - points[i].hit).norm() < length;
+      EXPECT_DOUBLE_EQ(points[i].weight, 1.0 / near) << trial << " " << i;
+      EXPECT_DOUBLE_EQ(moved[i].weight, points[i].weight) << trial << " " << i;
+    }
+  }
+}
+
+// A pile of n points in one spot is one piece of evidence in total; isolated points count one
+// each; a dense wall's points share theirs with the 2 m neighbours within the length (m = the
+// spacings shorter than it), its ends with fewer; length 0 leaves every weight at 1.
+TEST(RbpfMatcherTest, IndependenceWeightsSplitOnePieceOfEvidenceAmongNeighbours) {
+  std::vector<MatchPoint> pile(25, MatchPoint{{1.0, 2.0}, {1.0, 2.0}});
+  AssignIndependenceWeights(pile, 0.1);
+  for (const MatchPoint& p : pile) EXPECT_DOUBLE_EQ(p.weight, 1.0 / 25.0);
+
+  std::vector<MatchPoint> mixed;
+  for (int i = 0; i < 101; ++i) {
+    const Eigen::Vector2d p(0.013 * i, 1.0);  // a wall 1.3 m long, 13 mm spacing
+    mixed.push_back({p, p});
+  }
+  for (int i = 0; i < 10; ++i) {
+    const Eigen::Vector2d p(0.5 * i, 5.0 + 0.3 * i);  // far, 0.5 m apart
+    mixed.push_back({p, p});
+  }
+  const double length = 0.1;
+  AssignIndependenceWeights(mixed, length);
+  const int m = 7;  // 7 * 0.013 = 0.091 < 0.1 < 0.104
+  EXPECT_DOUBLE_EQ(mixed[50].weight, 1.0 / (2 * m + 1));
+  EXPECT_DOUBLE_EQ(mixed[0].weight, 1.0 / (m + 1));
+  EXPECT_DOUBLE_EQ(mixed[3].weight, 1.0 / (m + 4));
+  for (int i = 101; i < 111; ++i) EXPECT_DOUBLE_EQ(mixed[static_cast<std::size_t>(i)].weight, 1.0);
+  // The wall's total: 87 interior points at 1 / (2 m + 1), and at each end 1 / (m + 1) ... 1 / 2 m.
+  double wall = 0.0;
+  for (int i = 0; i < 101; ++i) wall += mixed[static_cast<std::size_t>(i)].weight;
+  double ends = 0.0;
+  for (int k = m + 1; k <= 2 * m; ++k) ends += 1.0 / k;
+  EXPECT_NEAR(wall, 87.0 / (2 * m + 1) + 2.0 * ends, 1e-9);
+
+  AssignIndependenceWeights(mixed, 0.0);
+  for (const MatchPoint& p : mixed) EXPECT_EQ(p.weight, 1.0);
+}
+
+// The weighted log-likelihood is the sum of each point's own log-likelihood (the fit of that point
+// alone) times its weight; with every weight 1 it is the plain log-likelihood.
+TEST(RbpfMatcherTest, WeightedLogLikelihoodSumsEachPointsOwnTimesItsWeight) {
+  OccupancyGridOptions map_options;
+  TiledGrid map(map_options);
+  map.InsertScan(RoomScan(Pose2()), Pose2());
+  const ScanPointsOptions points_options{0.1, 30.0, 1, 0.05};
+  std::vector<MatchPoint> points =
+      MakeMatchPoints(RoomScan(Pose2(0.1, 0.05, 0.02)), points_options, map.resolution());
+  ASSERT_GT(points.size(), 50u);
+  const RbpfMatcher matcher{RbpfMatcherOptions{}};
+  const Pose2 pose(0.08, 0.06, 0.015);  // near, not at, the truth: the points' fits differ
+  const MatchFit unit = matcher.Evaluate(map, points, pose);
+  EXPECT_DOUBLE_EQ(unit.weighted_log_likelihood, unit.log_likelihood);
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double expected = 0.0;
+  for (MatchPoint& p : points) {
+    p.weight = u(rng);
+    expected += p.weight * matcher.Evaluate(map, std::span(&p, 1), pose).log_likelihood;
+  }
+  const MatchFit weighted = matcher.Evaluate(map, points, pose);
+  EXPECT_NEAR(weighted.weighted_log_likelihood, expected, 1e-9 * std::abs(expected));
+  EXPECT_DOUBLE_EQ(weighted.log_likelihood, unit.log_likelihood);
+  EXPECT_LT(weighted.weighted_log_likelihood, 0.0);
+  EXPECT_GT(weighted.weighted_log_likelihood, weighted.log_likelihood);
+}
+
 }  // namespace
 }  // namespace slamrig::slam

@@ -172,6 +172,44 @@ TEST(RbpfTest, IndependentPointTemperingScalesEveryWeightAlike) {
   EXPECT_EQ(updates, 2);
 }
 
+// Per-point tempering changes the weights only: with the same seed the first update draws the
+// untempered filter's poses, the reported exponent is the mean of the scan's independence weights
+// (computed here from the match points), and over the run the flatter weights resample less.
+TEST(RbpfTest, PerPointTemperingKeepsTheProposalAndFlattensTheWeights) {
+  const ShortRun& run = GetShortRun();
+  RbpfOptions options = FastOptions();
+  const RbpfRun full = RunFilter(run.scans, options);
+  Rbpf untempered_filter(options);
+  options.weight_correlation_length_m = 0.1;
+  options.weight_correlation_per_point = true;
+  const RbpfRun tempered = RunFilter(run.scans, options);
+  Rbpf filter(options);
+  int updates = 0;
+  for (const SyncedScan& s : run.scans) {
+    const RbpfStep a = untempered_filter.AddScan(s.scan, s.increment);
+    const RbpfStep b = filter.AddScan(s.scan, s.increment);
+    if (!a.updated || updates++ == 0) continue;
+    std::vector<MatchPoint> points =
+        MakeMatchPoints(s.scan, options.points, options.map.resolution_m);
+    AssignIndependenceWeights(points, 0.1);
+    double mean = 0.0;
+    for (const MatchPoint& p : points) mean += p.weight / static_cast<double>(points.size());
+    EXPECT_NEAR(b.weight_exponent, mean, 1e-12);
+    EXPECT_LT(b.weight_exponent, 0.9);
+    EXPECT_GT(b.weight_exponent, 0.05);
+    for (std::size_t i = 0; i < filter.particles().size(); ++i) {
+      EXPECT_EQ(filter.particles()[i].pose.x(), untempered_filter.particles()[i].pose.x());
+      EXPECT_EQ(filter.particles()[i].pose.theta(), untempered_filter.particles()[i].pose.theta());
+    }
+    break;
+  }
+  EXPECT_EQ(updates, 2);
+  RecordProperty("resamples_full", std::to_string(full.resamples));
+  RecordProperty("resamples_per_point", std::to_string(tempered.resamples));
+  EXPECT_LT(tempered.resamples, full.resamples) << "full " << full.resamples;
+  EXPECT_LT(PositionRmse(tempered.online, run.run.truth), 0.1);
+}
+
 // proposal_spread scales the draw around the proposal's mean and nothing else: the same seed gives
 // the same climb and the same Gaussian, so the half-spread pose lies halfway between the mean
 // (spread 0) and the full draw (spread 1), particle for particle.
