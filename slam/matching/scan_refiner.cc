@@ -83,6 +83,7 @@ std::vector<std::string> ScanRefinerOptions::Validate() const {
   if (!(prior_sigma_yaw_rad >= 0.0)) {
     add("prior_sigma_yaw_rad", prior_sigma_yaw_rad, "must be >= 0");
   }
+  if (max_halvings < 0) add("max_halvings", max_halvings, "must be >= 0");
   return errors;
 }
 
@@ -141,14 +142,15 @@ RefineResult ScanRefiner::Refine(const GridView& raster, float max_value,
       const Eigen::Vector3d j(scale * m.gradient.x(), scale * m.gradient.y(),
                               scale * m.gradient.dot(dtheta));
       h += j * j.transpose();
-      b += j * residual;
+      b += options_.maximise_score ? j : Eigen::Vector3d(j * residual);
       residual_sum += residual;
     }
-    // The prior as extra residuals. The data's gradient is sum r_i scale grad M_i where the
-    // score's is sum grad M_i: weighting the prior's information by scale * mean(r_i) makes the
-    // two stationary points agree, so the steps head for the maximum of score - prior cost.
-    const Eigen::Vector3d w =
-        scale * (residual_sum / static_cast<double>(points_base.size())) * info;
+    // The prior as extra residuals. Maximising the score, b is the gradient of scale x (score -
+    // prior cost) and the prior's information enters scaled alike. On the residuals, the data's
+    // gradient is sum r_i scale grad M_i where the score's is sum grad M_i: weighting the prior's
+    // information by scale * mean(r_i) makes the two stationary points nearly agree.
+    const double mean_residual = residual_sum / static_cast<double>(points_base.size());
+    const Eigen::Vector3d w = scale * (options_.maximise_score ? 1.0 : mean_residual) * info;
     h.diagonal() += w;
     b -= w.cwiseProduct(offset(pose));
     // Levenberg-style damping keeps flat directions (a corridor) from exploding.
@@ -159,13 +161,21 @@ RefineResult ScanRefiner::Refine(const GridView& raster, float max_value,
     if (t_norm > options_.max_step_m) step *= options_.max_step_m / t_norm;
     if (std::abs(step.z()) > options_.max_step_rad)
       step *= options_.max_step_rad / std::abs(step.z());
-    const Pose2 candidate(pose.x() + step.x(), pose.y() + step.y(), pose.theta() + step.z());
-    // The samples stay those of result.pose when the candidate is refused (the loop ends then).
+    // The samples stay those of result.pose when every candidate is refused (the loop ends then).
     thread_local std::vector<Sample> candidate_samples;
-    const double score = SampleAll(raster, points_base, candidate, candidate_samples);
-    const double cost = prior_cost(candidate);
+    const int halvings = options_.maximise_score ? options_.max_halvings : 0;
+    Pose2 candidate;
+    double score = 0.0, cost = 0.0;
+    bool better = false;
+    for (int k = 0; k <= halvings && !better; ++k) {
+      if (k > 0) step *= 0.5;
+      candidate = Pose2(pose.x() + step.x(), pose.y() + step.y(), pose.theta() + step.z());
+      score = SampleAll(raster, points_base, candidate, candidate_samples);
+      cost = prior_cost(candidate);
+      better = score - cost > result.score - result.prior_cost;
+    }
     ++result.iterations;
-    if (!(score - cost > result.score - result.prior_cost)) break;
+    if (!better) break;
     samples.swap(candidate_samples);
     result.pose = candidate;
     result.score = score;

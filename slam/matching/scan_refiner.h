@@ -23,6 +23,16 @@ struct ScanRefinerOptions {
   /// drifting. 0 = no prior on that part.
   double prior_sigma_xy_m = 0.0;
   double prior_sigma_yaw_rad = 0.0;
+  /// What the steps climb. false: Hector's Gauss-Newton on the residuals 1 - M, whose optimum
+  /// weights the worst-fitting points most and is not the score's; a step that lowers the score
+  /// ends the refinement, so it stops between the two optima at a point that depends on where it
+  /// started. true: the score minus the prior itself, along the Gauss-Newton direction with the
+  /// score's gradient (an ascent direction: the normal matrix is positive definite), each step
+  /// halved up to max_halvings times until it raises the score; it ends near the score's maximum
+  /// in the start's basin, wherever in the basin the start is. Off: on the pf it only reshuffles
+  /// the seeds (README, "Particle filter: the map-writing pose").
+  bool maximise_score = false;
+  int max_halvings = 5;  ///< with maximise_score: step halvings tried before giving up
 
   /// One message per broken rule (prefixed "refine.").
   std::vector<std::string> Validate() const;
@@ -37,6 +47,8 @@ void VisitFields(V& v, ScanRefinerOptions& o) {
   v("converged_step_m", o.converged_step_m);
   v("prior_sigma_xy_m", o.prior_sigma_xy_m);
   v("prior_sigma_yaw_rad", o.prior_sigma_yaw_rad);
+  v("maximise_score", o.maximise_score);
+  v("max_halvings", o.max_halvings);
 }
 
 /// A refined pose and its score.
