@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <limits>
 #include <unordered_map>
+#include <utility>
 
 #include "slam/types/validation.h"
 
@@ -23,6 +24,25 @@ int FloorToInt(double v) {
   const int i = static_cast<int>(v);
   return i - (v < i);
 }
+
+// The square cells of side `length_m` that the independence counts hash end points by.
+class PointCells {
+ public:
+  explicit PointCells(double length_m) : inv_(1.0 / length_m) {}
+  std::pair<std::int64_t, std::int64_t> Of(const Eigen::Vector2d& v) const {
+    return {static_cast<std::int64_t>(std::floor(v.x() * inv_)),
+            static_cast<std::int64_t>(std::floor(v.y() * inv_))};
+  }
+  // Both indices packed into one word, so that no two of a cell's nine neighbours share a key
+  // (a multiplicative hash can map two of them to one bucket and count its points twice).
+  static std::uint64_t Key(std::int64_t x, std::int64_t y) {
+    return static_cast<std::uint64_t>(static_cast<std::uint32_t>(x)) << 32 |
+           static_cast<std::uint32_t>(y);
+  }
+
+ private:
+  double inv_;
+};
 
 }  // namespace
 
@@ -70,22 +90,18 @@ std::vector<MatchPoint> MakeMatchPoints(const LaserScan& scan, const ScanPointsO
 
 int CountIndependentPoints(std::span<const MatchPoint> points, double length_m) {
   if (!(length_m > 0.0)) return static_cast<int>(points.size());
-  // The kept points hashed by their cell of side length_m: a point within length_m of a kept one
-  // has it in its own cell or one of the eight around it.
-  const double inv = 1.0 / length_m;
+  // The kept points hashed by their cell: a point within length_m of a kept one has it in its
+  // own cell or one of the eight around it.
+  const PointCells cells(length_m);
   const double l2 = length_m * length_m;
-  auto key = [](std::int64_t x, std::int64_t y) {
-    return static_cast<std::uint64_t>(x) * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint64_t>(y);
-  };
   std::unordered_map<std::uint64_t, std::vector<Eigen::Vector2d>> kept;
   int count = 0;
   for (const MatchPoint& p : points) {
-    const auto cx = static_cast<std::int64_t>(std::floor(p.hit.x() * inv));
-    const auto cy = static_cast<std::int64_t>(std::floor(p.hit.y() * inv));
+    const auto [cx, cy] = cells.Of(p.hit);
     bool near = false;
     for (std::int64_t dy = -1; dy <= 1 && !near; ++dy) {
       for (std::int64_t dx = -1; dx <= 1 && !near; ++dx) {
-        const auto it = kept.find(key(cx + dx, cy + dy));
+        const auto it = kept.find(PointCells::Key(cx + dx, cy + dy));
         if (it == kept.end()) continue;
         for (const Eigen::Vector2d& q : it->second) {
           if ((q - p.hit).squaredNorm() < l2) {
@@ -96,7 +112,7 @@ int CountIndependentPoints(std::span<const MatchPoint> points, double length_m) 
       }
     }
     if (near) continue;
-    kept[key(cx, cy)].push_back(p.hit);
+    kept[PointCells::Key(cx, cy)].push_back(p.hit);
     ++count;
   }
   return count;
@@ -105,32 +121,21 @@ int CountIndependentPoints(std::span<const MatchPoint> points, double length_m) 
 void AssignIndependenceWeights(std::span<MatchPoint> points, double length_m) {
   for (MatchPoint& p : points) p.weight = 1.0;
   if (!(length_m > 0.0)) return;
-  // The points hashed by their cell of side length_m: a point within length_m of another has it
-  // in its own cell or one of the eight around it.
-  const double inv = 1.0 / length_m;
+  // The points hashed by their cell: a point within length_m of another has it in its own cell
+  // or one of the eight around it.
+  const PointCells cells(length_m);
   const double l2 = length_m * length_m;
-  auto cell = [inv](const Eigen::Vector2d& v) {
-    return std::pair<std::int64_t, std::int64_t>(
-        static_cast<std::int64_t>(std::floor(v.x() * inv)),
-        static_cast<std::int64_t>(std::floor(v.y() * inv)));
-  };
-  // Both indices packed into one word, so that no two of the nine cells share a key (a
-  // multiplicative hash can map two of them to one bucket and count its points twice).
-  auto key = [](std::int64_t x, std::int64_t y) {
-    return static_cast<std::uint64_t>(static_cast<std::uint32_t>(x)) << 32 |
-           static_cast<std::uint32_t>(y);
-  };
   std::unordered_map<std::uint64_t, std::vector<std::size_t>> buckets;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const auto [cx, cy] = cell(points[i].hit);
-    buckets[key(cx, cy)].push_back(i);
+    const auto [cx, cy] = cells.Of(points[i].hit);
+    buckets[PointCells::Key(cx, cy)].push_back(i);
   }
   for (MatchPoint& p : points) {
-    const auto [cx, cy] = cell(p.hit);
+    const auto [cx, cy] = cells.Of(p.hit);
     int neighbours = 0;
     for (std::int64_t dy = -1; dy <= 1; ++dy) {
       for (std::int64_t dx = -1; dx <= 1; ++dx) {
-        const auto it = buckets.find(key(cx + dx, cy + dy));
+        const auto it = buckets.find(PointCells::Key(cx + dx, cy + dy));
         if (it == buckets.end()) continue;
         for (const std::size_t j : it->second) {
           neighbours += (points[j].hit - p.hit).squaredNorm() < l2;
