@@ -67,15 +67,24 @@ CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
 }
 
 CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
-                                       const OccupancyGrid& grid)
-    : options_(options), origin_(grid.origin()), resolution_(grid.resolution()) {
+                                       const OccupancyGrid& grid, int decimation)
+    : options_(options),
+      origin_(grid.origin()),
+      resolution_(grid.resolution() * std::max(decimation, 1)) {
   SLAMRIG_CHECK(options_.Validate().empty(), "invalid CorrelativeMatcherOptions");
-  std::vector<float> values(grid.log_odds().size());
-  for (std::size_t c = 0; c < values.size(); ++c) {
-    const double l = grid.log_odds()[c];
-    values[c] = l > 0.0 ? static_cast<float>(1.0 - 1.0 / (1.0 + std::exp(l))) : 0.0f;
+  SLAMRIG_CHECK(decimation >= 1, "CorrelativeMatcher: decimation must be >= 1");
+  const int d = decimation;
+  const int width = (grid.width() + d - 1) / d, height = (grid.height() + d - 1) / d;
+  std::vector<float> values(static_cast<std::size_t>(width) * height, 0.0f);
+  for (int y = 0; y < grid.height(); ++y) {
+    for (int x = 0; x < grid.width(); ++x) {
+      const double l = grid.log_odds()[static_cast<std::size_t>(y) * grid.width() + x];
+      if (!(l > 0.0)) continue;
+      float& coarse = values[static_cast<std::size_t>(y / d) * width + x / d];
+      coarse = std::max(coarse, static_cast<float>(1.0 - 1.0 / (1.0 + std::exp(l))));
+    }
   }
-  Precompute(std::move(values), grid.width(), grid.height());
+  Precompute(std::move(values), width, height);
 }
 
 void CorrelativeMatcher::Precompute(std::vector<float> values, int width, int height) {

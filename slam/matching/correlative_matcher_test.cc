@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -200,6 +201,68 @@ TEST(CorrelativeMatcherTest, RecoversLargeOffsetsOnAnOccupancyGrid) {
     // the corridor test below relies on).
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(m->covariance.topLeftCorner<2, 2>());
     EXPECT_LT(eig.eigenvalues()[1], 5.0 * eig.eigenvalues()[0]) << trial;
+  }
+}
+
+// A grid searched d times coarser is searched as its max-pooled raster: the same poses and scores
+// as the plain matcher on a raster pooled here cell by cell, distinct places included. And the
+// coarse search still finds the office's scans from metres and up to pi away, to within a coarse
+// cell in x and y and two yaw steps (pooling flattens the score across a coarse cell, so the
+// discrete optimum may sit a step further; the relocaliser refines from there).
+TEST(CorrelativeMatcherTest, ADecimatedGridIsSearchedAsItsMaxPooledRaster) {
+  const SegmentWorld world = SegmentWorld::Office();
+  RandomEngine rng(5);
+  const OccupancyGrid grid = MapFromScans(world, OfficeLoopPoses(), rng);
+  ScanPointsOptions points;
+  points.voxel_size_m = 0.15;
+  for (const int d : {2, 3, 4}) {
+    const int width = (grid.width() + d - 1) / d, height = (grid.height() + d - 1) / d;
+    std::vector<float> pooled(static_cast<std::size_t>(width) * height, 0.0f);
+    for (int cy = 0; cy < height; ++cy) {
+      for (int cx = 0; cx < width; ++cx) {
+        float& v = pooled[static_cast<std::size_t>(cy) * width + cx];
+        for (int y = cy * d; y < std::min((cy + 1) * d, grid.height()); ++y) {
+          for (int x = cx * d; x < std::min((cx + 1) * d, grid.width()); ++x) {
+            const float l = grid.log_odds()[static_cast<std::size_t>(y) * grid.width() + x];
+            if (l > 0.0f) v = std::max(v, static_cast<float>(1.0 - 1.0 / (1.0 + std::exp(l))));
+          }
+        }
+      }
+    }
+    const GridView raster{pooled.data(), width, height, grid.origin(), d * grid.resolution()};
+    CorrelativeMatcherOptions options;
+    options.linear_window_m = 2.5;
+    options.branch_and_bound_depth = 5;
+    options.min_score = 0.3;
+    const CorrelativeMatcher decimated(options, grid, d);
+    const CorrelativeMatcher reference(options, raster);
+    for (int trial = 0; trial < 6; ++trial) {
+      const std::vector<Pose2> loop = OfficeLoopPoses();
+      const Pose2 base =
+          loop[static_cast<std::size_t>(Uniform01(rng) * static_cast<double>(loop.size()))];
+      const Pose2 truth(base.x() + 0.4 * Uniform01(rng) - 0.2,
+                        base.y() + 0.4 * Uniform01(rng) - 0.2, 6.28 * Uniform01(rng));
+      const std::vector<Eigen::Vector2d> scan =
+          ScanToBasePoints(world.Scan(truth, Time(), RangeFinderSpec{}, &rng), points);
+      const Pose2 initial(truth.x() + 4.0 * Uniform01(rng) - 2.0,
+                          truth.y() + 4.0 * Uniform01(rng) - 2.0,
+                          truth.theta() + (2.0 * Uniform01(rng) - 1.0) * 3.0);
+      const std::vector<MatchResult> fast = decimated.MatchDistinct(scan, initial, 3, 1.0, 0.5);
+      const std::vector<MatchResult> slow = reference.MatchDistinct(scan, initial, 3, 1.0, 0.5);
+      ASSERT_EQ(fast.size(), slow.size()) << d << " " << trial;
+      ASSERT_FALSE(fast.empty()) << d << " " << trial;
+      for (std::size_t r = 0; r < fast.size(); ++r) {
+        EXPECT_EQ(fast[r].pose, slow[r].pose) << d << " " << trial << " " << r;
+        EXPECT_EQ(fast[r].score, slow[r].score) << d << " " << trial << " " << r;
+      }
+      const double cell = d * grid.resolution();
+      EXPECT_DOUBLE_EQ(decimated.AngularStep(scan), reference.AngularStep(scan));
+      EXPECT_LT((fast.front().pose.translation() - truth.translation()).norm(), cell)
+          << d << " " << trial;
+      EXPECT_LT(std::abs(NormalizeAngle(fast.front().pose.theta() - truth.theta())),
+                2.0 * decimated.AngularStep(scan))
+          << d << " " << trial;
+    }
   }
 }
 

@@ -427,15 +427,18 @@ std::vector<ParticleFilter::ScoredPose> ParticleFilter::GlobalMatches(
     m.linear_window_m = 0.5 * (b - a).cwiseMax(0.0).maxCoeff();
     m.angular_window_rad = 3.14159265358979;  // every heading
     m.min_score = 0.0;
-    global_matcher_ = std::make_unique<CorrelativeMatcher>(m, map_);
+    const int decimation =
+        std::max(1, static_cast<int>(std::lround(o.search_resolution_m / map_.resolution())));
+    global_matcher_ = std::make_unique<CorrelativeMatcher>(m, map_, decimation);
   }
   std::vector<ScoredPose> places;
   for (const MatchResult& match : global_matcher_->MatchDistinct(
            near, Pose2(search_centre_.x(), search_centre_.y(), 0.0), o.global_candidates,
            o.distinct_radius_m, o.distinct_angle_rad)) {
-    if (const std::optional<ScoredPose> place = AcceptedPlace(points, match.pose)) {
-      places.push_back(*place);
-    }
+    // The coarse raster places the scan to within a coarse cell and yaw step: the shift search
+    // and refinement at the map's resolution take it from there.
+    const ScoredPose place = LocalMatch(points, match.pose);
+    if (place.quality >= o.accept_ratio * quality_slow_) places.push_back(place);
   }
   return places;
 }

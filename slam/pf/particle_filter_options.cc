@@ -50,6 +50,7 @@ std::vector<std::string> RelocalisationOptions::Validate() const {
   }
   if (resume_updates < 1) errors.push_back(Rule("resume_updates", resume_updates, "must be >= 1"));
   positive("search_max_range_m", search_max_range_m);
+  positive("search_resolution_m", search_resolution_m);
   positive("search_window_m", search_window_m);
   positive("max_lost_s", max_lost_s);
   if (!(reset_sigma_xy_m >= 0.0)) {

@@ -87,6 +87,14 @@ struct RelocalisationOptions {
   double slip_radius_m = 1.0;
   double slip_angle_rad = 0.6;       ///< and headings within this of the tracked one
   double search_max_range_m = 10.0;  ///< points used by the global search (a finer yaw step)
+  /// The global search's raster: the map max-pooled to this (rounded to a whole number of map
+  /// cells, at least one), each place it finds then matched at the map's resolution (the shift
+  /// search and refinement that tracking uses). The search's cost falls with the cube of the
+  /// ratio (translations in x and y, and headings, whose step follows the resolution): at the
+  /// map's 0.05 m each distinct place cost 1.6-2.4 s of CPU on intel's map, three quarters of a
+  /// default run (17.0 s -> 4.3 s at 0.2 m). On the ten corrected logs and the kidnapping
+  /// scenario 0.2 m relocalises where 0.05 m did, on the same scans.
+  double search_resolution_m = 0.2;
   /// The global search covers x and y within this of where the filter was lost (all of a
   /// building's floor; it bounds the cost on a city-sized map), every heading.
   double search_window_m = 20.0;
@@ -121,6 +129,7 @@ void VisitFields(V& v, RelocalisationOptions& o) {
   v("slip_radius_m", o.slip_radius_m);
   v("slip_angle_rad", o.slip_angle_rad);
   v("search_max_range_m", o.search_max_range_m);
+  v("search_resolution_m", o.search_resolution_m);
   v("search_window_m", o.search_window_m);
   v("max_lost_s", o.max_lost_s);
   v("reset_sigma_xy_m", o.reset_sigma_xy_m);
