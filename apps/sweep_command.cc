@@ -62,6 +62,9 @@ int RunSweepCommand(const std::vector<std::string>& args) {
   if (row >= 0) {
     return scenario::RunSweepRow(spec, options, static_cast<std::size_t>(row)) ? 0 : 3;
   }
+  // Every value of the grid resolves before a run starts or a file is written (a Slurm array is
+  // checked before it is submitted; its tasks, --row, were checked then).
+  scenario::CheckSweepGrid(spec);
   const scenario::SweepSummary s = scenario::RunSweep(spec, options);
   std::printf("%s: %d runs (%d from an earlier sweep, %d now), %d failed -> %s/results.csv\n",
               sweep_path.c_str(), s.total, s.already_done, s.ran, s.failed,

@@ -387,6 +387,59 @@ std::vector<std::string> ResultsHeader(const SweepSpec& spec,
   return header;
 }
 
+void CheckSweepGrid(const SweepSpec& spec) {
+  // LoadScenario names an overridden value's error by its --set argument; the sweep's user wrote
+  // no --set, so that prefix gives way to the value's place in the sweep file.
+  auto rule_of = [](const ConfigError& e) {
+    const std::string what = e.what();
+    const std::size_t colon = what.find(": ");
+    return what.rfind("--set ", 0) == 0 && colon != std::string::npos ? what.substr(colon + 2)
+                                                                      : what;
+  };
+  // Each value alone, over the base scenario: a failure is that value's.
+  for (const SweepParameter& p : spec.parameters) {
+    for (std::size_t v = 0; v < p.values.size(); ++v) {
+      try {
+        LoadScenario(spec.scenario_path, {p.key + "=" + p.values[v]});
+      } catch (const ConfigError& e) {
+        const std::string where =
+            v < p.where.size() ? p.where[v] : spec.path + ": parameters." + p.key;
+        throw ConfigError(where + ": " + rule_of(e));
+      }
+    }
+  }
+  // Then every combination, when there are few enough to check quickly.
+  std::size_t combinations = 1;
+  for (const SweepParameter& p : spec.parameters) {
+    combinations = combinations > kMaxCheckedCombinations / p.values.size()
+                       ? kMaxCheckedCombinations + 1
+                       : combinations * p.values.size();
+  }
+  if (spec.parameters.size() < 2 || combinations > kMaxCheckedCombinations) return;
+  std::vector<std::size_t> index(spec.parameters.size(), 0);
+  while (true) {
+    std::vector<std::string> overrides;
+    std::string named;
+    for (std::size_t p = 0; p < spec.parameters.size(); ++p) {
+      const SweepParameter& parameter = spec.parameters[p];
+      overrides.push_back(parameter.key + "=" + parameter.values[index[p]]);
+      named += (p ? " " : "") + overrides.back();
+    }
+    try {
+      LoadScenario(spec.scenario_path, overrides);
+    } catch (const ConfigError& e) {
+      throw ConfigError(spec.path + ": parameters: the combination " + named + ": " + rule_of(e));
+    }
+    std::size_t p = spec.parameters.size();
+    while (p > 0) {
+      --p;
+      if (++index[p] < spec.parameters[p].values.size()) break;
+      index[p] = 0;
+    }
+    if (p == 0 && index[0] == 0) return;
+  }
+}
+
 SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) {
   namespace fs = std::filesystem;
   const std::vector<SweepRun> runs = ExpandSweep(spec);

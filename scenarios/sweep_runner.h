@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,17 @@ struct SweepSummary {
 /// (summary_<metric>__<parameter>.png: the mean over seeds with the min-max spread) and
 /// summary.html.
 SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options);
+
+/// Resolves the sweep's scenario at every value of the grid, as its runs will, before anything
+/// runs or is written: each value alone (over the base scenario), then, for grids of at most
+/// kMaxCheckedCombinations parameter combinations, every combination (two values each valid
+/// alone may not be valid together; a larger grid meets those as failed runs). A bad value is a
+/// ConfigError naming its place in the sweep file and the rule it breaks, so a typo in the grid
+/// fails at once instead of as run 57 of an hour's study.
+void CheckSweepGrid(const SweepSpec& spec);
+
+/// The most parameter combinations CheckSweepGrid resolves one by one.
+inline constexpr std::size_t kMaxCheckedCombinations = 4096;
 
 /// Runs grid row `row` alone (a child `slamrig run` as in RunSweep) and writes its results.csv
 /// line, under the header, to `out_dir`/rows/<row>.csv atomically; results.csv is not touched

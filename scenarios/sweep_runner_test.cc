@@ -162,6 +162,37 @@ TEST(SweepTest, SummaryPoolsTheLandmarkAneesOverTheMappedLandmarks) {
   EXPECT_TRUE(std::filesystem::exists(dir.File("out/summary_anees_s.landmark_anees.png")));
 }
 
+// A bad value in the grid fails before any run or output, naming its place in the sweep file and
+// the rule; two values valid alone but not together fail as their combination; a good grid
+// passes. Over the shipped office scenario, which LoadScenario resolves for real.
+TEST(SweepTest, CheckSweepGridNamesTheBadValueBeforeAnythingRuns) {
+  testing::TempDir dir;
+  const std::string office = std::string(SLAMRIG_SOURCE_DIR) + "/scenarios/office_loop.yaml";
+  auto error = [&](const std::string& parameters) {
+    try {
+      CheckSweepGrid(LoadSweepSpec(dir.Write(
+          "sweep.yaml", "scenario: " + office + "\nseeds: 2\nparameters:\n" + parameters)));
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error("  slam.pf.particles: [30, 100]\n  world.drive.laps: [1, 2]\n"), "");
+  EXPECT_THAT(error("  world.drive.laps: [1]\n  slam.pf.particles: [30, 0]\n"),
+              ::testing::MatchesRegex(".*sweep.yaml:5:[0-9]+: parameters.slam.pf.particles\\[1\\]: "
+                                      "slam.pf.particles = 0; must be > 0"));
+  EXPECT_THAT(error("  slam.pf.particles: [abc]\n"),
+              ::testing::HasSubstr("sweep.yaml:4:23: parameters.slam.pf.particles[0]: "
+                                   "slam.pf.particles: expected an integer, got 'abc'"));
+  EXPECT_THAT(error("  slam.pf.relocalisation.slow_rate: [0.02, 0.5]\n"
+                    "  slam.pf.relocalisation.fast_rate: [1.0, 0.3]\n"),
+              ::testing::HasSubstr("sweep.yaml: parameters: the combination "
+                                   "slam.pf.relocalisation.slow_rate=0.5 "
+                                   "slam.pf.relocalisation.fast_rate=0.3: "
+                                   "slam.pf.relocalisation.slow_rate = 0.5; must be <= fast_rate"));
+  EXPECT_FALSE(std::filesystem::exists(dir.File("out")));
+}
+
 TEST(SweepTest, BadSweepFilesNameFileLineAndKey) {
   testing::TempDir dir;
   dir.Write("s.yaml", "name: x\n");

@@ -46,6 +46,7 @@ SweepSpec LoadSweepSpec(const std::string& path) {
     for (const YamlNode& v : values.Elements()) {
       if (!v.IsScalar()) v.Fail("sweep values must be scalars");
       p.values.push_back(v.As<std::string>());
+      p.where.push_back(v.Where());
     }
     if (p.values.empty()) values.Fail("needs at least one value");
     spec.parameters.push_back(std::move(p));

@@ -10,6 +10,7 @@ namespace slamrig::scenario {
 struct SweepParameter {
   std::string key;                  ///< dotted path into the scenario file, e.g. slam.pf.particles
   std::vector<std::string> values;  ///< YAML scalars, e.g. "0.01", "100"
+  std::vector<std::string> where;   ///< each value's place in the sweep file, "file:line:col"
 };
 
 /// A sweep file: a base scenario, a grid of parameters and a set of seeds.
