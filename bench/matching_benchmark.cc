@@ -2,7 +2,8 @@
 // and +-pi at 5 cm, a 1081-beam Hokuyo scan decimated to a few hundred points) and ICP, on the
 // SegmentWorld office mapped from scans round its corridor loop (built once, outside the timing);
 // then both on the real intel-corrected log (skipped with a message when the dataset is absent):
-// the loop-closure search on the map of its corrected poses, and IcpOdometry over the whole log.
+// the loop-closure search on the map of its corrected poses, the pf relocaliser's whole-map search
+// at full and coarser resolutions, and IcpOdometry over the whole log.
 //
 //   build/bench/matching_benchmark --benchmark_repetitions=5
 //   --benchmark_report_aggregates_only=true
@@ -193,6 +194,50 @@ BENCHMARK(BM_CorrelativeSearchIntel)
     ->Args({100, 8})
     ->Args({100, 9})
     ->Unit(benchmark::kMillisecond);
+
+// The pf relocaliser's global search (slam/pf/particle_filter.cc, GlobalMatches) on the intel
+// map: the whole map (+-20 m about its centre), every heading, the three best distinct places (1 m
+// or 0.5 rad apart), scan 400's points within 10 m at the pf's 5 cm voxels, min_score 0. Arg: the
+// decimation of the raster (relocalisation.search_resolution_m / the map's 0.05 m; 4 is the
+// default's 0.2 m). At 1, each lost update of a default pf run cost three such searches.
+void BM_RelocaliserSearchIntel(benchmark::State& state) {
+  const Intel* intel = TheIntel();
+  if (intel == nullptr) {
+    state.SkipWithError("intel-corrected.log.gz not found (set SLAMRIG_DATA_DIR)");
+    return;
+  }
+  const int decimation = static_cast<int>(state.range(0));
+  const Eigen::Vector2d extent =
+      Eigen::Vector2d(intel->grid.width(), intel->grid.height()) * intel->grid.resolution();
+  const Eigen::Vector2d centre = intel->grid.origin() + 0.5 * extent;
+  CorrelativeMatcherOptions options;
+  options.linear_window_m = std::min(20.0, 0.5 * extent.maxCoeff());
+  options.angular_window_rad = std::numbers::pi;
+  options.min_score = 0.0;
+  const CorrelativeMatcher matcher(options, intel->grid, decimation);
+  ScanPointsOptions points;
+  const CarmenScan& scan = intel->scans[400];
+  std::vector<Eigen::Vector2d> cloud;
+  for (const Eigen::Vector2d& p : ScanToBasePoints(scan.scan, points)) {
+    if (p.norm() <= 10.0) cloud.push_back(p);
+  }
+  const Pose2 truth = scan.logged_pose;
+  double error_m = -1.0;
+  int nodes = 0;
+  for (auto _ : state) {
+    const std::vector<MatchResult> places =
+        matcher.MatchDistinct(cloud, Pose2(centre.x(), centre.y(), 0.0), 3, 1.0, 0.5);
+    error_m =
+        places.empty() ? -1.0 : (places.front().pose.translation() - truth.translation()).norm();
+    nodes = places.empty() ? -1 : places.front().iterations;
+    benchmark::DoNotOptimize(places);
+  }
+  state.counters["points"] = static_cast<double>(cloud.size());
+  state.counters["error_m"] = error_m;  // of the best place, before the local match refines it
+  state.counters["yaw_step_mrad"] = 1000.0 * matcher.AngularStep(cloud);
+  state.counters["nodes"] = nodes;  // of the three searches together
+}
+BENCHMARK(BM_RelocaliserSearchIntel)->Arg(1)->Arg(2)->Arg(4)->Unit(benchmark::kMillisecond);
 
 // IcpOdometry over all intel scans with the recovered raw odometry as the prior. Counters: the
 // position RMSE against the corrected poses (both anchored at the first scan) of ICP odometry and
