@@ -169,6 +169,28 @@ TEST(CorrelativeMatcherTest, DistinctPlacesAreTheExhaustiveSearchsSuppressedMaxi
   EXPECT_GT(second, 20);
 }
 
+// A scan of the office from a random pose near its loop (any heading), and a guess up to 2 m and
+// 3 rad away from that pose.
+struct FarScan {
+  Pose2 truth;
+  Pose2 initial;
+  std::vector<Eigen::Vector2d> points;
+};
+FarScan ScanFromFarAway(const SegmentWorld& world, const ScanPointsOptions& points,
+                        RandomEngine& rng) {
+  const std::vector<Pose2> loop = OfficeLoopPoses();
+  const Pose2 base =
+      loop[static_cast<std::size_t>(Uniform01(rng) * static_cast<double>(loop.size()))];
+  FarScan far;
+  far.truth = Pose2(base.x() + 0.4 * Uniform01(rng) - 0.2, base.y() + 0.4 * Uniform01(rng) - 0.2,
+                    6.28 * Uniform01(rng));
+  far.points = ScanToBasePoints(world.Scan(far.truth, Time(), RangeFinderSpec{}, &rng), points);
+  far.initial =
+      Pose2(far.truth.x() + 4.0 * Uniform01(rng) - 2.0, far.truth.y() + 4.0 * Uniform01(rng) - 2.0,
+            far.truth.theta() + (2.0 * Uniform01(rng) - 1.0) * 3.0);
+  return far;
+}
+
 // On a map of the office, a decimated scan is found from an initial guess metres and up to pi off.
 TEST(CorrelativeMatcherTest, RecoversLargeOffsetsOnAnOccupancyGrid) {
   const SegmentWorld world = SegmentWorld::Office();
@@ -182,16 +204,7 @@ TEST(CorrelativeMatcherTest, RecoversLargeOffsetsOnAnOccupancyGrid) {
   ScanPointsOptions points;
   points.voxel_size_m = 0.15;
   for (int trial = 0; trial < 8; ++trial) {
-    const std::vector<Pose2> loop = OfficeLoopPoses();
-    const Pose2 base =
-        loop[static_cast<std::size_t>(Uniform01(rng) * static_cast<double>(loop.size()))];
-    const Pose2 truth(base.x() + 0.4 * Uniform01(rng) - 0.2, base.y() + 0.4 * Uniform01(rng) - 0.2,
-                      6.28 * Uniform01(rng));
-    const std::vector<Eigen::Vector2d> scan =
-        ScanToBasePoints(world.Scan(truth, Time(), RangeFinderSpec{}, &rng), points);
-    const Pose2 initial(truth.x() + 4.0 * Uniform01(rng) - 2.0,
-                        truth.y() + 4.0 * Uniform01(rng) - 2.0,
-                        truth.theta() + (2.0 * Uniform01(rng) - 1.0) * 3.0);
+    const auto [truth, initial, scan] = ScanFromFarAway(world, points, rng);
     const std::optional<MatchResult> m = matcher.Match(scan, initial);
     ASSERT_TRUE(m.has_value()) << trial;
     EXPECT_LT((m->pose.translation() - truth.translation()).norm(), 0.08) << trial;
@@ -237,16 +250,7 @@ TEST(CorrelativeMatcherTest, ADecimatedGridIsSearchedAsItsMaxPooledRaster) {
     const CorrelativeMatcher decimated(options, grid, d);
     const CorrelativeMatcher reference(options, raster);
     for (int trial = 0; trial < 6; ++trial) {
-      const std::vector<Pose2> loop = OfficeLoopPoses();
-      const Pose2 base =
-          loop[static_cast<std::size_t>(Uniform01(rng) * static_cast<double>(loop.size()))];
-      const Pose2 truth(base.x() + 0.4 * Uniform01(rng) - 0.2,
-                        base.y() + 0.4 * Uniform01(rng) - 0.2, 6.28 * Uniform01(rng));
-      const std::vector<Eigen::Vector2d> scan =
-          ScanToBasePoints(world.Scan(truth, Time(), RangeFinderSpec{}, &rng), points);
-      const Pose2 initial(truth.x() + 4.0 * Uniform01(rng) - 2.0,
-                          truth.y() + 4.0 * Uniform01(rng) - 2.0,
-                          truth.theta() + (2.0 * Uniform01(rng) - 1.0) * 3.0);
+      const auto [truth, initial, scan] = ScanFromFarAway(world, points, rng);
       const std::vector<MatchResult> fast = decimated.MatchDistinct(scan, initial, 3, 1.0, 0.5);
       const std::vector<MatchResult> slow = reference.MatchDistinct(scan, initial, 3, 1.0, 0.5);
       ASSERT_EQ(fast.size(), slow.size()) << d << " " << trial;
