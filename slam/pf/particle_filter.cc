@@ -236,9 +236,7 @@ bool ParticleFilter::Relocalise(const std::vector<Eigen::Vector2d>& points, cons
   std::vector<Candidate> places;
   for (const Candidate& c : candidates_) {
     const ScoredPose followed = LocalMatch(points, c.pose);
-    if (!same_place(followed.pose, c.pose) || followed.quality < o.accept_ratio * quality_slow_) {
-      continue;
-    }
+    if (!same_place(followed.pose, c.pose) || !FitsAsPlace(followed.quality)) continue;
     bool merged = false;
     for (Candidate& p : places) {
       if (distinct(p.pose, followed.pose)) continue;
@@ -302,8 +300,7 @@ bool ParticleFilter::Relocalise(const std::vector<Eigen::Vector2d>& points, cons
     // intel-corrected, lost at 2263 s with the filter at 0.55 of its usual quality and no
     // other place fitting, drifted 3 m on the frozen map until max_lost_s gave up). So does a
     // tracked hypothesis that fits as well as usual again: the alarm was a bad scan or two.
-    if (tracked.quality >= o.accept_ratio * quality_slow_ ||
-        unsupported_updates_ >= o.resume_updates) {
+    if (FitsAsPlace(tracked.quality) || unsupported_updates_ >= o.resume_updates) {
       ResumeTracking();
       step->lost = false;
       return false;
@@ -438,7 +435,7 @@ std::vector<ParticleFilter::ScoredPose> ParticleFilter::GlobalMatches(
     // The coarse raster places the scan to within a coarse cell and yaw step: the shift search
     // and refinement at the map's resolution take it from there.
     const ScoredPose place = LocalMatch(points, match.pose);
-    if (place.quality >= o.accept_ratio * quality_slow_) places.push_back(place);
+    if (FitsAsPlace(place.quality)) places.push_back(place);
   }
   return places;
 }
@@ -466,8 +463,12 @@ std::optional<ParticleFilter::ScoredPose> ParticleFilter::AcceptedPlace(
   const float field_max = static_cast<float>(likelihood_field_.Score(0.0));
   const RefineResult refined = refiner_.Refine(likelihood_field_.view(), field_max, points, pose);
   const double quality = Quality(static_cast<float>(refined.score), points.size());
-  if (quality < options_.relocalisation.accept_ratio * quality_slow_) return std::nullopt;
+  if (!FitsAsPlace(quality)) return std::nullopt;
   return ScoredPose{refined.pose, quality};
+}
+
+bool ParticleFilter::FitsAsPlace(double quality) const {
+  return quality >= options_.relocalisation.accept_ratio * quality_slow_;
 }
 
 ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {

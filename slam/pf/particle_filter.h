@@ -95,13 +95,17 @@ class ParticleFilter {
   // must (accept_ratio).
   std::optional<ScoredPose> NearMatch(const std::vector<Eigen::Vector2d>& points,
                                       const Pose2& pose);
-  // Up to global_candidates distinct places on the whole map, each accepted as a place.
+  // Up to global_candidates distinct places on the whole map (searched at search_resolution_m),
+  // each matched by LocalMatch and kept when it fits as a place (FitsAsPlace).
   std::vector<ScoredPose> GlobalMatches(const std::vector<Eigen::Vector2d>& near,
                                         const std::vector<Eigen::Vector2d>& points);
-  // `pose` refined on the likelihood field with all `points`, when it fits as a place must
-  // (accept_ratio x the long-term quality): the judgement of both searches above.
+  // `pose` refined on the likelihood field with all `points`, when it fits as a place
+  // (FitsAsPlace): the near search's judgement.
   std::optional<ScoredPose> AcceptedPlace(const std::vector<Eigen::Vector2d>& points,
                                           const Pose2& pose);
+  // A match of this quality fits as a place: accept_ratio x the long-term quality from before the
+  // loss, the one bar for followed, tracked, near and global places alike.
+  bool FitsAsPlace(double quality) const;
   std::vector<double> Score(const std::vector<Eigen::Vector2d>& points,
                             const MatchConstraints& constraints, float* best_score);
 
