@@ -417,7 +417,7 @@ void CheckSweepGrid(const SweepSpec& spec) {
   }
   if (spec.parameters.size() < 2 || combinations > kMaxCheckedCombinations) return;
   std::vector<std::size_t> index(spec.parameters.size(), 0);
-  while (true) {
+  do {
     std::vector<std::string> overrides;
     std::string named;
     for (std::size_t p = 0; p < spec.parameters.size(); ++p) {
@@ -430,14 +430,7 @@ void CheckSweepGrid(const SweepSpec& spec) {
     } catch (const ConfigError& e) {
       throw ConfigError(spec.path + ": parameters: the combination " + named + ": " + rule_of(e));
     }
-    std::size_t p = spec.parameters.size();
-    while (p > 0) {
-      --p;
-      if (++index[p] < spec.parameters[p].values.size()) break;
-      index[p] = 0;
-    }
-    if (p == 0 && index[0] == 0) return;
-  }
+  } while (NextGridPoint(spec, &index));
 }
 
 SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) {

@@ -74,7 +74,7 @@ SweepSpec LoadSweepSpec(const std::string& path) {
 std::vector<SweepRun> ExpandSweep(const SweepSpec& spec) {
   std::vector<SweepRun> runs;
   std::vector<std::size_t> index(spec.parameters.size(), 0);
-  while (true) {
+  do {
     for (const std::uint64_t seed : spec.seeds) {
       SweepRun run;
       run.value_index = index;
@@ -85,16 +85,18 @@ std::vector<SweepRun> ExpandSweep(const SweepSpec& spec) {
       run.id += "seed=" + std::to_string(seed);
       runs.push_back(std::move(run));
     }
-    // Odometer increment, last parameter fastest.
-    std::size_t p = spec.parameters.size();
-    while (p > 0) {
-      --p;
-      if (++index[p] < spec.parameters[p].values.size()) break;
-      index[p] = 0;
-      if (p == 0) return runs;
-    }
-    if (spec.parameters.empty()) return runs;
+  } while (NextGridPoint(spec, &index));
+  return runs;
+}
+
+bool NextGridPoint(const SweepSpec& spec, std::vector<std::size_t>* index) {
+  // Odometer increment, last parameter fastest.
+  for (std::size_t p = spec.parameters.size(); p > 0;) {
+    --p;
+    if (++(*index)[p] < spec.parameters[p].values.size()) return true;
+    (*index)[p] = 0;
   }
+  return false;
 }
 
 }  // namespace slamrig::scenario

@@ -50,4 +50,9 @@ SweepSpec LoadSweepSpec(const std::string& path);
 /// Every combination of parameter values times every seed, in a fixed order.
 std::vector<SweepRun> ExpandSweep(const SweepSpec& spec);
 
+/// Moves `index` (one value index per parameter, all 0 at the grid's first point) to the next
+/// combination of parameter values, the last parameter fastest. False, with `index` back at the
+/// first point, when it was the last (at once for a grid without parameters).
+bool NextGridPoint(const SweepSpec& spec, std::vector<std::size_t>* index);
+
 }  // namespace slamrig::scenario
