@@ -22,6 +22,7 @@
 #include "slam/matching/scan_points.h"
 #include "slam/matching/testing/segment_world.h"
 #include "slam/odometry/scan_sync.h"
+#include "slam/pf/particle_filter_options.h"
 
 namespace slamrig::slam {
 namespace {
@@ -195,23 +196,25 @@ BENCHMARK(BM_CorrelativeSearchIntel)
     ->Args({100, 9})
     ->Unit(benchmark::kMillisecond);
 
-// The pf relocaliser's global search (slam/pf/particle_filter.cc, GlobalMatches) on the intel
-// map: the whole map (+-20 m about its centre), every heading, the three best distinct places (1 m
-// or 0.5 rad apart), scan 400's points within 10 m at the pf's 5 cm voxels, min_score 0. Arg: the
-// decimation of the raster (relocalisation.search_resolution_m / the map's 0.05 m; 4 is the
-// default's 0.2 m). At 1, each lost update of a default pf run cost three such searches.
+// The pf relocaliser's global search (slam/pf/particle_filter.cc, GlobalMatches) with its default
+// RelocalisationOptions on the intel map: the whole map (up to search_window_m about its centre),
+// every heading, the global_candidates best distinct places, scan 400's points within
+// search_max_range_m at the pf's 5 cm voxels, min_score 0. Arg: the decimation of the raster
+// (relocalisation.search_resolution_m / the map's 0.05 m; 4 is the default's 0.2 m). At 1, each
+// lost update of a default pf run cost three such searches.
 void BM_RelocaliserSearchIntel(benchmark::State& state) {
   const Intel* intel = TheIntel();
   if (intel == nullptr) {
     state.SkipWithError("intel-corrected.log.gz not found (set SLAMRIG_DATA_DIR)");
     return;
   }
+  const RelocalisationOptions relocalisation;
   const int decimation = static_cast<int>(state.range(0));
   const Eigen::Vector2d extent =
       Eigen::Vector2d(intel->grid.width(), intel->grid.height()) * intel->grid.resolution();
   const Eigen::Vector2d centre = intel->grid.origin() + 0.5 * extent;
   CorrelativeMatcherOptions options;
-  options.linear_window_m = std::min(20.0, 0.5 * extent.maxCoeff());
+  options.linear_window_m = std::min(relocalisation.search_window_m, 0.5 * extent.maxCoeff());
   options.angular_window_rad = std::numbers::pi;
   options.min_score = 0.0;
   const CorrelativeMatcher matcher(options, intel->grid, decimation);
@@ -219,14 +222,15 @@ void BM_RelocaliserSearchIntel(benchmark::State& state) {
   const CarmenScan& scan = intel->scans[400];
   std::vector<Eigen::Vector2d> cloud;
   for (const Eigen::Vector2d& p : ScanToBasePoints(scan.scan, points)) {
-    if (p.norm() <= 10.0) cloud.push_back(p);
+    if (p.norm() <= relocalisation.search_max_range_m) cloud.push_back(p);
   }
   const Pose2 truth = scan.logged_pose;
   double error_m = -1.0;
   int nodes = 0;
   for (auto _ : state) {
-    const std::vector<MatchResult> places =
-        matcher.MatchDistinct(cloud, Pose2(centre.x(), centre.y(), 0.0), 3, 1.0, 0.5);
+    const std::vector<MatchResult> places = matcher.MatchDistinct(
+        cloud, Pose2(centre.x(), centre.y(), 0.0), relocalisation.global_candidates,
+        relocalisation.distinct_radius_m, relocalisation.distinct_angle_rad);
     error_m =
         places.empty() ? -1.0 : (places.front().pose.translation() - truth.translation()).norm();
     nodes = places.empty() ? -1 : places.front().iterations;

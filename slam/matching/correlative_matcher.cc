@@ -68,9 +68,7 @@ CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
 
 CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
                                        const OccupancyGrid& grid, int decimation)
-    : options_(options),
-      origin_(grid.origin()),
-      resolution_(grid.resolution() * std::max(decimation, 1)) {
+    : options_(options), origin_(grid.origin()), resolution_(grid.resolution() * decimation) {
   SLAMRIG_CHECK(options_.Validate().empty(), "invalid CorrelativeMatcherOptions");
   SLAMRIG_CHECK(decimation >= 1, "CorrelativeMatcher: decimation must be >= 1");
   const int d = decimation;
