@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "slam/types/check.h"
@@ -31,6 +32,21 @@ double LikelihoodField::Score(double distance_m) const {
   if (distance_m > options_.cutoff_sigmas * options_.sigma_m * (1.0 + 1e-9)) return 0.0;
   const double g = std::exp(-0.5 * distance_m * distance_m / (options_.sigma_m * options_.sigma_m));
   return std::log(options_.z_hit * g + options_.z_rand) - std::log(options_.z_rand);
+}
+
+double LikelihoodField::Distance(double score) const {
+  if (!(score > 0.0)) return std::numeric_limits<double>::infinity();
+  // score = log(z_hit g + z_rand) - log(z_rand), g = exp(-d^2 / (2 sigma^2)).
+  const double g = std::min(1.0, options_.z_rand * std::expm1(score) / options_.z_hit);
+  return options_.sigma_m * std::sqrt(-2.0 * std::log(g));
+}
+
+void LikelihoodField::SetSigma(double sigma_m) {
+  SLAMRIG_CHECK(sigma_m > 0.0, "LikelihoodField::SetSigma needs sigma_m > 0");
+  if (sigma_m == options_.sigma_m) return;
+  options_.sigma_m = sigma_m;
+  kernel_resolution_ = 0.0;  // the kernel is rebuilt
+  followed_ = nullptr;       // and the followed field recomputed everywhere
 }
 
 void LikelihoodField::EnsureKernel(double resolution) {

@@ -60,6 +60,13 @@ class LikelihoodField {
   GridView view(const Eigen::AlignedBox2d& region) const;
   /// Value of a cell at distance `distance_m` from the nearest wall.
   double Score(double distance_m) const;
+  /// The distance from the nearest wall that has value `score` (Score's inverse); +infinity for
+  /// 0 and below (no wall within the cutoff).
+  double Distance(double score) const;
+
+  double sigma_m() const { return options_.sigma_m; }
+  /// Takes another sigma (> 0): the next Follow recomputes the whole field, an Update its window.
+  void SetSigma(double sigma_m);
 
  private:
   void EnsureKernel(double resolution);

@@ -98,6 +98,10 @@ double ScanRefiner::Score(const GridView& raster, std::span<const Eigen::Vector2
   return sum;
 }
 
+double ScanRefiner::ValueAt(const GridView& raster, const Eigen::Vector2d& world) {
+  return Interpolate(raster, world).value;
+}
+
 RefineResult ScanRefiner::Refine(const GridView& raster, float max_value,
                                  std::span<const Eigen::Vector2d> points_base,
                                  const Pose2& initial) const {

@@ -83,6 +83,8 @@ class ScanRefiner {
   /// Sum over points of the interpolated raster value at `pose`.
   static double Score(const GridView& raster, std::span<const Eigen::Vector2d> points_base,
                       const Pose2& pose);
+  /// The interpolated raster value at a world point, as the refinement samples it.
+  static double ValueAt(const GridView& raster, const Eigen::Vector2d& world);
 
  private:
   ScanRefinerOptions options_;

@@ -1,0 +1,63 @@
+#include "slam/matching/adaptive_field_sigma.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "slam/matching/scan_refiner.h"
+#include "slam/types/check.h"
+#include "slam/types/validation.h"
+
+namespace slamrig::slam {
+
+std::vector<std::string> AdaptiveSigmaOptions::Validate() const {
+  std::vector<std::string> errors;
+  auto add = [&](const char* field, double got, const char* rule) {
+    errors.push_back(RuleViolation(field, got, rule));
+  };
+  if (!(residual_factor > 0.0)) add("residual_factor", residual_factor, "must be > 0");
+  if (!(min_m > 0.0)) add("min_m", min_m, "must be > 0");
+  if (!(max_m >= min_m)) add("max_m", max_m, "must be >= min_m");
+  if (!(window_m > 0.0)) add("window_m", window_m, "must be > 0");
+  if (min_points < 1) add("min_points", min_points, "must be >= 1");
+  if (!(rate > 0.0 && rate <= 1.0)) add("rate", rate, "must be in (0, 1]");
+  if (warmup_updates < 0) add("warmup_updates", warmup_updates, "must be >= 0");
+  if (!(change_ratio >= 0.0)) add("change_ratio", change_ratio, "must be >= 0");
+  return errors;
+}
+
+AdaptiveFieldSigma::AdaptiveFieldSigma(const AdaptiveSigmaOptions& options, double initial_sigma_m)
+    : options_(options), sigma_m_(initial_sigma_m) {
+  SLAMRIG_CHECK(options_.Validate().empty(), "invalid AdaptiveSigmaOptions");
+  SLAMRIG_CHECK(initial_sigma_m > 0.0, "AdaptiveFieldSigma needs a sigma > 0");
+}
+
+std::optional<double> AdaptiveFieldSigma::MedianWallDistance(
+    const LikelihoodField& field, const GridView& view,
+    std::span<const Eigen::Vector2d> points_base, const Pose2& pose) const {
+  thread_local std::vector<double> distances;
+  distances.clear();
+  for (const Eigen::Vector2d& p : points_base) {
+    const double d = field.Distance(ScanRefiner::ValueAt(view, pose * p));
+    if (d <= options_.window_m) distances.push_back(d);
+  }
+  if (distances.size() < static_cast<std::size_t>(options_.min_points)) return std::nullopt;
+  const auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
+  std::nth_element(distances.begin(), middle, distances.end());
+  return *middle;
+}
+
+bool AdaptiveFieldSigma::Observe(double median_m) {
+  if (!options_.enabled) return false;
+  // The mean of the first 1 / rate medians, then an exponential average with that memory.
+  ++updates_;
+  median_m_ += std::max(options_.rate, 1.0 / updates_) * (median_m - median_m_);
+  if (updates_ <= options_.warmup_updates) return false;
+  const double target =
+      std::clamp(options_.residual_factor * median_m_, options_.min_m, options_.max_m);
+  if (std::abs(target - sigma_m_) <= options_.change_ratio * sigma_m_) return false;
+  sigma_m_ = target;
+  ++moves_;
+  return true;
+}
+
+}  // namespace slamrig::slam
