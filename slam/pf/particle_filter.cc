@@ -46,6 +46,7 @@ ParticleFilter::ParticleFilter(const ParticleFilterOptions& options)
       map_(options.map),
       correlator_(options.correlation),
       likelihood_field_(options.likelihood_field),
+      field_sigma_(options.adaptive_sigma, options.likelihood_field.sigma_m),
       occupied_mask_(options.correlation.occupied_threshold),
       refiner_(options.refiner),
       rng_(options.seed),
@@ -83,9 +84,9 @@ std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& po
     for (const Particle& p : particles_) particles_box.extend(p.pose.translation());
     double reach = 0.0;
     for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
-    const double margin =
-        reach + (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
-        options_.likelihood_field.cutoff_sigmas * options_.likelihood_field.sigma_m;
+    const double margin = reach +
+                          (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
+                          options_.likelihood_field.cutoff_sigmas * likelihood_field_.sigma_m();
     const Eigen::Vector2d m = Eigen::Vector2d::Constant(margin);
     // Kept up to date where the map changed; the window keeps reads outside it at 0.
     likelihood_field_.Follow(map_);
@@ -398,7 +399,7 @@ ParticleFilter::ScoredPose ParticleFilter::LocalMatch(const std::vector<Eigen::V
   for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
   const Eigen::Vector2d margin = Eigen::Vector2d::Constant(
       reach + (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
-      options_.likelihood_field.cutoff_sigmas * options_.likelihood_field.sigma_m);
+      options_.likelihood_field.cutoff_sigmas * likelihood_field_.sigma_m());
   likelihood_field_.Follow(map_);
   const GridView view = likelihood_field_.view(
       Eigen::AlignedBox2d(pose.translation() - margin, pose.translation() + margin));
@@ -546,6 +547,14 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
   // points also leave the map.)
   const bool judged = !points.empty() && ObservedFraction(points, step.best_pose) >= 0.5;
   step.neff = EffectiveSampleSize(weights);
+  // How far this scan's points lie from the map's walls, read before the scan is inserted.
+  std::optional<double> wall_distance;
+  if (judged && !lost_ && options_.observation == ObservationModel::kLikelihoodField &&
+      options_.adaptive_sigma.enabled) {
+    likelihood_field_.Follow(map_);
+    wall_distance = field_sigma_.MedianWallDistance(likelihood_field_, likelihood_field_.view(),
+                                                    points, step.best_pose);
+  }
   if (lost_) {
     // Lost since an earlier update: the map stays frozen until the filter resumes (the scan fits
     // where the filter is, or next to it, and is mapped as usual) or relocalises (a new cloud).
@@ -560,6 +569,11 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
     const bool suspect = judged && TrackQuality(step.quality, scan.time);
     step.lost = lost_;
     if (!suspect) map_.InsertScan(scan, step.best_pose);
+    // A scan that tracked as usual tells how sharp the map is; the field follows (its next
+    // Follow recomputes it everywhere).
+    if (!suspect && !lost_ && wall_distance && field_sigma_.Observe(*wall_distance)) {
+      likelihood_field_.SetSigma(field_sigma_.sigma_m());
+    }
     if (lost_) {
       // Just lost: the weights say nothing now; keep the cloud for the odometry to carry.
       last_step_ = step;

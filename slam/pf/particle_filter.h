@@ -65,6 +65,10 @@ class ParticleFilter {
   int relocalisation_count() const { return relocalisation_count_; }
   /// Lost alarms that ended with the tracked hypothesis matching well again (no relocalisation).
   int resumed_count() const { return resumed_count_; }
+  /// The likelihood field's sigma now, and the smoothed median wall distance it follows
+  /// (AdaptiveSigmaOptions).
+  double field_sigma_m() const { return likelihood_field_.sigma_m(); }
+  double wall_distance_m() const { return field_sigma_.median_m(); }
   /// The odometry's heading drift fitted so far (OdometryCalibrationOptions), rad per metre.
   double odometry_drift_rad_per_m() const { return calibration_.drift_rad_per_m(); }
 
@@ -113,6 +117,7 @@ class ParticleFilter {
   OccupancyGrid map_;
   MapCorrelator correlator_;
   LikelihoodField likelihood_field_;
+  AdaptiveFieldSigma field_sigma_;
   OccupiedMask occupied_mask_;  // the map's walls for the occupied-indicator correlation
   ScanRefiner refiner_;
   RandomEngine rng_;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "slam/grid/occupancy_grid.h"
+#include "slam/matching/adaptive_field_sigma.h"
 #include "slam/matching/likelihood_field.h"
 #include "slam/matching/map_correlator.h"
 #include "slam/matching/scan_points.h"
@@ -158,7 +159,10 @@ struct ParticleFilterOptions {
   /// The shift search: 9x9 cells and 9 yaws 0.0075 rad apart. With kLikelihoodField its `value`
   /// must be kRawValue.
   MapCorrelatorOptions correlation{4, 4, 0.0075, CorrelationValue::kRawValue, 0.0f};
+  /// The field's sigma: likelihood_field.sigma_m to start with, then following the map's own
+  /// sharpness (AdaptiveSigmaOptions; residual_factor 0 keeps it).
   LikelihoodFieldOptions likelihood_field{0.08, 0.9, 0.1, 0.0f, 3.0};
+  AdaptiveSigmaOptions adaptive_sigma;
   /// log-weight += observation_scale * score (the softmax temperature; 1 in the reports).
   double observation_scale = 0.5;
   /// Move each particle to its best shift (the reports' "future work"); false: only weight it.
@@ -240,6 +244,7 @@ void VisitFields(V& v, ParticleFilterOptions& o) {
   v.Struct("points", o.points);
   v.Struct("correlation", o.correlation);
   v.Struct("likelihood_field", o.likelihood_field);
+  v.Struct("adaptive_sigma", o.adaptive_sigma);
   v("observation_scale", o.observation_scale);
   v("move_to_best_shift", o.move_to_best_shift);
   v("refine", o.refine);

@@ -355,6 +355,48 @@ TEST(ParticleFilterTest, AKidnappingIntoAnAliasedPlaceWaitsForTheScansToTellTheT
   EXPECT_LT((end.translation() - run.truth[replay_to - 1].map_from_base.translation()).norm(), 0.3);
 }
 
+// The simulated office's walls are mapped sharply (a 1 cm range noise, scans 0.25 m apart): the
+// field's sigma follows the median wall distance down from its 0.08 m start, and the filter
+// tracks as before. Off (the default), the sigma stays.
+TEST(ParticleFilterTest, TheFieldSigmaFollowsHowSharpTheMapIs) {
+  const ShortRun& run = GetShortRun();
+  ParticleFilterOptions options = FastOptions();
+  options.adaptive_sigma.enabled = true;
+  options.adaptive_sigma.min_m = 0.02;
+  options.adaptive_sigma.max_m = 0.2;
+  options.adaptive_sigma.window_m = 0.06;
+  ParticleFilter filter(options);
+  std::vector<Pose2> poses;
+  for (const SyncedScan& scan : run.scans) {
+    poses.push_back(filter.AddScan(scan.scan, scan.increment).best_pose);
+  }
+  const double wall = filter.wall_distance_m();
+  EXPECT_GT(wall, 0.005);
+  EXPECT_LT(wall, 0.025);
+  EXPECT_LT(filter.field_sigma_m(), 0.06);
+  // Within the change ratio of its target.
+  EXPECT_NEAR(filter.field_sigma_m(), options.adaptive_sigma.residual_factor * wall,
+              options.adaptive_sigma.change_ratio * filter.field_sigma_m() + 1e-9);
+  EXPECT_LT(testing::AnchoredPositionRmse(poses, run.run.truth), 0.1);
+
+  ParticleFilter fixed(FastOptions());
+  for (const SyncedScan& scan : run.scans) fixed.AddScan(scan.scan, scan.increment);
+  EXPECT_EQ(fixed.field_sigma_m(), FastOptions().likelihood_field.sigma_m);
+  EXPECT_EQ(fixed.wall_distance_m(), 0.0);
+}
+
+TEST(ParticleFilterTest, AdaptiveSigmaNeedsItsWindowInsideTheFieldsReach) {
+  ParticleFilterOptions options;
+  options.adaptive_sigma.enabled = true;
+  options.adaptive_sigma.min_m = 0.04;  // reach 3 x 0.04 = 0.12 < window 0.15
+  EXPECT_THAT(options.Validate(),
+              ::testing::ElementsAre("adaptive_sigma.window_m = 0.15; must be <= "
+                                     "likelihood_field.cutoff_sigmas x adaptive_sigma.min_m"));
+  options.adaptive_sigma.max_m = 0.03;
+  EXPECT_THAT(options.Validate(),
+              ::testing::Contains("adaptive_sigma.max_m = 0.03; must be >= min_m"));
+}
+
 TEST(ParticleFilterTest, ValidateNamesFieldValueAndRule) {
   ParticleFilterOptions options;
   options.num_particles = 0;

@@ -28,7 +28,7 @@ const std::vector<Algorithm>& Algorithms() {
        "reports, the ECE276A reports' method)",
        {"default", "reports"},
        {"mean_neff", "resamples", "updates", "lost", "relocalisations", "resumed", "lost_at_s",
-        "relocalised_at_s"},
+        "relocalised_at_s", "field_sigma_m", "wall_distance_m"},
        [](const std::string& preset) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<
              AlgorithmOptionsFor<ParticleFilterOptions, ParticleFilterEstimator>>(

@@ -27,10 +27,15 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
     relocalised_at_s_ = t;
   }
   was_lost_ = step.lost;
-  return {step.best_pose,
-          step.mean_pose,
-          {{"neff", step.neff}, {"match_quality", step.quality}, {"lost", step.lost ? 1.0 : 0.0}},
-          std::nullopt};
+  ScanEstimate estimate{
+      step.best_pose,
+      step.mean_pose,
+      {{"neff", step.neff}, {"match_quality", step.quality}, {"lost", step.lost ? 1.0 : 0.0}},
+      std::nullopt};
+  if (filter_.options().adaptive_sigma.enabled) {
+    estimate.trace.push_back({"field_sigma_m", filter_.field_sigma_m()});
+  }
+  return estimate;
 }
 
 std::map<std::string, double> ParticleFilterEstimator::Statistics() const {
@@ -41,7 +46,9 @@ std::map<std::string, double> ParticleFilterEstimator::Statistics() const {
           {"relocalisations", filter_.relocalisation_count()},
           {"resumed", filter_.resumed_count()},
           {"lost_at_s", lost_at_s_},
-          {"relocalised_at_s", relocalised_at_s_}};
+          {"relocalised_at_s", relocalised_at_s_},
+          {"field_sigma_m", filter_.field_sigma_m()},
+          {"wall_distance_m", filter_.wall_distance_m()}};
 }
 
 EstimatorView ParticleFilterEstimator::View() const {
