@@ -137,6 +137,9 @@ std::vector<std::string> ParticleFilterOptions::Validate() const {
       correlation.value != CorrelationValue::kRawValue) {
     errors.push_back("correlation.value = occupied; must be log_odds with the likelihood field");
   }
+  if (adaptive_sigma.enabled && observation != ObservationModel::kLikelihoodField) {
+    errors.push_back("adaptive_sigma.enabled = true; needs observation = likelihood_field");
+  }
   if (refine && !move_to_best_shift) {
     errors.push_back("refine = true; needs move_to_best_shift = true");
   }

@@ -395,6 +395,12 @@ TEST(ParticleFilterTest, AdaptiveSigmaNeedsItsWindowInsideTheFieldsReach) {
   options.adaptive_sigma.max_m = 0.03;
   EXPECT_THAT(options.Validate(),
               ::testing::Contains("adaptive_sigma.max_m = 0.03; must be >= min_m"));
+  // The correlation model has no field to adapt.
+  ParticleFilterOptions reports = ParticleFilterOptions::ReportsPreset();
+  reports.adaptive_sigma.enabled = true;
+  EXPECT_THAT(reports.Validate(),
+              ::testing::ElementsAre(
+                  "adaptive_sigma.enabled = true; needs observation = likelihood_field"));
 }
 
 TEST(ParticleFilterTest, ValidateNamesFieldValueAndRule) {
