@@ -32,8 +32,9 @@ AdaptiveFieldSigma::AdaptiveFieldSigma(const AdaptiveSigmaOptions& options, doub
 }
 
 std::optional<double> AdaptiveFieldSigma::MedianWallDistance(
-    const LikelihoodField& field, const GridView& view,
-    std::span<const Eigen::Vector2d> points_base, const Pose2& pose) const {
+    const LikelihoodField& field, std::span<const Eigen::Vector2d> points_base,
+    const Pose2& pose) const {
+  const GridView view = field.view();
   thread_local std::vector<double> distances;
   distances.clear();
   for (const Eigen::Vector2d& p : points_base) {

@@ -6,7 +6,6 @@
 #include <string>
 #include <vector>
 
-#include "slam/matching/grid_view.h"
 #include "slam/matching/likelihood_field.h"
 #include "slam/types/pose2.h"
 
@@ -65,9 +64,9 @@ class AdaptiveFieldSigma {
   AdaptiveFieldSigma(const AdaptiveSigmaOptions& options, double initial_sigma_m);
 
   /// The median distance to the nearest wall of `points_base` seen from `pose`, read off
-  /// `field` (whose raster `view` is) as the scan refiner samples it, over the points within
+  /// `field` (its whole raster, view()) as the scan refiner samples it, over the points within
   /// window_m of a wall; nullopt when fewer than min_points are.
-  std::optional<double> MedianWallDistance(const LikelihoodField& field, const GridView& view,
+  std::optional<double> MedianWallDistance(const LikelihoodField& field,
                                            std::span<const Eigen::Vector2d> points_base,
                                            const Pose2& pose) const;
   /// Takes one update's median; true when the sigma moved (sigma_m()).

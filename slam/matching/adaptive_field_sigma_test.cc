@@ -96,8 +96,7 @@ TEST(AdaptiveFieldSigmaTest, MedianWallDistanceMeasuresHowFarThePointsLieOffTheW
       }
       std::nth_element(near.begin(), near.begin() + near.size() / 2, near.end());
       const double expected = near[near.size() / 2];
-      const std::optional<double> median =
-          adaptive.MedianWallDistance(field, field.view(), points, pose);
+      const std::optional<double> median = adaptive.MedianWallDistance(field, points, pose);
       ASSERT_TRUE(median.has_value());
       EXPECT_GT(*median, expected) << sigma << " " << spread;
       EXPECT_LT(*median, expected + 0.015) << sigma << " " << spread;
@@ -124,14 +123,13 @@ TEST(AdaptiveFieldSigmaTest, PointsFarFromEveryWallAreNotCounted) {
       100, [](int) { return -0.5; }, &pose);
   auto points = near;
   points.insert(points.end(), open.begin(), open.end());
-  const std::optional<double> median =
-      adaptive.MedianWallDistance(field, field.view(), points, pose);
+  const std::optional<double> median = adaptive.MedianWallDistance(field, points, pose);
   ASSERT_TRUE(median.has_value());
-  EXPECT_EQ(*median, adaptive.MedianWallDistance(field, field.view(), near, pose).value());
+  EXPECT_EQ(*median, adaptive.MedianWallDistance(field, near, pose).value());
   // Too few near a wall: nothing to say.
   const auto few = PointsOffTheWall(
       19, [](int) { return 0.01; }, &pose);
-  EXPECT_FALSE(adaptive.MedianWallDistance(field, field.view(), few, pose).has_value());
+  EXPECT_FALSE(adaptive.MedianWallDistance(field, few, pose).has_value());
 }
 
 TEST(AdaptiveFieldSigmaTest, TheSigmaFollowsTheSmoothedMedianWithinItsBounds) {

@@ -552,8 +552,7 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
   if (judged && !lost_ && options_.observation == ObservationModel::kLikelihoodField &&
       options_.adaptive_sigma.enabled) {
     likelihood_field_.Follow(map_);
-    wall_distance = field_sigma_.MedianWallDistance(likelihood_field_, likelihood_field_.view(),
-                                                    points, step.best_pose);
+    wall_distance = field_sigma_.MedianWallDistance(likelihood_field_, points, step.best_pose);
   }
   if (lost_) {
     // Lost since an earlier update: the map stays frozen until the filter resumes (the scan fits
