@@ -21,8 +21,9 @@ namespace slamrig::slam {
 /// intel but doubled acapulco's error and lost aces, a fixed 0.1 did the reverse (README, "the
 /// likelihood field's sigma").
 struct AdaptiveSigmaOptions {
-  /// Off by default (the field keeps its sigma_m): see the README's study for why.
-  bool enabled = false;
+  /// On by default; off, the field keeps its sigma_m (README, "a field sigma that follows the
+  /// map").
+  bool enabled = true;
   /// The sigma is this x the smoothed median distance, within [min_m, max_m].
   double residual_factor = 2.5;
   double min_m = 0.06;

@@ -148,6 +148,21 @@ std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& po
   return scores;
 }
 
+void ParticleFilter::HoldMeanAlongWeakDirections(const Pose2& predicted_mean,
+                                                 const MatchConstraints& constraints) {
+  // Resampling draws the cloud's members by their cross-axis offset and heading; along the axis
+  // their places are a random pick of the spread, and the weights can favour the places the map
+  // was written from (behind). Either would move the cloud's mean along the axis, update after
+  // update; the whole cloud is shifted back so that its mean follows the odometry there.
+  const Pose2 now = WeightedMeanPose(particles_);
+  const Pose2 held =
+      RemapAlongWeakDirections(predicted_mean, now, constraints, options_.degeneracy_ratio);
+  const Eigen::Vector2d shift = held.translation() - now.translation();
+  for (Particle& p : particles_) {
+    p.pose = Pose2(p.pose.x() + shift.x(), p.pose.y() + shift.y(), p.pose.theta());
+  }
+}
+
 bool ParticleFilter::Unimodal(const Pose2& mean) const {
   const double r = options_.unimodal_radius_m, a = options_.unimodal_yaw_rad;
   if (!(r > 0.0) || !(a > 0.0)) return false;
@@ -510,9 +525,11 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
   const std::vector<Eigen::Vector2d>& points = selected.points;
   step.points_used = static_cast<int>(points.size());
   bool degenerate = false;
+  MatchConstraints constraints;
+  // The cloud's mean as the odometry moved it: along a degenerate direction it stays the estimate.
+  const Pose2 predicted_mean = WeightedMeanPose(particles_);
   if (!points.empty()) {
-    const MatchConstraints constraints =
-        DecomposeInformation(ScanInformation(points, selected.normals));
+    constraints = DecomposeInformation(ScanInformation(points, selected.normals));
     degenerate =
         options_.degeneracy_ratio > 0.0 && constraints.WeakCount(options_.degeneracy_ratio) > 0;
     const std::vector<double> scores = Score(points, constraints, &step.best_score);
@@ -538,6 +555,16 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
     // particles keep their odometry, and the mean of that spread built a worse corridor map (ATE
     // 0.24 -> 0.37 m).
     step.best_pose = step.mean_pose;
+  }
+  if (degenerate) {
+    // Along the directions the scan leaves open the estimate is the cloud's mean where the
+    // odometry put it, not any one particle's place there: the particles keep their own sampled
+    // motion along the axis (the spread later scans can correct), and which of them carries the
+    // most weight says nothing about it.
+    step.best_pose = RemapAlongWeakDirections(predicted_mean, step.best_pose, constraints,
+                                              options_.degeneracy_ratio);
+    step.mean_pose = RemapAlongWeakDirections(predicted_mean, step.mean_pose, constraints,
+                                              options_.degeneracy_ratio);
   }
   step.quality = Quality(step.best_score, points.size());
   // The lost test is made only when most of the scan lands where the map has been observed:
@@ -591,6 +618,7 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
     step.resampled = true;
     ++resample_count_;
   }
+  if (degenerate) HoldMeanAlongWeakDirections(predicted_mean, constraints);
   // The calibration learns from updates that tracked on both ends: a loss, a relocalisation or a
   // slip correction moves the estimate by more than the odometry's error.
   if (!points.empty() && !step.lost && !step.relocalised && !last_step_.lost &&

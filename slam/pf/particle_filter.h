@@ -77,6 +77,10 @@ class ParticleFilter {
   double Quality(float score, std::size_t num_points) const;
   // Every particle that carries weight lies within unimodal_radius_m / unimodal_yaw_rad of `mean`.
   bool Unimodal(const Pose2& mean) const;
+  /// Shifts the cloud so that its weighted mean along the scan's weak directions is
+  /// `predicted_mean`'s (solution remapping applied to the cloud as a whole).
+  void HoldMeanAlongWeakDirections(const Pose2& predicted_mean,
+                                   const MatchConstraints& constraints);
   // Updates the quality averages; true when this scan is suspect (not to be inserted).
   bool TrackQuality(double quality, Time now);
   // A pose matched on the likelihood field and its quality (Quality()).

@@ -84,7 +84,8 @@ ParticleFilterOptions ParticleFilterOptions::ReportsPreset() {
   o.min_update_distance_m = 0.0;
   o.min_update_angle_rad = 0.0;
   o.degeneracy_ratio = 0.0;
-  o.unimodal_radius_m = 0.0;  // the best particle, as in the reports
+  o.unimodal_radius_m = 0.0;         // the best particle, as in the reports
+  o.adaptive_sigma.enabled = false;  // there is no likelihood field to sharpen
   return o;
 }
 
@@ -138,7 +139,8 @@ std::vector<std::string> ParticleFilterOptions::Validate() const {
     errors.push_back("correlation.value = occupied; must be log_odds with the likelihood field");
   }
   if (adaptive_sigma.enabled && observation != ObservationModel::kLikelihoodField) {
-    errors.push_back("adaptive_sigma.enabled = true; needs observation = likelihood_field");
+    errors.push_back(
+        "adaptive_sigma.enabled = true; needs observation = likelihood_field (or set it false)");
   }
   if (refine && !move_to_best_shift) {
     errors.push_back("refine = true; needs move_to_best_shift = true");

@@ -160,7 +160,8 @@ struct ParticleFilterOptions {
   /// must be kRawValue.
   MapCorrelatorOptions correlation{4, 4, 0.0075, CorrelationValue::kRawValue, 0.0f};
   /// The field's sigma: likelihood_field.sigma_m to start with, then following the map's own
-  /// sharpness (AdaptiveSigmaOptions; residual_factor 0 keeps it).
+  /// sharpness (AdaptiveSigmaOptions; `adaptive_sigma.enabled: false` keeps it). Needs the
+  /// likelihood-field observation model: with `observation: correlation` turn it off.
   LikelihoodFieldOptions likelihood_field{0.08, 0.9, 0.1, 0.0f, 3.0};
   AdaptiveSigmaOptions adaptive_sigma;
   /// log-weight += observation_scale * score (the softmax temperature; 1 in the reports).
@@ -174,8 +175,9 @@ struct ParticleFilterOptions {
   /// Degeneracy: a translation direction whose information in the scan's own geometry (an
   /// eigenvalue of its point-to-line J^T J, yaw marginalised) is below this fraction of the
   /// largest keeps each particle's odometry prediction (solution remapping, Zhang et al. 2016),
-  /// and the weights do not depend on it: along a corridor's axis the scan says nothing.
-  /// 0 = off.
+  /// and the weights do not depend on it: along a corridor's axis the scan says nothing. There
+  /// the estimate and the cloud's weighted mean also follow the odometry (the cloud is shifted
+  /// back along the axis after resampling; each particle keeps its own spread). 0 = off.
   double degeneracy_ratio = 0.05;
   /// Beams meeting their surface at a larger incidence angle (beam to surface normal, the normal
   /// from the neighbouring points) are left out of the weighting and the degeneracy analysis.

@@ -85,6 +85,7 @@ TEST(ParticleFilterTest, MapCorrelationWithoutRefinementTracks) {
   ParticleFilterOptions options = FastOptions();
   options.observation = ObservationModel::kMapCorrelation;
   options.correlation.value = CorrelationValue::kOccupiedIndicator;
+  options.adaptive_sigma.enabled = false;  // no field to sharpen
   options.refine = false;
   options.observation_scale = 1.0;
   const PfRun pf = RunParticleFilter(run.scans, options);
@@ -147,7 +148,12 @@ TEST(ParticleFilterTest, FindsItselfLostAfterAKidnappingAndRelocalises) {
   // In this world of long bare walls a displaced scan still scores ~0.7 of its usual quality
   // (in the simulated office it drops to ~0.35): a stricter ratio than the default's 0.5.
   options.relocalisation.enabled = true;
+  // That ratio is a level for the field's fixed 0.08 m: the sigma the map's sharpness gives
+  // here (0.06 m) scores the run's last scan, turning into new ground, at 0.63 of the usual
+  // quality, a false alarm in the last update that this test cannot see resolved. The kidnapping
+  // scenario checks the defaults.
   options.relocalisation.lost_ratio = 0.7;
+  options.adaptive_sigma.enabled = false;
   ParticleFilter filter(options);
   for (std::size_t i = 0; i < jump_at; ++i)
     filter.AddScan(run.scans[i].scan, run.scans[i].increment);
@@ -355,9 +361,51 @@ TEST(ParticleFilterTest, AKidnappingIntoAnAliasedPlaceWaitsForTheScansToTellTheT
   EXPECT_LT((end.translation() - run.truth[replay_to - 1].map_from_base.translation()).norm(), 0.3);
 }
 
+// A featureless corridor 60 m long, driven 25 m down its middle with the wheels 2 % long and a
+// 10 m lidar, so that no scan sees an end wall: nothing but the odometry says how far the robot
+// went. Along the axis the estimate must follow the odometry (solution remapping applied to the
+// cloud as a whole), not drift by resampling or by the map's pull towards where it was written
+// from; across it and in heading the scans keep the estimate on the truth.
+TEST(ParticleFilterTest, AlongAFeaturelessCorridorTheEstimateFollowsTheOdometry) {
+  testing::SegmentWorld world({});
+  world.AddBox(0.0, -1.2, 60.0, 1.2);
+  testing::SyntheticRunOptions run_options;
+  run_options.waypoints = {{12.0, 0.0}, {58.0, 0.0}};
+  run_options.laps = 1;
+  run_options.max_duration_s = 50.0;
+  run_options.speed_m_s = 0.5;
+  run_options.scan_rate_hz = 10.0;
+  run_options.lidar.num_beams = 271;
+  run_options.lidar.angle_increment_rad = 1.0 * 3.14159265358979 / 180.0;
+  run_options.lidar.range_max_m = 10.0;
+  run_options.right_scale_error = 0.02;
+  run_options.left_scale_error = 0.02;
+  const testing::SyntheticRun run = testing::MakeSyntheticRun(world, run_options);
+  const std::vector<SyncedScan> scans = SyncToScans(run.records, ScanSyncOptions{}).scans;
+  ASSERT_EQ(scans.size(), run.truth.size());
+  const PfRun pf = RunParticleFilter(scans, FastOptions());
+  const std::vector<Pose2> odometry = DeadReckoningPoses(scans);
+  const Pose2 start = run.truth.front().map_from_base;
+  double worst_along = 0.0, worst_across = 0.0;
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    const Pose2 estimate = start * pf.trajectory.poses()[i].pose;
+    const Pose2 odometry_pose = start * odometry[i];
+    const Pose2& truth = run.truth[i].map_from_base;
+    worst_along = std::max(worst_along, std::abs(estimate.x() - odometry_pose.x()));
+    worst_across = std::max(worst_across, std::abs(estimate.y() - truth.y()));
+  }
+  const double travelled = run.truth.back().map_from_base.x() - start.x();
+  ASSERT_GT(travelled, 20.0);
+  // The wheels' 2 % is there in both, and nowhere else to be seen.
+  EXPECT_NEAR(start.x() + odometry.back().x() - run.truth.back().map_from_base.x(),
+              0.02 * travelled, 0.1);
+  EXPECT_LT(worst_along, 0.1);
+  EXPECT_LT(worst_across, 0.05);
+}
+
 // The simulated office's walls are mapped sharply (a 1 cm range noise, scans 0.25 m apart): the
 // field's sigma follows the median wall distance down from its 0.08 m start, and the filter
-// tracks as before. Off (the default), the sigma stays.
+// tracks as before. Off, the sigma stays.
 TEST(ParticleFilterTest, TheFieldSigmaFollowsHowSharpTheMapIs) {
   const ShortRun& run = GetShortRun();
   ParticleFilterOptions options = FastOptions();
@@ -379,7 +427,9 @@ TEST(ParticleFilterTest, TheFieldSigmaFollowsHowSharpTheMapIs) {
               options.adaptive_sigma.change_ratio * filter.field_sigma_m() + 1e-9);
   EXPECT_LT(testing::AnchoredPositionRmse(poses, run.run.truth), 0.1);
 
-  ParticleFilter fixed(FastOptions());
+  ParticleFilterOptions off = FastOptions();
+  off.adaptive_sigma.enabled = false;
+  ParticleFilter fixed(off);
   for (const SyncedScan& scan : run.scans) fixed.AddScan(scan.scan, scan.increment);
   EXPECT_EQ(fixed.field_sigma_m(), FastOptions().likelihood_field.sigma_m);
   EXPECT_EQ(fixed.wall_distance_m(), 0.0);
@@ -395,12 +445,14 @@ TEST(ParticleFilterTest, AdaptiveSigmaNeedsItsWindowInsideTheFieldsReach) {
   options.adaptive_sigma.max_m = 0.03;
   EXPECT_THAT(options.Validate(),
               ::testing::Contains("adaptive_sigma.max_m = 0.03; must be >= min_m"));
-  // The correlation model has no field to adapt.
+  // The correlation model has no field to adapt: the reports' preset turns it off, and asking
+  // for both is refused.
   ParticleFilterOptions reports = ParticleFilterOptions::ReportsPreset();
+  EXPECT_THAT(reports.Validate(), ::testing::IsEmpty());
   reports.adaptive_sigma.enabled = true;
   EXPECT_THAT(reports.Validate(),
-              ::testing::ElementsAre(
-                  "adaptive_sigma.enabled = true; needs observation = likelihood_field"));
+              ::testing::ElementsAre("adaptive_sigma.enabled = true; needs observation = "
+                                     "likelihood_field (or set it false)"));
 }
 
 TEST(ParticleFilterTest, ValidateNamesFieldValueAndRule) {
