@@ -25,10 +25,8 @@ std::vector<std::string> AdaptiveSigmaOptions::Validate() const {
   return errors;
 }
 
-AdaptiveFieldSigma::AdaptiveFieldSigma(const AdaptiveSigmaOptions& options, double initial_sigma_m)
-    : options_(options), sigma_m_(initial_sigma_m) {
+AdaptiveFieldSigma::AdaptiveFieldSigma(const AdaptiveSigmaOptions& options) : options_(options) {
   SLAMRIG_CHECK(options_.Validate().empty(), "invalid AdaptiveSigmaOptions");
-  SLAMRIG_CHECK(initial_sigma_m > 0.0, "AdaptiveFieldSigma needs a sigma > 0");
 }
 
 std::optional<double> AdaptiveFieldSigma::MedianWallDistance(
@@ -47,18 +45,19 @@ std::optional<double> AdaptiveFieldSigma::MedianWallDistance(
   return *middle;
 }
 
-bool AdaptiveFieldSigma::Observe(double median_m) {
-  if (!options_.enabled) return false;
+std::optional<double> AdaptiveFieldSigma::Observe(double median_m, double sigma_in_use_m) {
+  if (!options_.enabled) return std::nullopt;
   // The mean of the first 1 / rate medians, then an exponential average with that memory.
   ++updates_;
   median_m_ += std::max(options_.rate, 1.0 / updates_) * (median_m - median_m_);
-  if (updates_ <= options_.warmup_updates) return false;
+  if (updates_ <= options_.warmup_updates) return std::nullopt;
   const double target =
       std::clamp(options_.residual_factor * median_m_, options_.min_m, options_.max_m);
-  if (std::abs(target - sigma_m_) <= options_.change_ratio * sigma_m_) return false;
-  sigma_m_ = target;
+  if (std::abs(target - sigma_in_use_m) <= options_.change_ratio * sigma_in_use_m) {
+    return std::nullopt;
+  }
   ++moves_;
-  return true;
+  return target;
 }
 
 }  // namespace slamrig::slam

@@ -62,7 +62,7 @@ void VisitFields(V& v, AdaptiveSigmaOptions& o) {
 /// The smoothed median wall distance and the sigma it implies (AdaptiveSigmaOptions).
 class AdaptiveFieldSigma {
  public:
-  AdaptiveFieldSigma(const AdaptiveSigmaOptions& options, double initial_sigma_m);
+  explicit AdaptiveFieldSigma(const AdaptiveSigmaOptions& options);
 
   /// The median distance to the nearest wall of `points_base` seen from `pose`, read off
   /// `field` (its whole raster, view()) as the scan refiner samples it, over the points within
@@ -70,17 +70,16 @@ class AdaptiveFieldSigma {
   std::optional<double> MedianWallDistance(const LikelihoodField& field,
                                            std::span<const Eigen::Vector2d> points_base,
                                            const Pose2& pose) const;
-  /// Takes one update's median; true when the sigma moved (sigma_m()).
-  bool Observe(double median_m);
+  /// Takes one update's median; the sigma the field should move to from `sigma_in_use_m` (its
+  /// own, LikelihoodField::sigma_m()), or nullopt to keep it.
+  std::optional<double> Observe(double median_m, double sigma_in_use_m);
 
-  double sigma_m() const { return sigma_m_; }
   /// The smoothed median wall distance (0 before the first update).
   double median_m() const { return median_m_; }
   int moves() const { return moves_; }
 
  private:
   AdaptiveSigmaOptions options_;
-  double sigma_m_;
   double median_m_ = 0.0;
   int updates_ = 0;
   int moves_ = 0;

@@ -81,7 +81,7 @@ TEST(AdaptiveFieldSigmaTest, MedianWallDistanceMeasuresHowFarThePointsLieOffTheW
     LikelihoodField field(field_options);
     field.Follow(grid);
     AdaptiveSigmaOptions options;
-    const AdaptiveFieldSigma adaptive(options, sigma);
+    const AdaptiveFieldSigma adaptive(options);
     double previous = 0.0;
     for (const double spread : {0.01, 0.02, 0.04, 0.06}) {
       std::normal_distribution<double> noise(0.0, spread);
@@ -114,7 +114,7 @@ TEST(AdaptiveFieldSigmaTest, PointsFarFromEveryWallAreNotCounted) {
   field.Follow(grid);
   AdaptiveSigmaOptions options;
   options.min_points = 20;
-  const AdaptiveFieldSigma adaptive(options, 0.08);
+  const AdaptiveFieldSigma adaptive(options);
   Pose2 pose;
   // 30 points near the wall and 100 in open space: the median is the near points' alone.
   const auto near = PointsOffTheWall(
@@ -141,26 +141,33 @@ TEST(AdaptiveFieldSigmaTest, TheSigmaFollowsTheSmoothedMedianWithinItsBounds) {
   options.warmup_updates = 10;
   options.rate = 0.1;
   options.change_ratio = 0.1;
-  AdaptiveFieldSigma adaptive(options, 0.08);
+  AdaptiveFieldSigma adaptive(options);
+  double sigma = 0.08;  // the field's, moved where Observe says
+  auto observe = [&](AdaptiveFieldSigma& a, double median) {
+    const std::optional<double> moved = a.Observe(median, sigma);
+    if (moved) sigma = *moved;
+    return moved.has_value();
+  };
   // Warm-up: a median implying 0.06 moves nothing for 10 updates.
-  for (int i = 0; i < 10; ++i) EXPECT_FALSE(adaptive.Observe(0.03));
-  EXPECT_EQ(adaptive.sigma_m(), 0.08);
-  EXPECT_TRUE(adaptive.Observe(0.03));
-  EXPECT_NEAR(adaptive.sigma_m(), 0.06, 1e-12);
+  for (int i = 0; i < 10; ++i) EXPECT_FALSE(observe(adaptive, 0.03));
+  EXPECT_EQ(sigma, 0.08);
+  EXPECT_TRUE(observe(adaptive, 0.03));
+  EXPECT_NEAR(sigma, 0.06, 1e-12);
   // Within change_ratio of the sigma in use: no move.
-  for (int i = 0; i < 100; ++i) EXPECT_FALSE(adaptive.Observe(0.0315));
+  for (int i = 0; i < 100; ++i) EXPECT_FALSE(observe(adaptive, 0.0315));
   EXPECT_NEAR(adaptive.median_m(), 0.0315, 1e-4);
   // Blurred walls raise it to its bound and no further; sharp ones lower it to the other.
-  for (int i = 0; i < 200; ++i) adaptive.Observe(0.2);
-  EXPECT_EQ(adaptive.sigma_m(), 0.12);
-  for (int i = 0; i < 200; ++i) adaptive.Observe(0.001);
-  EXPECT_EQ(adaptive.sigma_m(), 0.05);
+  for (int i = 0; i < 200; ++i) observe(adaptive, 0.2);
+  EXPECT_EQ(sigma, 0.12);
+  for (int i = 0; i < 200; ++i) observe(adaptive, 0.001);
+  EXPECT_EQ(sigma, 0.05);
   EXPECT_GE(adaptive.moves(), 3);
   // Off: the sigma stays.
   options.enabled = false;
-  AdaptiveFieldSigma off(options, 0.08);
-  for (int i = 0; i < 100; ++i) EXPECT_FALSE(off.Observe(0.01));
-  EXPECT_EQ(off.sigma_m(), 0.08);
+  AdaptiveFieldSigma off(options);
+  sigma = 0.08;
+  for (int i = 0; i < 100; ++i) EXPECT_FALSE(observe(off, 0.01));
+  EXPECT_EQ(sigma, 0.08);
 }
 
 }  // namespace

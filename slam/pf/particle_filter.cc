@@ -46,7 +46,7 @@ ParticleFilter::ParticleFilter(const ParticleFilterOptions& options)
       map_(options.map),
       correlator_(options.correlation),
       likelihood_field_(options.likelihood_field),
-      field_sigma_(options.adaptive_sigma, options.likelihood_field.sigma_m),
+      field_sigma_(options.adaptive_sigma),
       occupied_mask_(options.correlation.occupied_threshold),
       refiner_(options.refiner),
       rng_(options.seed),
@@ -597,8 +597,11 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
     if (!suspect) map_.InsertScan(scan, step.best_pose);
     // A scan that tracked as usual tells how sharp the map is; the field follows (its next
     // Follow recomputes it everywhere).
-    if (!suspect && !lost_ && wall_distance && field_sigma_.Observe(*wall_distance)) {
-      likelihood_field_.SetSigma(field_sigma_.sigma_m());
+    if (!suspect && !lost_ && wall_distance) {
+      if (const std::optional<double> sigma =
+              field_sigma_.Observe(*wall_distance, likelihood_field_.sigma_m())) {
+        likelihood_field_.SetSigma(*sigma);
+      }
     }
     if (lost_) {
       // Just lost: the weights say nothing now; keep the cloud for the odometry to carry.
