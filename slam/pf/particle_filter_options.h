@@ -42,9 +42,9 @@ struct RelocalisationOptions {
   /// (new ground says nothing). While lost the filter goes on tracking (only the map is frozen),
   /// and a loss ends in a relocalisation only when a place elsewhere fits clearly better than
   /// anything near the filter on confirm_updates updates in a row, followed through the odometry;
-  /// otherwise tracking resumes. On the ten corrected logs (seed 1) this relocalises twice, both
-  /// right (freiburg-079 after its estimate ran 3.5 m off, infinite-corridor), and never falsely
-  /// (README, "lost-filter detection"). Only the likelihood-field
+  /// otherwise tracking resumes. On the ten corrected logs (seed 1) this relocalises twice:
+  /// freiburg-079, rightly, after its estimate ran 3.5 m off, and infinite-corridor (a log the pf
+  /// fails either way; README, "lost-filter detection"). Only the likelihood-field
   /// observation model has a quality in [0, 1] to watch.
   bool enabled = true;
   /// alpha_fast of the short-term average of the quality: 1 reacts to the first bad scan (a
