@@ -74,7 +74,8 @@ void ParticleFilter::Predict(const Pose2& odometry_increment) {
 }
 
 std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& points,
-                                          const MatchConstraints& constraints, float* best_score) {
+                                          const MatchConstraints& constraints,
+                                          const Pose2& predicted_mean, float* best_score) {
   const int n = options_.num_particles;
   const bool use_field = options_.observation == ObservationModel::kLikelihoodField;
   GridView field_view;
@@ -106,7 +107,6 @@ std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& po
   std::vector<CorrelationResult> results(static_cast<std::size_t>(n));
   const double ratio = options_.degeneracy_ratio;
   const bool weak = ratio > 0.0 && constraints.WeakCount(ratio) > 0;
-  const Pose2 cloud_mean = WeightedMeanPose(particles_);
   auto score_block = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
       CorrelationResult& r = results[static_cast<std::size_t>(i)];
@@ -127,7 +127,8 @@ std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& po
       if (weak) {
         r.pose = RemapAlongWeakDirections(predicted, r.pose, constraints, ratio);
         if (use_field) {
-          const Pose2 weighed = RemapAlongWeakDirections(cloud_mean, r.pose, constraints, ratio);
+          const Pose2 weighed =
+              RemapAlongWeakDirections(predicted_mean, r.pose, constraints, ratio);
           r.score = static_cast<float>(ScanRefiner::Score(field_view, points, weighed));
         }
       }
@@ -532,7 +533,7 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
     constraints = DecomposeInformation(ScanInformation(points, selected.normals));
     degenerate =
         options_.degeneracy_ratio > 0.0 && constraints.WeakCount(options_.degeneracy_ratio) > 0;
-    const std::vector<double> scores = Score(points, constraints, &step.best_score);
+    const std::vector<double> scores = Score(points, constraints, predicted_mean, &step.best_score);
     for (std::size_t i = 0; i < scores.size(); ++i) {
       log_weights_[i] += options_.observation_scale * scores[i];
     }

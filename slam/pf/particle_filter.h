@@ -115,7 +115,8 @@ class ParticleFilter {
   // loss, the one bar for followed, tracked, near and global places alike.
   bool FitsAsPlace(double quality) const;
   std::vector<double> Score(const std::vector<Eigen::Vector2d>& points,
-                            const MatchConstraints& constraints, float* best_score);
+                            const MatchConstraints& constraints, const Pose2& predicted_mean,
+                            float* best_score);
 
   ParticleFilterOptions options_;
   OccupancyGrid map_;
