@@ -15,9 +15,9 @@ std::vector<std::string> AdaptiveSigmaOptions::Validate() const {
     errors.push_back(RuleViolation(field, got, rule));
   };
   if (!(residual_factor > 0.0)) add("residual_factor", residual_factor, "must be > 0");
-  if (!(min_cells > 0.0)) add("min_cells", min_cells, "must be > 0");
-  if (!(max_cells >= min_cells)) add("max_cells", max_cells, "must be >= min_cells");
-  if (!(window_cells > 0.0)) add("window_cells", window_cells, "must be > 0");
+  if (!(min_m > 0.0)) add("min_m", min_m, "must be > 0");
+  if (!(max_m >= min_m)) add("max_m", max_m, "must be >= min_m");
+  if (!(window_m > 0.0)) add("window_m", window_m, "must be > 0");
   if (min_points < 1) add("min_points", min_points, "must be >= 1");
   if (!(rate > 0.0 && rate <= 1.0)) add("rate", rate, "must be in (0, 1]");
   if (warmup_updates < 0) add("warmup_updates", warmup_updates, "must be >= 0");
@@ -25,10 +25,8 @@ std::vector<std::string> AdaptiveSigmaOptions::Validate() const {
   return errors;
 }
 
-AdaptiveFieldSigma::AdaptiveFieldSigma(const AdaptiveSigmaOptions& options, double cell_m)
-    : options_(options), cell_m_(cell_m) {
+AdaptiveFieldSigma::AdaptiveFieldSigma(const AdaptiveSigmaOptions& options) : options_(options) {
   SLAMRIG_CHECK(options_.Validate().empty(), "invalid AdaptiveSigmaOptions");
-  SLAMRIG_CHECK(cell_m_ > 0.0, "AdaptiveFieldSigma: the cell size must be > 0");
 }
 
 std::optional<double> AdaptiveFieldSigma::MedianWallDistance(
@@ -39,7 +37,7 @@ std::optional<double> AdaptiveFieldSigma::MedianWallDistance(
   distances.clear();
   for (const Eigen::Vector2d& p : points_base) {
     const double d = field.Distance(ScanRefiner::ValueAt(view, pose * p));
-    if (d <= options_.window_cells * cell_m_) distances.push_back(d);
+    if (d <= options_.window_m) distances.push_back(d);
   }
   if (distances.size() < static_cast<std::size_t>(options_.min_points)) return std::nullopt;
   const auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
@@ -53,8 +51,8 @@ std::optional<double> AdaptiveFieldSigma::Observe(double median_m, double sigma_
   ++updates_;
   median_m_ += std::max(options_.rate, 1.0 / updates_) * (median_m - median_m_);
   if (updates_ <= options_.warmup_updates) return std::nullopt;
-  const double target = std::clamp(options_.residual_factor * median_m_,
-                                   options_.min_cells * cell_m_, options_.max_cells * cell_m_);
+  const double target =
+      std::clamp(options_.residual_factor * median_m_, options_.min_m, options_.max_m);
   if (std::abs(target - sigma_in_use_m) <= options_.change_ratio * sigma_in_use_m) {
     return std::nullopt;
   }

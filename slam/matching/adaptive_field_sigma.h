@@ -24,17 +24,18 @@ struct AdaptiveSigmaOptions {
   /// On by default; off, the field keeps its sigma_m (README, "a field sigma that follows the
   /// map").
   bool enabled = true;
-  /// The sigma is this x the smoothed median distance, within [min_cells, max_cells] cells of
-  /// the map (0.06-0.08 m on a 0.05 m map). In cells, not metres: the median holds the cells'
-  /// own quantisation, so a finer map earns a sharper field (office_loop on a 0.025 m map ends
-  /// 0.029 m off with these bounds, 0.087 m with the 0.05 m map's 0.06-0.08 m).
+  /// The sigma is this x the smoothed median distance, within [min_m, max_m]. Metres, not map
+  /// cells: a real lidar's noise and a real map's blur do not shrink with the cells (intel on a
+  /// 0.025 m map ends 0.061 m off with these bounds, 0.156 with [1.2, 1.6] cells; on a 0.1 m map
+  /// 0.098 against 2.55). A simulated 1 cm lidar on a fine map wants less: turn it off and set
+  /// the sigma (scenarios/office_camera.yaml).
   double residual_factor = 2.5;
-  double min_cells = 1.2;
-  double max_cells = 1.6;
-  /// Points further than this many cells from every wall (new ground, clutter, a person) are
-  /// left out of the median. At most likelihood_field.cutoff_sigmas x min_cells: beyond the
-  /// field's cutoff a distance cannot be read off it.
-  double window_cells = 3.0;
+  double min_m = 0.06;
+  double max_m = 0.08;
+  /// Points further than this from every wall (new ground, clutter, a person) are left out of
+  /// the median. At most likelihood_field.cutoff_sigmas x min_m: beyond the field's cutoff a
+  /// distance cannot be read off it.
+  double window_m = 0.15;
   int min_points = 20;  ///< an update with fewer points near a wall is not counted
   /// The smoothed median is the mean of the first 1 / rate updates' medians, then an exponential
   /// average with that memory (each update's median weighs `rate`).
@@ -53,9 +54,9 @@ template <typename V>
 void VisitFields(V& v, AdaptiveSigmaOptions& o) {
   v("enabled", o.enabled);
   v("residual_factor", o.residual_factor);
-  v("min_cells", o.min_cells);
-  v("max_cells", o.max_cells);
-  v("window_cells", o.window_cells);
+  v("min_m", o.min_m);
+  v("max_m", o.max_m);
+  v("window_m", o.window_m);
   v("min_points", o.min_points);
   v("rate", o.rate);
   v("warmup_updates", o.warmup_updates);
@@ -65,12 +66,11 @@ void VisitFields(V& v, AdaptiveSigmaOptions& o) {
 /// The smoothed median wall distance and the sigma it implies (AdaptiveSigmaOptions).
 class AdaptiveFieldSigma {
  public:
-  /// `cell_m`: the map's (and so the field's) cell size, the unit of the bounds and the window.
-  AdaptiveFieldSigma(const AdaptiveSigmaOptions& options, double cell_m);
+  explicit AdaptiveFieldSigma(const AdaptiveSigmaOptions& options);
 
   /// The median distance to the nearest wall of `points_base` seen from `pose`, read off
   /// `field` (its whole raster, view()) as the scan refiner samples it, over the points within
-  /// window_cells of a wall; nullopt when fewer than min_points are.
+  /// window_m of a wall; nullopt when fewer than min_points are.
   std::optional<double> MedianWallDistance(const LikelihoodField& field,
                                            std::span<const Eigen::Vector2d> points_base,
                                            const Pose2& pose) const;
@@ -84,7 +84,6 @@ class AdaptiveFieldSigma {
 
  private:
   AdaptiveSigmaOptions options_;
-  double cell_m_ = 0.0;
   double median_m_ = 0.0;
   int updates_ = 0;
   int moves_ = 0;

@@ -81,7 +81,7 @@ TEST(AdaptiveFieldSigmaTest, MedianWallDistanceMeasuresHowFarThePointsLieOffTheW
     LikelihoodField field(field_options);
     field.Follow(grid);
     AdaptiveSigmaOptions options;
-    const AdaptiveFieldSigma adaptive(options, grid.resolution());
+    const AdaptiveFieldSigma adaptive(options);
     double previous = 0.0;
     for (const double spread : {0.01, 0.02, 0.04, 0.06}) {
       std::normal_distribution<double> noise(0.0, spread);
@@ -92,7 +92,7 @@ TEST(AdaptiveFieldSigmaTest, MedianWallDistanceMeasuresHowFarThePointsLieOffTheW
           200, [&](int i) { return offsets[i]; }, &pose);
       std::vector<double> near;
       for (double o : offsets) {
-        if (std::abs(o) <= options.window_cells * grid.resolution()) near.push_back(std::abs(o));
+        if (std::abs(o) <= options.window_m) near.push_back(std::abs(o));
       }
       std::nth_element(near.begin(), near.begin() + near.size() / 2, near.end());
       const double expected = near[near.size() / 2];
@@ -114,7 +114,7 @@ TEST(AdaptiveFieldSigmaTest, PointsFarFromEveryWallAreNotCounted) {
   field.Follow(grid);
   AdaptiveSigmaOptions options;
   options.min_points = 20;
-  const AdaptiveFieldSigma adaptive(options, grid.resolution());
+  const AdaptiveFieldSigma adaptive(options);
   Pose2 pose;
   // 30 points near the wall and 100 in open space: the median is the near points' alone.
   const auto near = PointsOffTheWall(
@@ -136,12 +136,12 @@ TEST(AdaptiveFieldSigmaTest, TheSigmaFollowsTheSmoothedMedianWithinItsBounds) {
   AdaptiveSigmaOptions options;
   options.enabled = true;
   options.residual_factor = 2.0;
-  options.min_cells = 1.0;  // 0.05-0.12 m on a 0.05 m map
-  options.max_cells = 2.4;
+  options.min_m = 0.05;
+  options.max_m = 0.12;
   options.warmup_updates = 10;
   options.rate = 0.1;
   options.change_ratio = 0.1;
-  AdaptiveFieldSigma adaptive(options, 0.05);
+  AdaptiveFieldSigma adaptive(options);
   double sigma = 0.08;  // the field's, moved where Observe says
   auto observe = [&](AdaptiveFieldSigma& a, double median) {
     const std::optional<double> moved = a.Observe(median, sigma);
@@ -158,35 +158,16 @@ TEST(AdaptiveFieldSigmaTest, TheSigmaFollowsTheSmoothedMedianWithinItsBounds) {
   EXPECT_NEAR(adaptive.median_m(), 0.0315, 1e-4);
   // Blurred walls raise it to its bound and no further; sharp ones lower it to the other.
   for (int i = 0; i < 200; ++i) observe(adaptive, 0.2);
-  EXPECT_NEAR(sigma, 0.12, 1e-12);
+  EXPECT_EQ(sigma, 0.12);
   for (int i = 0; i < 200; ++i) observe(adaptive, 0.001);
-  EXPECT_NEAR(sigma, 0.05, 1e-12);
+  EXPECT_EQ(sigma, 0.05);
   EXPECT_GE(adaptive.moves(), 3);
   // Off: the sigma stays.
   options.enabled = false;
-  AdaptiveFieldSigma off(options, 0.05);
+  AdaptiveFieldSigma off(options);
   sigma = 0.08;
   for (int i = 0; i < 100; ++i) EXPECT_FALSE(observe(off, 0.01));
   EXPECT_EQ(sigma, 0.08);
-}
-
-// The bounds are cells: on a map twice as fine the same walls may earn a field twice as sharp,
-// and the median of a map's quantisation alone (its cells' own spread) gives the same sigma in
-// cells at any resolution.
-TEST(AdaptiveFieldSigmaTest, TheBoundsScaleWithTheMapsCells) {
-  AdaptiveSigmaOptions options;
-  options.warmup_updates = 0;
-  options.rate = 1.0;
-  options.change_ratio = 0.0;
-  for (const double cell : {0.025, 0.05, 0.1}) {
-    AdaptiveFieldSigma adaptive(options, cell);
-    EXPECT_NEAR(adaptive.Observe(10.0, 1.0).value(), options.max_cells * cell, 1e-12) << cell;
-    EXPECT_NEAR(adaptive.Observe(0.0, 1.0).value(), options.min_cells * cell, 1e-12) << cell;
-    // Within the bounds the sigma is residual_factor x the median, whatever the cell.
-    const double median = 0.56 * cell;  // 2.5 x 0.56 = 1.4 cells
-    EXPECT_NEAR(adaptive.Observe(median, 1.0).value(), options.residual_factor * median, 1e-12)
-        << cell;
-  }
 }
 
 }  // namespace

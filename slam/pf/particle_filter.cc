@@ -46,7 +46,7 @@ ParticleFilter::ParticleFilter(const ParticleFilterOptions& options)
       map_(options.map),
       correlator_(options.correlation),
       likelihood_field_(options.likelihood_field),
-      field_sigma_(options.adaptive_sigma, options.map.resolution_m),
+      field_sigma_(options.adaptive_sigma),
       occupied_mask_(options.correlation.occupied_threshold),
       refiner_(options.refiner),
       rng_(options.seed),

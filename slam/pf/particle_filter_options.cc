@@ -126,11 +126,10 @@ std::vector<std::string> ParticleFilterOptions::Validate() const {
   Prefixed("correlation", correlation.Validate(), errors);
   Prefixed("likelihood_field", likelihood_field.Validate(), errors);
   Prefixed("adaptive_sigma", adaptive_sigma.Validate(), errors);
-  if (adaptive_sigma.enabled && adaptive_sigma.window_cells > likelihood_field.cutoff_sigmas *
-                                                                  adaptive_sigma.min_cells *
-                                                                  (1 + 1e-9)) {
-    errors.push_back(Rule("adaptive_sigma.window_cells", adaptive_sigma.window_cells,
-                          "must be <= likelihood_field.cutoff_sigmas x adaptive_sigma.min_cells"));
+  if (adaptive_sigma.enabled && adaptive_sigma.window_m > likelihood_field.cutoff_sigmas *
+                                                              adaptive_sigma.min_m * (1 + 1e-9)) {
+    errors.push_back(Rule("adaptive_sigma.window_m", adaptive_sigma.window_m,
+                          "must be <= likelihood_field.cutoff_sigmas x adaptive_sigma.min_m"));
   }
   Prefixed("refiner", refiner.Validate(), errors);
   Prefixed("relocalisation", relocalisation.Validate(), errors);

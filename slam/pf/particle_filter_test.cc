@@ -410,9 +410,9 @@ TEST(ParticleFilterTest, TheFieldSigmaFollowsHowSharpTheMapIs) {
   const ShortRun& run = GetShortRun();
   ParticleFilterOptions options = FastOptions();
   options.adaptive_sigma.enabled = true;
-  options.adaptive_sigma.min_cells = 0.4;  // 0.02-0.2 m on the 0.05 m map
-  options.adaptive_sigma.max_cells = 4.0;
-  options.adaptive_sigma.window_cells = 1.2;
+  options.adaptive_sigma.min_m = 0.02;
+  options.adaptive_sigma.max_m = 0.2;
+  options.adaptive_sigma.window_m = 0.06;
   ParticleFilter filter(options);
   std::vector<Pose2> poses;
   for (const SyncedScan& scan : run.scans) {
@@ -438,13 +438,13 @@ TEST(ParticleFilterTest, TheFieldSigmaFollowsHowSharpTheMapIs) {
 TEST(ParticleFilterTest, AdaptiveSigmaNeedsItsWindowInsideTheFieldsReach) {
   ParticleFilterOptions options;
   options.adaptive_sigma.enabled = true;
-  options.adaptive_sigma.min_cells = 0.8;  // reach 3 x 0.8 = 2.4 cells < window 3
+  options.adaptive_sigma.min_m = 0.04;  // reach 3 x 0.04 = 0.12 < window 0.15
   EXPECT_THAT(options.Validate(),
-              ::testing::ElementsAre("adaptive_sigma.window_cells = 3; must be <= "
-                                     "likelihood_field.cutoff_sigmas x adaptive_sigma.min_cells"));
-  options.adaptive_sigma.max_cells = 0.6;
+              ::testing::ElementsAre("adaptive_sigma.window_m = 0.15; must be <= "
+                                     "likelihood_field.cutoff_sigmas x adaptive_sigma.min_m"));
+  options.adaptive_sigma.max_m = 0.03;
   EXPECT_THAT(options.Validate(),
-              ::testing::Contains("adaptive_sigma.max_cells = 0.6; must be >= min_cells"));
+              ::testing::Contains("adaptive_sigma.max_m = 0.03; must be >= min_m"));
   // The correlation model has no field to adapt: the reports' preset turns it off, and asking
   // for both is refused.
   ParticleFilterOptions reports = ParticleFilterOptions::ReportsPreset();
