@@ -58,15 +58,11 @@ struct RbpfOptions {
   /// correlated (GMapping flattens its weights in the same way).
   double observation_scale = 0.2;
   /// The importance weight is multiplied by eta ^ weight_exponent, not by eta: a tempered weight
-  /// (GMapping flattens its weights in its normalisation, obsSigmaGain), so that a scan's many
-  /// correlated beams do not deplete the particles. The proposal and the odometry check keep the
-  /// full observation_scale (a tempered check missed freiburg-079's reversals). Not the default
-  /// yet: at 0.25 intel with 100 particles resamples at 330 of 909 updates instead of 598 and
-  /// seeds 2 and 3 end 0.063 and 0.107 m off instead of 0.247 and 0.152, but seed 1 ends 0.122
-  /// instead of 0.085, and with 30 particles aces (0.68 -> 0.95 m; seed 2 0.44 -> 0.86) and
-  /// edmonton (0.26 -> 0.52 m) get worse. 0.5 with cell_hit_means (README "The study that decides
-  /// the default"): intel with 100 particles, seeds 1-5, median 0.073 m instead of 0.096, but with
-  /// 30 particles, seeds 1-3, edmonton's median goes from 0.30 to 0.75 m. 1 = untempered.
+  /// (GMapping flattens its weights in the same way, obsSigmaGain), on top of the independent-point
+  /// factor below. The proposal and the odometry check keep the full observation_scale (a
+  /// tempered check missed freiburg-079's reversals). 1 = no further tempering (the default: a
+  /// uniform 0.25 or 0.5 flattens the sparse scans of open halls as much as the dense ones of
+  /// corridors, and lost aces and edmonton; README "Rao-Blackwellised particle filter").
   double weight_exponent = 1.0;
   /// Tempering from the scan's independent points: end points closer than this to each other
   /// count as one piece of evidence (CountIndependentPoints), and the weight takes eta ^ (e *
@@ -76,12 +72,12 @@ struct RbpfOptions {
   /// share their errors (Thrun, Burgard, Fox, Probabilistic Robotics, Sec. 6.4 and 6.8: beam
   /// dependence, met by subsampling or damping). So a dense scan (many beams on a few walls) is
   /// flattened to the number of points it holds at this spacing, a sparse one (15 end points in
-  /// an open hall) is left untempered. 0 = off. Not the default: at 0.1 with cell_hit_means,
-  /// intel with 100 particles ends 0.055-0.067 m off over seeds 1-5, but with 30 particles the
-  /// median over seeds 1-3 is worse on edmonton (0.30 -> 0.60 m; over seeds 1-7 0.90 -> 0.60),
-  /// acapulco (0.159 -> 0.169) and freiburg-101 (0.051 -> 0.052) (README, "Tempering from the
-  /// scan's independent points").
-  double weight_correlation_length_m = 0.0;
+  /// an open hall) is left untempered. 0 = off. Default 0.1 m (twice likelihood_sigma_m), with
+  /// cell_hit_means: untempered, intel with 100 particles resamples at 598 of 909 updates and ends
+  /// 0.085-0.210 m off over seeds 1-5; with both 0.055-0.067 m. At 30 particles over the ten
+  /// corrected logs it is better or equal on nine, and on acapulco within the seeds' spread
+  /// (README, "The study that decides the default").
+  double weight_correlation_length_m = 0.1;
   /// How weight_correlation_length_m tempers: false, one factor for the whole scan (above); true,
   /// per point (AssignIndependenceWeights): each point's log-likelihood in the weight counts 1 /
   /// (the end points within the length of it), so a cluster on a near wall counts as one piece of
@@ -120,7 +116,7 @@ struct RbpfOptions {
   /// PointAccumulator), and the matcher measures a point's distance to that mean, not to the
   /// cell's centre: a wall seen at a sub-cell offset is matched there, not on the 5 cm lattice.
   /// Costs three floats per cell.
-  bool cell_hit_means = false;
+  bool cell_hit_means = true;
 
   /// Filter only after the robot moved this far or turned this much since the last update; in
   /// between, poses follow the odometry and the maps are left alone.

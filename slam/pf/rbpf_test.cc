@@ -117,6 +117,7 @@ TEST(RbpfTest, OdometryCheckKeepsRightOdometryAlongACorridor) {
 TEST(RbpfTest, TemperedWeightsResampleLessOften) {
   const ShortRun& run = GetShortRun();
   RbpfOptions options = FastOptions();
+  options.weight_correlation_length_m = 0.0;  // the uniform exponent alone
   options.weight_exponent = 1.0;
   const RbpfRun full = RunFilter(run.scans, options);
   options.weight_exponent = 0.25;
@@ -136,6 +137,7 @@ TEST(RbpfTest, IndependentPointTemperingScalesEveryWeightAlike) {
   const ShortRun& run = GetShortRun();
   RbpfOptions options = FastOptions();
   options.resample_neff_ratio = 0.0;  // no resampling: the particles stay in step
+  options.weight_correlation_length_m = 0.0;
   Rbpf full(options);
   options.weight_correlation_length_m = 0.1;
   Rbpf tempered(options);
@@ -178,6 +180,7 @@ TEST(RbpfTest, IndependentPointTemperingScalesEveryWeightAlike) {
 TEST(RbpfTest, PerPointTemperingKeepsTheProposalAndFlattensTheWeights) {
   const ShortRun& run = GetShortRun();
   RbpfOptions options = FastOptions();
+  options.weight_correlation_length_m = 0.0;
   const RbpfRun full = RunFilter(run.scans, options);
   Rbpf untempered_filter(options);
   options.weight_correlation_length_m = 0.1;
