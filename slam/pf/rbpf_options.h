@@ -74,9 +74,10 @@ struct RbpfOptions {
   /// flattened to the number of points it holds at this spacing, a sparse one (15 end points in
   /// an open hall) is left untempered. 0 = off. Default 0.1 m (twice likelihood_sigma_m), with
   /// cell_hit_means: untempered, intel with 100 particles resamples at 598 of 909 updates and ends
-  /// 0.085-0.210 m off over seeds 1-5; with both 0.055-0.067 m. At 30 particles over the ten
-  /// corrected logs it is better or equal on nine, and on acapulco within the seeds' spread
-  /// (README, "The study that decides the default").
+  /// 0.085-0.210 m off over seeds 1-5; with both 0.055-0.067 m. At 30 particles on the ten
+  /// corrected logs it is better on seven (edmonton over seven seeds), the same on freiburg-101
+  /// and seattle, and worse on acapulco by 0.024 m in the mean over nine seeds (README, "The
+  /// study that decides the default").
   double weight_correlation_length_m = 0.1;
   /// How weight_correlation_length_m tempers: false, one factor for the whole scan (above); true,
   /// per point (AssignIndependenceWeights): each point's log-likelihood in the weight counts 1 /
