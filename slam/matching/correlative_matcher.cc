@@ -4,6 +4,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <queue>
 
 #include "slam/types/check.h"
 #include "slam/types/validation.h"
@@ -16,7 +17,8 @@ struct Node {
   int k = 0;
   int i = 0;
   int j = 0;
-  float bound = 0.0f;
+  int level = 0;           // the block spans 2^level x 2^level cells
+  float bound = 0.0f;      // the block's score at that level: no pose in it scores more
   std::int64_t index = 0;  // of its corner in the exhaustive search's (k, j, i) order
 };
 
@@ -193,85 +195,61 @@ std::vector<MatchResult> CorrelativeMatcher::MatchDistinct(
   for (int k = -wk; k <= wk; ++k) {
     for (int j = -wxy; j <= wxy; j += block) {
       for (int i = -wxy; i <= wxy; i += block) {
-        roots.push_back(Node{k, i, j, score(top, k, i, j), index_of(k, i, j)});
+        roots.push_back(Node{k, i, j, top, score(top, k, i, j), index_of(k, i, j)});
       }
     }
   }
-  std::sort(roots.begin(), roots.end(), BetterFirst);
-  // Greedy non-maximum suppression: each search is the exact branch and bound over the poses
-  // outside the neighbourhoods of the results before it.
+  // Best-first branch and bound: the open blocks in a heap, the highest bound (then the earliest
+  // in search order) on top. A leaf that comes to the top is the best pose not yet excluded: every
+  // block still open bounds its poses no higher, and with an equal bound starts later in search
+  // order (a block's poses come at or after its corner). So it is the exact search's answer, after
+  // scoring only blocks whose bound reaches it; the depth-first order of Hess 2016, Sec. V-A,
+  // scores every block above the best pose found so far, from min_score up. One heap serves the
+  // greedy non-maximum suppression's searches: what the earlier ones left open is still a
+  // partition of the poses neither taken nor excluded, and a block excluded once stays so.
   std::vector<Node> found;
-  std::int64_t nodes_scored = static_cast<std::int64_t>(roots.size());
-  while (static_cast<int>(found.size()) < count) {
-    // Best so far: the sum to beat (min_score until a pose reaches it) and its search index.
-    float best_sum = static_cast<float>(options_.min_score * n);
-    std::int64_t best_index = -1;
-    Node best;
-    // A block of 2^level cells lies wholly within an earlier result's neighbourhood: its corners
-    // do (the neighbourhood is a disc in x and y), at a yaw within min_angle_rad of the result's.
-    auto excluded = [&](const Node& node, int level) {
-      const int last = (1 << level) - 1;
-      const int i1 = std::min(node.i + last, wxy), j1 = std::min(node.j + last, wxy);
-      for (const Node& e : found) {
-        if (std::abs(NormalizeAngle((node.k - e.k) * step)) > min_angle_rad) continue;
-        bool inside = true;
-        for (const int i : {node.i, i1}) {
-          for (const int j : {node.j, j1}) {
-            inside = inside &&
-                     std::hypot((i - e.i) * resolution_, (j - e.j) * resolution_) <= min_distance_m;
-          }
-        }
-        if (inside) return true;
-      }
-      return false;
-    };
-    auto pruned = [&](const Node& node, int level) {
-      return node.bound < best_sum ||
-             (best_index >= 0 && node.bound == best_sum && node.index >= best_index) ||
-             (!found.empty() && excluded(node, level));
-    };
-
-    // Depth-first branch and bound (Hess 2016, Sec. V-A), recursive over the levels.
-    auto descend = [&](auto&& self, const Node& node, int level) -> void {
-      if (level == 0) {
-        if (!found.empty() && excluded(node, 0)) return;
-        if (node.bound > best_sum ||
-            (node.bound == best_sum && (best_index < 0 || node.index < best_index))) {
-          best_sum = node.bound;
-          best_index = node.index;
-          best = node;
-        }
-        return;
-      }
-      const int half = 1 << (level - 1);
-      Node children[4];
-      int num_children = 0;
-      for (const int dj : {0, half}) {
-        for (const int di : {0, half}) {
-          const int i = node.i + di, j = node.j + dj;
-          if (i > wxy || j > wxy) continue;
-          children[num_children++] =
-              Node{node.k, i, j, score(level - 1, node.k, i, j), index_of(node.k, i, j)};
+  // A block of 2^level cells lies wholly within an earlier result's neighbourhood: its corners do
+  // (the neighbourhood is a disc in x and y), at a yaw within min_angle_rad of the result's.
+  auto excluded = [&](const Node& node) {
+    const int last = (1 << node.level) - 1;
+    const int i1 = std::min(node.i + last, wxy), j1 = std::min(node.j + last, wxy);
+    for (const Node& e : found) {
+      if (std::abs(NormalizeAngle((node.k - e.k) * step)) > min_angle_rad) continue;
+      bool inside = true;
+      for (const int i : {node.i, i1}) {
+        for (const int j : {node.j, j1}) {
+          inside = inside &&
+                   std::hypot((i - e.i) * resolution_, (j - e.j) * resolution_) <= min_distance_m;
         }
       }
-      nodes_scored += num_children;
-      for (int a = 1; a < num_children; ++a) {  // insertion sort of at most four
-        for (int b = a; b > 0 && BetterFirst(children[b], children[b - 1]); --b) {
-          std::swap(children[b], children[b - 1]);
-        }
-      }
-      for (int c = 0; c < num_children; ++c) {
-        if (!pruned(children[c], level - 1)) self(self, children[c], level - 1);
-      }
-    };
-
-    for (const Node& root : roots) {
-      if (root.bound < best_sum) break;  // sorted: every later root is bounded lower still
-      if (!pruned(root, top)) descend(descend, root, top);
+      if (inside) return true;
     }
-
-    if (best_index < 0) break;
-    found.push_back(best);
+    return false;
+  };
+  auto lower_priority = [](const Node& a, const Node& b) { return BetterFirst(b, a); };
+  std::priority_queue<Node, std::vector<Node>, decltype(lower_priority)> open(lower_priority,
+                                                                              std::move(roots));
+  const float min_sum = static_cast<float>(options_.min_score * n);
+  std::int64_t nodes_scored = static_cast<std::int64_t>(open.size());
+  while (static_cast<int>(found.size()) < count && !open.empty()) {
+    const Node node = open.top();
+    open.pop();
+    if (node.bound < min_sum) break;  // and so is every block still open
+    if (!found.empty() && excluded(node)) continue;
+    if (node.level == 0) {
+      found.push_back(node);
+      continue;
+    }
+    const int half = 1 << (node.level - 1);
+    for (const int dj : {0, half}) {
+      for (const int di : {0, half}) {
+        const int i = node.i + di, j = node.j + dj;
+        if (i > wxy || j > wxy) continue;
+        open.push(Node{node.k, i, j, node.level - 1, score(node.level - 1, node.k, i, j),
+                       index_of(node.k, i, j)});
+        ++nodes_scored;
+      }
+    }
   }
   for (const Node& best : found) {
     MatchResult result;

@@ -41,8 +41,8 @@ struct CorrelativeMatcherOptions {
 /// with the exact multi-resolution search of Hess et al., "Real-Time Loop Closure in 2D LIDAR
 /// SLAM", ICRA 2016, Sec. V: precomputation grids (Sec. V-C: each cell of level h holds the maximum
 /// of the 2^h x 2^h raster cells above and right of it) bound the score of a whole block of
-/// translations, and a depth-first branch and bound (Sec. V-A) visits the blocks best bound
-/// first and prunes every block whose bound cannot beat the best pose so far.
+/// translations, and a branch and bound visits the blocks best bound first (best-first, where
+/// Sec. V-A goes depth-first), so that it scores only the blocks whose bound reaches the answer.
 ///
 /// The search is over the discrete poses (x0 + i r, y0 + j r, yaw0 + k s) of the window, with r the
 /// raster's resolution and s the yaw step. The scan at yaw index k is discretised once: point p's
