@@ -64,4 +64,12 @@ function(slamrig_add_test name)
   slamrig_set_target_options(${name})
   add_test(NAME ${name} COMMAND ${name} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   set_tests_properties(${name} PROPERTIES LABELS ${ARG_LABEL})
+  # `cmake --build B --target slamrig_unit_tests` builds what `ctest -L unit` runs, and nothing
+  # else (the sanitizer stage of scripts/test.sh).
+  if(ARG_LABEL STREQUAL "unit")
+    if(NOT TARGET slamrig_unit_tests)
+      add_custom_target(slamrig_unit_tests)
+    endif()
+    add_dependencies(slamrig_unit_tests ${name})
+  endif()
 endfunction()

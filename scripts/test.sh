@@ -1,36 +1,62 @@
 #!/usr/bin/env bash
-# The whole test suite, as CI runs it: dependencies, a Release build with warnings as errors,
-# every ctest label (unit, integration, scenario), an ASan/UBSan build of the unit tests, and
-# every reader of outside data over its fuzz corpus (libFuzzer, clang), and the clang-format
-# check (last, so that a formatting slip never hides a test result). Build folders: build-ci/,
-# build-asan/ and build-fuzz/ (all ignored by git).
+# The whole test suite, as CI runs it: dependencies, the clang-format check, a Release build with
+# warnings as errors and every ctest label (unit, integration, scenario, python), then one clang
+# build with AddressSanitizer, UndefinedBehaviorSanitizer and libFuzzer's coverage that runs the
+# unit tests and every reader of outside data over its fuzz corpus. Two builds, in build-ci/ and
+# build-fuzz/ (both ignored by git); ccache is used when it is installed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 bash scripts/install_deps.sh
 
 jobs=$(nproc)
-echo "== Release build (warnings are errors)"
-cmake -S . -B build-ci -DCMAKE_BUILD_TYPE=Release -DCMAKE_COMPILE_WARNING_AS_ERROR=ON >/dev/null
-cmake --build build-ci -j"$jobs"
+failed=()
 
-echo "== ASan/UBSan build"
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSLAMRIG_SANITIZE=ON \
-  -DSLAMRIG_BUILD_BENCHMARKS=OFF -DCMAKE_COMPILE_WARNING_AS_ERROR=ON >/dev/null
-cmake --build build-asan -j"$jobs"
-
-echo "== unit tests under ASan/UBSan"
-ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build-asan -L unit --output-on-failure -j"$jobs"
-
-echo "== fuzz corpora"
-# Every reader over its seed corpus and regression inputs once, under libFuzzer + ASan/UBSan
-# (clang; builds only the fuzz targets in build-fuzz/).
-SLAMRIG_FUZZ_JOBS="$jobs" bash fuzz/run_fuzzers.sh --corpus-only
-
-echo "== all tests (Release)"
-ctest --test-dir build-ci --output-on-failure -j"$jobs"
-
+# Formatting first: it takes seconds, and a slip is reported with the test results, never
+# instead of them.
 echo "== clang-format"
 mapfile -t sources < <(git ls-files '*.h' '*.cc')
-clang-format --dry-run --Werror "${sources[@]}"
+if ! clang-format --dry-run --Werror "${sources[@]}"; then failed+=(clang-format); fi
+
+launcher=()
+if command -v ccache >/dev/null 2>&1; then
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  # Paths relative to the clone's parent, so that two clones side by side share cache entries.
+  CCACHE_BASEDIR=$(cd .. && pwd)
+  export CCACHE_BASEDIR
+fi
+
+echo "== Release build (warnings are errors)"
+cmake -S . -B build-ci -DCMAKE_BUILD_TYPE=Release -DCMAKE_COMPILE_WARNING_AS_ERROR=ON \
+  "${launcher[@]}" >/dev/null
+cmake --build build-ci -j"$jobs"
+
+echo "== all tests (Release)"
+if ! ctest --test-dir build-ci --output-on-failure -j"$jobs"; then failed+=(ctest-release); fi
+
+echo "== clang build: ASan/UBSan and libFuzzer coverage"
+# One instrumented build serves both the sanitizer run of the unit tests and the fuzz corpora;
+# it builds only the unit tests, the fuzz targets and the slamrig binary (fuzz/make_corpora.sh).
+CC=clang CXX=clang++ cmake -S . -B build-fuzz -DSLAMRIG_FUZZ=ON -DSLAMRIG_SANITIZE=ON \
+  -DSLAMRIG_BUILD_BENCHMARKS=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_COMPILE_WARNING_AS_ERROR=ON "${launcher[@]}" >/dev/null
+cmake --build build-fuzz -j"$jobs" --target slamrig_unit_tests
+
+echo "== unit tests under ASan/UBSan"
+if ! ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  ctest --test-dir build-fuzz -L unit --output-on-failure -j"$jobs"; then
+  failed+=(ctest-asan)
+fi
+
+echo "== fuzz corpora"
+# Every reader over its seed corpus and regression inputs once.
+if ! SLAMRIG_FUZZ_BUILD_DIR=build-fuzz SLAMRIG_FUZZ_JOBS="$jobs" \
+  bash fuzz/run_fuzzers.sh --corpus-only; then
+  failed+=(fuzz)
+fi
+
+if ((${#failed[@]} > 0)); then
+  echo "test.sh: failed: ${failed[*]}" >&2
+  exit 1
+fi
+echo "test.sh: all stages passed"
