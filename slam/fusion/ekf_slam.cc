@@ -76,7 +76,7 @@ EkfSlam::EkfSlam(const EkfSlamOptions& options)
       motion_(options.motion),
       probe_pose_(options.motion),
       probe_gyro_(options.motion) {
-  SLAMRIG_CHECK(options.Validate().empty(), "EkfSlam: invalid options");
+  SLAMRIG_CHECK_VALID(options, "EkfSlamOptions");
   // PoseEkf's prior on the gyro states.
   p_(kBias, kBias) = options.motion.gyro_bias_sigma_rad_s * options.motion.gyro_bias_sigma_rad_s;
   p_(kBias + 1, kBias + 1) = options.motion.gyro_scale_sigma * options.motion.gyro_scale_sigma;

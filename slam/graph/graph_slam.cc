@@ -164,7 +164,7 @@ GraphSlam::GraphSlam(const GraphSlamOptions& options)
       odometry_(options.odometry),
       optimizer_(options.optimizer),
       consistency_(options.loop_pairwise_chi2) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid GraphSlamOptions");
+  SLAMRIG_CHECK_VALID(options_, "GraphSlamOptions");
 }
 
 Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment) {

@@ -58,7 +58,7 @@ std::vector<std::string> CorrelativeMatcherOptions::Validate() const {
 CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
                                        const GridView& raster)
     : options_(options), origin_(raster.origin), resolution_(raster.resolution) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid CorrelativeMatcherOptions");
+  SLAMRIG_CHECK_VALID(options_, "CorrelativeMatcherOptions");
   std::vector<float> values(static_cast<std::size_t>(raster.width) * raster.height);
   for (int y = 0; y < raster.height; ++y) {
     for (int x = 0; x < raster.width; ++x) {
@@ -71,7 +71,7 @@ CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
 CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
                                        const OccupancyGrid& grid, int decimation)
     : options_(options), origin_(grid.origin()), resolution_(grid.resolution() * decimation) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid CorrelativeMatcherOptions");
+  SLAMRIG_CHECK_VALID(options_, "CorrelativeMatcherOptions");
   SLAMRIG_CHECK(decimation >= 1, "CorrelativeMatcher: decimation must be >= 1");
   const int d = decimation;
   const int width = (grid.width() + d - 1) / d, height = (grid.height() + d - 1) / d;

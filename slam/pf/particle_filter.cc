@@ -58,7 +58,7 @@ ParticleFilter::ParticleFilter(const ParticleFilterOptions& options)
       refiner_(options.refiner),
       rng_(options.seed),
       calibration_(options.odometry_calibration) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid ParticleFilterOptions");
+  SLAMRIG_CHECK_VALID(options_, "ParticleFilterOptions");
   if (options_.num_threads > 1) pool_ = std::make_unique<ThreadPool>(options_.num_threads);
   const int n = options_.num_particles;
   particles_.assign(static_cast<std::size_t>(n), Particle{Pose2(), 1.0 / n});

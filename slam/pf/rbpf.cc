@@ -28,7 +28,7 @@ RbpfPoseNode::~RbpfPoseNode() {
 
 Rbpf::Rbpf(const RbpfOptions& options)
     : options_(options), matcher_(options.matcher), rng_(options.seed) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid RbpfOptions");
+  SLAMRIG_CHECK_VALID(options_, "RbpfOptions");
   if (options_.num_threads > 1) pool_ = std::make_unique<ThreadPool>(options_.num_threads);
 }
 

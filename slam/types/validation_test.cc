@@ -4,6 +4,8 @@
 
 #include <limits>
 
+#include "slam/types/check.h"
+
 namespace slamrig {
 namespace {
 
@@ -42,6 +44,21 @@ TEST(RulesTest, NestedUnderTheRootKeepsKeys) {
   Rules rules;
   rules.Nested("", {"seed = -1; must be >= 0"});
   EXPECT_EQ(rules.errors(), std::vector<std::string>{"seed = -1; must be >= 0"});
+}
+
+struct BrokenOptions {
+  int particles = 0;
+  std::vector<std::string> Validate() const {
+    Rules rules;
+    rules.Positive("particles", particles).Positive("threads", particles);
+    return rules.errors();
+  }
+};
+
+TEST(CheckValidDeathTest, AbortsNamingTheTypeAndTheFirstBrokenRule) {
+  EXPECT_DEATH(SLAMRIG_CHECK_VALID(BrokenOptions{}, "BrokenOptions"),
+               "invalid BrokenOptions: particles = 0; must be > 0");
+  SLAMRIG_CHECK_VALID(BrokenOptions{.particles = 3}, "BrokenOptions");  // passes
 }
 
 }  // namespace
