@@ -68,8 +68,13 @@ ParticleFilterOptions ParticleFilterOptions::ReportsPreset() {
   o.sigma_xy_m = 0.005;
   o.sigma_yaw_rad = 0.003;
   o.observation = ObservationModel::kMapCorrelation;
-  o.points = ScanPointsOptions{0.1, 30.0, 1, 0.0};
-  o.correlation = MapCorrelatorOptions{4, 0, 0.01, CorrelationValue::kOccupiedIndicator, 0.0f};
+  o.points = ScanPointsOptions{
+      .min_range_m = 0.1, .max_range_m = 30.0, .beam_stride = 1, .voxel_size_m = 0.0};
+  o.correlation = MapCorrelatorOptions{.xy_half_width_cells = 4,
+                                       .yaw_half_steps = 0,
+                                       .yaw_step_rad = 0.01,
+                                       .value = CorrelationValue::kOccupiedIndicator,
+                                       .occupied_threshold = 0.0f};
   o.observation_scale = 1.0;
   o.move_to_best_shift = false;
   o.refine = false;
