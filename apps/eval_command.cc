@@ -14,15 +14,10 @@
 #include "slam/io/atomic_file.h"
 #include "slam/io/tum_io.h"
 #include "slam/types/error.h"
+#include "slam/types/format.h"
 
 namespace slamrig::app {
 namespace {
-
-std::string Fixed(double v, int digits) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.*f", digits, v);
-  return buffer;
-}
 
 std::string ReadText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

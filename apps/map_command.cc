@@ -15,6 +15,7 @@
 #include "slam/io/map_server.h"
 #include "slam/io/tum_io.h"
 #include "slam/types/error.h"
+#include "slam/types/format.h"
 
 namespace slamrig::app {
 namespace {
@@ -28,12 +29,6 @@ std::string Join(const std::map<std::string, int>& counts) {
     out += (out.empty() ? "" : ", ") + std::to_string(n) + " " + reason;
   }
   return out;
-}
-
-std::string Fixed(double v, int digits) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.*f", digits, v);
-  return buffer;
 }
 
 }  // namespace

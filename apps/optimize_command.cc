@@ -13,6 +13,7 @@
 #include "slam/graph/pose_graph_optimizer.h"
 #include "slam/io/log_reader.h"
 #include "slam/types/error.h"
+#include "slam/types/format.h"
 
 namespace slamrig::app {
 namespace {
@@ -45,12 +46,6 @@ PoseGraphOptimizerOptions ParseChoices(const std::string& robust, const std::str
   }
   for (const std::string& e : options.Validate()) throw ConfigError("slamrig optimize: " + e);
   return options;
-}
-
-std::string Number(const char* format, double v) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), format, v);
-  return buffer;
 }
 
 }  // namespace

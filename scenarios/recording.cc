@@ -54,6 +54,80 @@ std::vector<std::string> RunOptions::Validate() const {
   return errors;
 }
 
+namespace {
+
+// The one sink of a recording, by format; the concrete one is kept for its counters.
+struct RecordSinks {
+  std::unique_ptr<slam::CarmenSink> carmen;
+  std::unique_ptr<slam::BagSink> bag;
+  std::unique_ptr<slam::Ece276aSink> ece276a;
+  // The ECE276A layout has no odometry: the summary's comes from the same integration.
+  std::optional<slam::RobotOdometry> ece276a_odometry;
+
+  slam::RecordSink& log() {
+    return carmen    ? static_cast<slam::RecordSink&>(*carmen)
+           : ece276a ? static_cast<slam::RecordSink&>(*ece276a)
+                     : *bag;
+  }
+};
+
+// Opens the sink of `recording.format` in `out_dir` (the log named `run_name`).
+void OpenSinks(const sim::SimulatorOptions& options, const RecordingOptions& recording,
+               const slam::WheelOdometryOptions& odometry, const std::string& out_dir,
+               const std::string& run_name, RecordSinks* sinks) {
+  namespace fs = std::filesystem;
+  const std::string dir = fs::path(out_dir).string() + "/";
+  const sim::RobotSpec& robot = options.robot;
+  if (recording.format == RecordingFormat::kEce276a) {
+    sinks->ece276a = std::make_unique<slam::Ece276aSink>(
+        out_dir, slam::Ece276aWriteOptions{.dataset = recording.ece276a_dataset});
+    sinks->ece276a_odometry.emplace(odometry);
+  } else if (recording.format == RecordingFormat::kCarmen) {
+    slam::CarmenSinkOptions carmen;
+    carmen.odometry = odometry;
+    carmen.params = {
+        {"robot_front_laser_max", FormatNumber(robot.lidar.range_max_m)},
+        {"robot_frontlaser_offset", FormatNumber(robot.lidar.mount.x_m)},
+        // ROBOTLASER1 has no field for these; slamrig's reader applies them to every laser line.
+        {"laser_time_increment_s", FormatNumber(robot.lidar.time_increment_s())},
+        {"laser_range_min_m", FormatNumber(robot.lidar.range_min_m)},
+        {"slamrig_world", options.world.name.empty() ? "unnamed" : options.world.name},
+        {"slamrig_robot", robot.name.empty() ? "unnamed" : robot.name},
+        {"slamrig_seed", std::to_string(options.seed)}};
+    sinks->carmen = std::make_unique<slam::CarmenSink>(dir + run_name, carmen);
+  } else {
+    slam::BagSinkOptions bag;
+    bag.writer.storage = recording.format == RecordingFormat::kMcap ? slam::BagStorage::kMcap
+                                                                    : slam::BagStorage::kSqlite3;
+    bag.writer.compression = recording.compression;
+    bag.writer.topics = recording.topics;
+    bag.writer.ticks_per_revolution = robot.encoders.ticks_per_revolution;
+    bag.odometry = odometry;
+    // A bag from an earlier run is replaced; anything else in the way is an error (BagWriter).
+    if (fs::exists(fs::path(dir + run_name) / "metadata.yaml")) fs::remove_all(dir + run_name);
+    sinks->bag = std::make_unique<slam::BagSink>(dir + run_name, bag);
+  }
+}
+
+// The sink's counts of what it wrote, and the odometry's last pose.
+void CountRecords(const RecordSinks& sinks, RunSummary* summary) {
+  if (sinks.ece276a) {
+    summary->num_scans = sinks.ece276a->scans();
+    summary->num_odometry = sinks.ece276a->encoder_readings();
+    summary->num_imu = sinks.ece276a->imu_samples();
+    summary->final_odometry = sinks.ece276a_odometry->pose();
+  } else {
+    summary->num_scans = sinks.carmen ? sinks.carmen->scans() : sinks.bag->scans();
+    summary->num_odometry =
+        sinks.carmen ? sinks.carmen->odometry_lines() : sinks.bag->odometry_messages();
+    summary->num_imu = sinks.carmen ? sinks.carmen->imu_samples() : sinks.bag->imu_samples();
+    summary->final_odometry =
+        sinks.carmen ? sinks.carmen->odometry_pose() : sinks.bag->odometry_pose();
+  }
+}
+
+}  // namespace
+
 std::vector<std::string> RecordingOptions::Validate() const {
   if (format == RecordingFormat::kEce276a) {
     if (ece276a_dataset < 0) {
@@ -67,7 +141,7 @@ std::vector<std::string> RecordingOptions::Validate() const {
 
 RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptions& run,
                             const std::string& out_dir, const RecordingOptions& recording) {
-  SLAMRIG_CHECK(run.Validate().empty(), "invalid RunOptions");
+  SLAMRIG_CHECK_VALID(run, "RunOptions");
   if (const auto errors = recording.Validate(); !errors.empty()) {
     throw ConfigError("recording: " + errors.front());
   }
@@ -90,52 +164,17 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
   slam::WheelOdometryOptions odometry;
   odometry.robot = sim::NominalOdometry(robot);
   odometry.use_gyro = robot.imu.enabled;
-  // One sink, by format; the concrete one is kept for its counters.
-  std::unique_ptr<slam::CarmenSink> carmen_sink;
-  std::unique_ptr<slam::BagSink> bag_sink;
-  std::unique_ptr<slam::Ece276aSink> ece276a_sink;
-  // The ECE276A layout has no odometry: the summary's comes from the same integration.
-  std::optional<slam::RobotOdometry> ece276a_odometry;
   const std::string run_name = recording.format == RecordingFormat::kCarmen ? "run.log" : "run";
-  if (recording.format == RecordingFormat::kEce276a) {
-    ece276a_sink = std::make_unique<slam::Ece276aSink>(
-        out_dir, slam::Ece276aWriteOptions{.dataset = recording.ece276a_dataset});
-    ece276a_odometry.emplace(odometry);
-  } else if (recording.format == RecordingFormat::kCarmen) {
-    slam::CarmenSinkOptions carmen;
-    carmen.odometry = odometry;
-    carmen.params = {
-        {"robot_front_laser_max", FormatNumber(robot.lidar.range_max_m)},
-        {"robot_frontlaser_offset", FormatNumber(robot.lidar.mount.x_m)},
-        // ROBOTLASER1 has no field for these; slamrig's reader applies them to every laser line.
-        {"laser_time_increment_s", FormatNumber(robot.lidar.time_increment_s())},
-        {"laser_range_min_m", FormatNumber(robot.lidar.range_min_m)},
-        {"slamrig_world", options.world.name.empty() ? "unnamed" : options.world.name},
-        {"slamrig_robot", robot.name.empty() ? "unnamed" : robot.name},
-        {"slamrig_seed", std::to_string(options.seed)}};
-    carmen_sink = std::make_unique<slam::CarmenSink>(dir + run_name, carmen);
-  } else {
-    slam::BagSinkOptions bag;
-    bag.writer.storage = recording.format == RecordingFormat::kMcap ? slam::BagStorage::kMcap
-                                                                    : slam::BagStorage::kSqlite3;
-    bag.writer.compression = recording.compression;
-    bag.writer.topics = recording.topics;
-    bag.writer.ticks_per_revolution = robot.encoders.ticks_per_revolution;
-    bag.odometry = odometry;
-    // A bag from an earlier run is replaced; anything else in the way is an error (BagWriter).
-    if (fs::exists(fs::path(dir + run_name) / "metadata.yaml")) fs::remove_all(dir + run_name);
-    bag_sink = std::make_unique<slam::BagSink>(dir + run_name, bag);
-  }
-  slam::RecordSink& log = carmen_sink    ? static_cast<slam::RecordSink&>(*carmen_sink)
-                          : ece276a_sink ? static_cast<slam::RecordSink&>(*ece276a_sink)
-                                         : *bag_sink;
+  RecordSinks sinks;
+  OpenSinks(options, recording, odometry, out_dir, run_name, &sinks);
+  slam::RecordSink& log = sinks.log();
 
   Trajectory truth_at_scans;
   auto consume = [&](const sim::StepResult& step) {
     for (std::size_t i = 0; i < step.records.size(); ++i) {
       const Record& record = step.records[i];
       const GroundTruthPose truth = step.truth[i].ToGroundTruthPose();
-      if (ece276a_odometry) ece276a_odometry->Add(record);
+      if (sinks.ece276a_odometry) sinks.ece276a_odometry->Add(record);
       if (const auto* scan = std::get_if<LaserScan>(&record)) {
         truth_at_scans.Append(scan->time, truth.map_from_base);
         log.Add(record, &truth);
@@ -158,20 +197,9 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
   consume(advance(true));
   log.Commit();
 
-  if (ece276a_sink) {
-    summary.num_scans = ece276a_sink->scans();
-    summary.num_odometry = ece276a_sink->encoder_readings();
-    summary.num_imu = ece276a_sink->imu_samples();
-    summary.final_odometry = ece276a_odometry->pose();
-  } else {
-    summary.num_scans = carmen_sink ? carmen_sink->scans() : bag_sink->scans();
-    summary.num_odometry =
-        carmen_sink ? carmen_sink->odometry_lines() : bag_sink->odometry_messages();
-    summary.num_imu = carmen_sink ? carmen_sink->imu_samples() : bag_sink->imu_samples();
-    summary.final_odometry = carmen_sink ? carmen_sink->odometry_pose() : bag_sink->odometry_pose();
-  }
+  CountRecords(sinks, &summary);
   summary.num_frames = rig ? rig->frames() : 0;
-  summary.frames_skipped = carmen_sink ? carmen_sink->frames_skipped() : 0;
+  summary.frames_skipped = sinks.carmen ? sinks.carmen->frames_skipped() : 0;
   summary.duration_s = sim.time().seconds();
   summary.drive_finished = sim.drive_finished();
   summary.final_truth = sim.Truth().map_from_base;
@@ -179,8 +207,8 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
   slam::WriteFileAtomically(dir + "world.yaml", sim::WorldSpecToYaml(options.world));
   slam::WriteFileAtomically(dir + "robot.yaml", sim::RobotSpecToYaml(options.robot));
   slam::WriteFileAtomically(dir + "sim.yaml", SimSettingsYaml(options, summary));
-  if (ece276a_sink) {
-    summary.files = ece276a_sink->files();
+  if (sinks.ece276a) {
+    summary.files = sinks.ece276a->files();
   } else {
     summary.files.push_back(dir + run_name);
   }

@@ -375,13 +375,15 @@ std::string ResolvedYaml(const ScenarioSpec& spec, const std::vector<std::string
   return std::string(out.c_str()) + "\n";
 }
 
-}  // namespace
+// The --set overrides of the world and robot files (key without its "world." or "robot."
+// prefix, value); the others are applied to the scenario file itself.
+struct FileOverrides {
+  std::vector<std::pair<std::string, std::string>> world, robot;
+};
 
-ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string>& overrides,
-                          std::optional<std::uint64_t> seed) {
-  YamlNode root = YamlNode::LoadFile(path);
-  if (!root.IsMap()) root.Fail("a scenario file is a map (name, world, robot, slam, ...)");
-  std::vector<std::pair<std::string, std::string>> world_set, robot_set;
+FileOverrides ApplyOverrides(const std::vector<std::string>& overrides, YamlNode* root_node) {
+  YamlNode& root = *root_node;
+  FileOverrides sets;
   for (const std::string& o : overrides) {
     const std::size_t eq = o.find('=');
     if (eq == std::string::npos || eq == 0) {
@@ -389,89 +391,84 @@ ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string
     }
     const std::string key = o.substr(0, eq), value = o.substr(eq + 1);
     if (key.rfind("world.", 0) == 0) {
-      world_set.emplace_back(key.substr(6), value);
+      sets.world.emplace_back(key.substr(6), value);
     } else if (key.rfind("robot.", 0) == 0) {
-      robot_set.emplace_back(key.substr(6), value);
+      sets.robot.emplace_back(key.substr(6), value);
     } else {
       root.Override(key, value, "--set " + o);
     }
   }
+  return sets;
+}
 
-  ScenarioSpec spec;
-  spec.path = path;
-  spec.name = fs::path(path).stem().string();
-  root.Read("name", &spec.name);
-  root.Read("description", &spec.description);
-  spec.has_duration = root.Has("duration_s");
-  root.Read("duration_s", &spec.duration_s);
-  if (!(spec.duration_s > 0.0 && spec.duration_s <= 1e6)) {
-    root.Required("duration_s").Fail("must be in (0, 1e6] seconds");
+// A recorded log: `source` and the robot file its wheel geometry comes from.
+LogSource ReadLogSource(const YamlNode& root, const YamlNode& source, const std::string& path,
+                        const FileOverrides& sets) {
+  for (const char* key : {"world", "world_overrides", "faults"}) {
+    if (root.Has(key))
+      root.Required(key).Fail("a log scenario (source: {log: ...}) has no " + std::string(key));
   }
-  root.Read("seed", &spec.seed);
-  if (seed) spec.seed = *seed;
-
-  if (const auto source = root.Optional("source")) {
-    // A recorded log.
-    for (const char* key : {"world", "world_overrides", "faults"}) {
-      if (root.Has(key))
-        root.Required(key).Fail("a log scenario (source: {log: ...}) has no " + std::string(key));
-    }
-    if (!world_set.empty())
-      throw ConfigError("--set world." + world_set.front().first + ": a log scenario has no world");
-    LogSource log;
-    log.path = ResolveLog(source->Required("log"), path);
-    source->Read("lenient", &log.read.lenient);
-    if (const auto topics = source->Optional("topics")) {
-      if (!topics->IsMap()) topics->Fail("topics is a map (scan: /front/scan, ...)");
-      for (const std::string& key : topics->Keys()) {
-        std::string* name = log.read.topics.Find(key);
-        if (name == nullptr) {
-          topics->Required(key).Fail("unknown topic key '" + key + "' (expected one of " +
-                                     slam::BagTopicNames::Keys() + ")");
-        }
-        *name = topics->Get<std::string>(key);
+  if (!sets.world.empty())
+    throw ConfigError("--set world." + sets.world.front().first + ": a log scenario has no world");
+  LogSource log;
+  log.path = ResolveLog(source.Required("log"), path);
+  source.Read("lenient", &log.read.lenient);
+  if (const auto topics = source.Optional("topics")) {
+    if (!topics->IsMap()) topics->Fail("topics is a map (scan: /front/scan, ...)");
+    for (const std::string& key : topics->Keys()) {
+      std::string* name = log.read.topics.Find(key);
+      if (name == nullptr) {
+        topics->Required(key).Fail("unknown topic key '" + key + "' (expected one of " +
+                                   slam::BagTopicNames::Keys() + ")");
       }
-      topics->ThrowIfInvalid(log.read.topics.Validate());
+      *name = topics->Get<std::string>(key);
     }
-    if (const auto robot_node = root.Optional("robot")) {
-      YamlNode robot = WorldOrRobot(*robot_node, path, "robots");
-      for (const auto& [k, v] : robot_set) robot.Override(k, v, "--set robot." + k + "=" + v);
-      log.robot = sim::NominalOdometry(sim::ParseRobotSpec(robot));
-      robot.CheckAllKeysUsed();
-    } else if (!robot_set.empty()) {
-      throw ConfigError("--set robot." + robot_set.front().first + ": the scenario has no robot");
-    }
-    spec.log = log;
-  } else {
-    // A simulated world, with the scenario's and the command line's overrides.
-    SimulatedSource sim_source;
-    YamlNode world = WorldOrRobot(root.Required("world"), path, "worlds");
-    YamlNode robot = WorldOrRobot(root.Required("robot"), path, "robots");
-    for (const char* section : {"world_overrides", "robot_overrides"}) {
-      if (auto o = root.Optional(section)) {
-        for (const std::string& key : o->Keys()) {
-          const YamlNode value = o->Required(key);
-          if (!value.IsScalar()) value.Fail("override values must be scalars");
-          // Located and resolved (a relative path) by the scenario file that says it.
-          (section[0] == 'w' ? world : robot)
-              .Override(key, value.As<std::string>(), value.Where(),
-                        std::filesystem::path(path).parent_path().string());
-        }
-      }
-    }
-    for (const auto& [k, v] : world_set) world.Override(k, v, "--set world." + k + "=" + v);
-    for (const auto& [k, v] : robot_set) robot.Override(k, v, "--set robot." + k + "=" + v);
-    sim_source.options.world = sim::ParseWorldSpec(world);
-    world.CheckAllKeysUsed();
-    sim_source.options.robot = sim::ParseRobotSpec(robot);
+    topics->ThrowIfInvalid(log.read.topics.Validate());
+  }
+  if (const auto robot_node = root.Optional("robot")) {
+    YamlNode robot = WorldOrRobot(*robot_node, path, "robots");
+    for (const auto& [k, v] : sets.robot) robot.Override(k, v, "--set robot." + k + "=" + v);
+    log.robot = sim::NominalOdometry(sim::ParseRobotSpec(robot));
     robot.CheckAllKeysUsed();
-    sim_source.options.seed = spec.seed;
-    if (auto faults = root.Optional("faults")) ReadFaults(*faults, &sim_source);
-    root.ThrowIfInvalid(sim_source.options.Validate());
-    spec.simulated = std::move(sim_source);
+  } else if (!sets.robot.empty()) {
+    throw ConfigError("--set robot." + sets.robot.front().first + ": the scenario has no robot");
   }
+  return log;
+}
 
-  // SLAM configurations, in file order, with the source's wheel geometry.
+// A simulated world, with the scenario's and the command line's overrides.
+SimulatedSource ReadSimulatedSource(const YamlNode& root, const std::string& path,
+                                    std::uint64_t seed, const FileOverrides& sets) {
+  SimulatedSource sim_source;
+  YamlNode world = WorldOrRobot(root.Required("world"), path, "worlds");
+  YamlNode robot = WorldOrRobot(root.Required("robot"), path, "robots");
+  for (const char* section : {"world_overrides", "robot_overrides"}) {
+    if (auto o = root.Optional(section)) {
+      for (const std::string& key : o->Keys()) {
+        const YamlNode value = o->Required(key);
+        if (!value.IsScalar()) value.Fail("override values must be scalars");
+        // Located and resolved (a relative path) by the scenario file that says it.
+        (section[0] == 'w' ? world : robot)
+            .Override(key, value.As<std::string>(), value.Where(),
+                      std::filesystem::path(path).parent_path().string());
+      }
+    }
+  }
+  for (const auto& [k, v] : sets.world) world.Override(k, v, "--set world." + k + "=" + v);
+  for (const auto& [k, v] : sets.robot) robot.Override(k, v, "--set robot." + k + "=" + v);
+  sim_source.options.world = sim::ParseWorldSpec(world);
+  world.CheckAllKeysUsed();
+  sim_source.options.robot = sim::ParseRobotSpec(robot);
+  robot.CheckAllKeysUsed();
+  sim_source.options.seed = seed;
+  if (auto faults = root.Optional("faults")) ReadFaults(*faults, &sim_source);
+  root.ThrowIfInvalid(sim_source.options.Validate());
+  return sim_source;
+}
+
+// The SLAM configurations, in file order, with the source's wheel geometry.
+void ReadConfigs(const YamlNode& root, ScenarioSpec* spec_out) {
+  ScenarioSpec& spec = *spec_out;
   const YamlNode slam = root.Required("slam");
   if (!slam.IsMap()) slam.Fail("expected a map of SLAM configurations (name: {algorithm: ...})");
   const slam::DiffDriveParams robot =
@@ -489,6 +486,35 @@ ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string
     spec.configs.push_back(std::move(config));
   }
   if (spec.configs.empty()) slam.Fail("needs at least one SLAM configuration");
+}
+
+}  // namespace
+
+ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string>& overrides,
+                          std::optional<std::uint64_t> seed) {
+  YamlNode root = YamlNode::LoadFile(path);
+  if (!root.IsMap()) root.Fail("a scenario file is a map (name, world, robot, slam, ...)");
+  const FileOverrides sets = ApplyOverrides(overrides, &root);
+
+  ScenarioSpec spec;
+  spec.path = path;
+  spec.name = fs::path(path).stem().string();
+  root.Read("name", &spec.name);
+  root.Read("description", &spec.description);
+  spec.has_duration = root.Has("duration_s");
+  root.Read("duration_s", &spec.duration_s);
+  if (!(spec.duration_s > 0.0 && spec.duration_s <= 1e6)) {
+    root.Required("duration_s").Fail("must be in (0, 1e6] seconds");
+  }
+  root.Read("seed", &spec.seed);
+  if (seed) spec.seed = *seed;
+
+  if (const auto source = root.Optional("source")) {
+    spec.log = ReadLogSource(root, *source, path, sets);
+  } else {
+    spec.simulated = ReadSimulatedSource(root, path, spec.seed, sets);
+  }
+  ReadConfigs(root, &spec);
 
   if (auto texture = root.Optional("texture")) {
     if (!spec.simulated || !spec.simulated->options.robot.camera)

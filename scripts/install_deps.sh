@@ -11,7 +11,7 @@ packages=(
   clang libclang-rt-14-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri
   slurm-wlm munge
-  procps
+  procps universal-ctags
   pybind11-dev python3-dev python3-numpy python3-pytest
 )
 

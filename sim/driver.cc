@@ -65,7 +65,7 @@ std::vector<std::string> DriveOptions::Validate() const {
 }
 
 Driver::Driver(const DriveOptions& options) : options_(options) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid DriveOptions");
+  SLAMRIG_CHECK_VALID(options_, "DriveOptions");
   if (options_.mode != DriveMode::kWaypoints) return;
   path_ = options_.waypoints_m;
   if (options_.closed) path_.push_back(path_.front());

@@ -24,7 +24,7 @@ std::vector<std::string> EncoderOptions::Validate() const {
 EncoderModel::EncoderModel(const EncoderOptions& options, int num_right, int num_left,
                            std::uint64_t seed)
     : options_(options), num_right_(num_right) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid EncoderOptions");
+  SLAMRIG_CHECK_VALID(options_, "EncoderOptions");
   SLAMRIG_CHECK(num_right > 0 && num_left > 0, "an encoder per side at least");
   RandomStream rng(seed, "encoders");
   for (int i = 0; i < num_right + num_left; ++i) phase_ticks_.push_back(rng.Uniform());

@@ -43,7 +43,7 @@ ImuModel::ImuModel(const ImuOptions& options, std::uint64_t seed)
     : options_(options),
       gyro_{options.gyro, RandomStream(seed, "imu.gyro")},
       accel_{options.accel, RandomStream(seed, "imu.accel")} {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid ImuOptions");
+  SLAMRIG_CHECK_VALID(options_, "ImuOptions");
   for (Triad* triad : {&gyro_, &accel_}) {
     for (int axis = 0; axis < 3; ++axis) {
       triad->turn_on_bias[axis] = triad->noise.turn_on_bias_stddev * triad->rng.Gaussian();

@@ -64,7 +64,7 @@ std::vector<std::string> LidarOptions::Validate() const {
 
 LidarModel::LidarModel(const LidarOptions& options, std::uint64_t seed)
     : options_(options), rng_(seed, "lidar") {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid LidarOptions");
+  SLAMRIG_CHECK_VALID(options_, "LidarOptions");
   if (options_.range_resolution_m > 0.0) inverse_resolution_ = 1.0 / options_.range_resolution_m;
   p_max_random_ = options_.p_max + options_.p_random;
   p_any_ = options_.p_max + options_.p_random + options_.p_short;

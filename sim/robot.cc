@@ -18,7 +18,7 @@ double MoveTowards(double value, double target, double max_step) {
 
 Robot::Robot(const RobotSpec& spec, World* world, const Pose2& map_from_base)
     : spec_(spec), world_(world) {
-  SLAMRIG_CHECK(spec_.Validate().empty(), "invalid RobotSpec");
+  SLAMRIG_CHECK_VALID(spec_, "RobotSpec");
   const ChassisOptions& chassis = spec_.chassis;
   const WheelOptions& w = spec_.wheels;
 

@@ -29,7 +29,7 @@ b2FixtureDef WallFixtureDef(const b2Shape* shape) {
 }  // namespace
 
 World::World(const WorldSpec& spec) : spec_(spec) {
-  SLAMRIG_CHECK(spec_.Validate().empty(), "invalid WorldSpec");
+  SLAMRIG_CHECK_VALID(spec_, "WorldSpec");
   world_ = std::make_unique<b2World>(b2Vec2(0.0f, 0.0f));
 
   b2BodyDef static_def;

@@ -110,5 +110,28 @@ TEST(DependencyRulesTest, SlamNeverSeesTheSimulatorAndSimNeverTheRunner) {
   EXPECT_THAT(violations, ::testing::IsEmpty());
 }
 
+// slam/io/bag is its own library (slamrig_bag), which slamrig_io links for its log reader: the
+// bag code may use slam/io's header-only types and slamrig_atomic_file, never code compiled into
+// slamrig_io, or the two libraries would need each other.
+TEST(DependencyRulesTest, BagNeedsNoCodeOfSlamrigIo) {
+  const std::vector<std::string> allowed = {"slam/io/atomic_file.h", "slam/io/dataset.h",
+                                            "slam/io/record_sink.h"};
+  std::vector<std::string> violations;
+  int checked = 0;
+  for (const Include& inc : Includes()) {
+    if (inc.file.rfind("slam/io/bag/", 0) != 0 || inc.file.find("_test.cc") != std::string::npos ||
+        inc.file.rfind("slam/io/bag/testing/", 0) == 0) {
+      continue;  // the tests and test tools link slamrig_io itself
+    }
+    if (inc.target.rfind("slam/io/", 0) != 0 || inc.target.rfind("slam/io/bag/", 0) == 0) continue;
+    ++checked;
+    if (std::find(allowed.begin(), allowed.end(), inc.target) == allowed.end()) {
+      violations.push_back(inc.file + " includes " + inc.target);
+    }
+  }
+  EXPECT_GT(checked, 0);
+  EXPECT_THAT(violations, ::testing::IsEmpty());
+}
+
 }  // namespace
 }  // namespace slamrig

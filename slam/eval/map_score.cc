@@ -41,7 +41,7 @@ std::vector<std::string> MapScoreOptions::Validate() const {
 
 MapScore ScoreMap(const OccupancyGrid& estimate, const Pose2& truth_from_estimate,
                   const OccupancyGrid& truth, const MapScoreOptions& options) {
-  SLAMRIG_CHECK(options.Validate().empty(), "invalid MapScoreOptions");
+  SLAMRIG_CHECK_VALID(options, "MapScoreOptions");
   // Occupied cells of both maps on the truth lattice (cell indices may fall outside the truth
   // grid).
   const double occupied_log_odds =

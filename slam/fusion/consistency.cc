@@ -61,13 +61,6 @@ double PoseNees(const Pose2& truth, const Pose2& estimate, const Eigen::Matrix3d
   return e.dot(ldlt.solve(e));
 }
 
-Eigen::Matrix3d RotateCovariance(const Eigen::Matrix3d& covariance, double yaw_rad) {
-  Eigen::Matrix3d j = Eigen::Matrix3d::Identity();
-  const double c = std::cos(yaw_rad), s = std::sin(yaw_rad);
-  j.topLeftCorner<2, 2>() << c, -s, s, c;
-  return j * covariance * j.transpose();
-}
-
 std::string CovarianceCsv(const Trajectory& poses,
                           const std::vector<Eigen::Matrix3d>& covariances) {
   SLAMRIG_CHECK(poses.size() == covariances.size(), "CovarianceCsv: one covariance per pose");

@@ -17,9 +17,8 @@ namespace slamrig::slam {
 /// frame: e = truth - estimate with the angle wrapped. Infinity when the covariance is singular.
 double PoseNees(const Pose2& truth, const Pose2& estimate, const Eigen::Matrix3d& covariance);
 
-/// `covariance` of (x, y, yaw) in frame B as seen from frame A, where A_from_B turns by `yaw_rad`:
-/// J P J^T with J = diag(R(yaw), 1).
-Eigen::Matrix3d RotateCovariance(const Eigen::Matrix3d& covariance, double yaw_rad);
+/// RotateCovariance lives with Pose2 (slam/types/pose2.h); callers here name it slam::.
+using slamrig::RotateCovariance;
 
 /// CSV of one covariance per pose, "# time_s,xx,xy,xt,yy,yt,tt" then one line per pose (m^2,
 /// m rad, rad^2); `covariances` has one matrix per pose of `poses` (checked).

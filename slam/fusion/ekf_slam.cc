@@ -76,7 +76,7 @@ EkfSlam::EkfSlam(const EkfSlamOptions& options)
       motion_(options.motion),
       probe_pose_(options.motion),
       probe_gyro_(options.motion) {
-  SLAMRIG_CHECK(options.Validate().empty(), "EkfSlam: invalid options");
+  SLAMRIG_CHECK_VALID(options, "EkfSlamOptions");
   // PoseEkf's prior on the gyro states.
   p_(kBias, kBias) = options.motion.gyro_bias_sigma_rad_s * options.motion.gyro_bias_sigma_rad_s;
   p_(kBias + 1, kBias + 1) = options.motion.gyro_scale_sigma * options.motion.gyro_scale_sigma;
@@ -231,6 +231,108 @@ bool EkfSlam::LooksRound(const Tentative& t) const {
                                           options_.extraction.model_test_probability);
 }
 
+EkfSlam::Nearby EkfSlam::PredictNearby(double reach_m) const {
+  const Pose2 at = pose();
+  Nearby nearby;
+  for (int j = 0; j < landmarks(); ++j) {
+    RangeBearingPrediction pred = PredictRangeBearing(at, landmark(j));
+    if (pred.z(0) > reach_m + options_.extraction.max_radius_m) continue;
+    nearby.landmarks.push_back(j);
+    nearby.predictions.push_back(pred);
+  }
+  return nearby;
+}
+
+Eigen::Matrix2d EkfSlam::PredictionBlock(const Nearby& nearby, int a, int b) const {
+  const int la = LandmarkRow(nearby.landmarks[a]), lb = LandmarkRow(nearby.landmarks[b]);
+  const auto& pa = nearby.predictions[a];
+  const auto& pb = nearby.predictions[b];
+  return pa.d_pose * p_.block<3, 3>(0, 0) * pb.d_pose.transpose() +
+         pa.d_pose * p_.block<3, 2>(0, lb) * pb.d_landmark.transpose() +
+         pa.d_landmark * p_.block<2, 3>(la, 0) * pb.d_pose.transpose() +
+         pa.d_landmark * p_.block<2, 2>(la, lb) * pb.d_landmark.transpose();
+}
+
+void EkfSlam::Associate(const std::vector<LandmarkObservation>& observations, const Nearby& nearby,
+                        LandmarkUpdate* out) {
+  const int m = static_cast<int>(nearby.landmarks.size());
+  AssociationProblem problem;
+  problem.gate_probability = options_.gate_probability;
+  for (const LandmarkObservation& z : observations) {
+    problem.observations.emplace_back(z.range_m, z.bearing_rad);
+    problem.observation_covariances.push_back(z.covariance);
+  }
+  for (const RangeBearingPrediction& pred : nearby.predictions) {
+    problem.predictions.push_back(pred.z);
+  }
+  problem.prediction_covariance.resize(2 * m, 2 * m);
+  for (int a = 0; a < m; ++a) {
+    for (int b = a; b < m; ++b) {
+      const Eigen::Matrix2d s = PredictionBlock(nearby, a, b);
+      problem.prediction_covariance.block<2, 2>(2 * a, 2 * b) = s;
+      problem.prediction_covariance.block<2, 2>(2 * b, 2 * a) = s.transpose();
+    }
+  }
+  const Association association =
+      options_.association == LandmarkAssociationMethod::kNearestNeighbour
+          ? NearestNeighbour(problem)
+          : JointCompatibility(problem);
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    const int a = association.landmark_of_observation[i];
+    if (a >= 0) out->landmark_of_observation[i] = nearby.landmarks[a];
+  }
+  Update(observations, out->landmark_of_observation, out);
+}
+
+bool EkfSlam::Ambiguous(const LandmarkObservation& obs, const Eigen::Vector2d& z, const Pose2& now,
+                        double gate, Nearby* nearby) const {
+  const int m = static_cast<int>(nearby->landmarks.size());
+  bool ambiguous = false;
+  for (int a = 0; a < m && !ambiguous; ++a) {
+    const RangeBearingPrediction pred = PredictRangeBearing(now, landmark(nearby->landmarks[a]));
+    nearby->predictions[a] = pred;
+    const Eigen::Matrix2d s = PredictionBlock(*nearby, a, a) + obs.covariance;
+    Eigen::Vector2d v = z - pred.z;
+    v(1) = NormalizeAngle(v(1));
+    ambiguous = v.dot(s.ldlt().solve(v)) < gate;
+  }
+  return ambiguous;
+}
+
+int EkfSlam::Sight(const LandmarkObservation& obs, const Eigen::Vector2d& z, const Pose2& now) {
+  const Eigen::Vector2d position = InverseRangeBearing(now, z).position;
+  Tentative* seen = nullptr;
+  for (Tentative& t : tentative_) {
+    if ((t.position - position).norm() < options_.tentative_radius_m) {
+      seen = &t;
+      break;
+    }
+  }
+  if (!seen) {
+    tentative_.push_back({position, 0, 0, {}, {}, 0.0, 0.0, 0, 0});
+    seen = &tentative_.back();
+  }
+  if (seen->sightings > 0 && seen->last_scan == scans_) return -1;  // once per scan
+  ++seen->sightings;
+  seen->last_scan = scans_;
+  seen->radii.push_back(obs.radius_m);
+  seen->radius_variances.push_back(obs.radius_variance_m2);
+  seen->circle_sse += obs.circle_sse_m2;
+  seen->circle_dof += obs.circle_dof;
+  seen->lines_sse += obs.lines.sse_m2;
+  seen->lines_dof += obs.lines.dof;
+  if (seen->sightings < options_.min_sightings) return -1;
+  if (!LooksRound(*seen)) {
+    // Not one round object: forget what was seen, so that only sightings from here on count.
+    ++inconsistent_tentatives_;
+    *seen = {position, 0, scans_, {}, {}, 0.0, 0.0, 0, 0};
+    return -1;
+  }
+  const int id = Augment(z, obs.covariance);
+  tentative_.erase(tentative_.begin() + (seen - tentative_.data()));
+  return id;
+}
+
 LandmarkUpdate EkfSlam::Observe(const std::vector<LandmarkObservation>& observations,
                                 double range_max_m) {
   ++scans_;
@@ -239,54 +341,8 @@ LandmarkUpdate EkfSlam::Observe(const std::vector<LandmarkObservation>& observat
   out.observations = n_obs;
   out.landmark_of_observation.assign(n_obs, -1);
   const double reach = options_.max_range_m > 0.0 ? options_.max_range_m : range_max_m;
-
-  // Candidates: the landmarks within reach, their predicted observations and joint covariance
-  // H P H^T by 2 x 2 blocks (H is sparse: the pose and one landmark per row pair).
-  const Pose2 at = pose();
-  std::vector<int> candidates;
-  std::vector<RangeBearingPrediction> predictions;
-  for (int j = 0; j < landmarks(); ++j) {
-    RangeBearingPrediction pred = PredictRangeBearing(at, landmark(j));
-    if (pred.z(0) > reach + options_.extraction.max_radius_m) continue;
-    candidates.push_back(j);
-    predictions.push_back(pred);
-  }
-  const int m = static_cast<int>(candidates.size());
-  const auto block = [&](int a, int b) -> Eigen::Matrix2d {
-    const int la = LandmarkRow(candidates[a]), lb = LandmarkRow(candidates[b]);
-    const auto& pa = predictions[a];
-    const auto& pb = predictions[b];
-    return pa.d_pose * p_.block<3, 3>(0, 0) * pb.d_pose.transpose() +
-           pa.d_pose * p_.block<3, 2>(0, lb) * pb.d_landmark.transpose() +
-           pa.d_landmark * p_.block<2, 3>(la, 0) * pb.d_pose.transpose() +
-           pa.d_landmark * p_.block<2, 2>(la, lb) * pb.d_landmark.transpose();
-  };
-  if (m > 0 && n_obs > 0) {
-    AssociationProblem problem;
-    problem.gate_probability = options_.gate_probability;
-    for (const LandmarkObservation& z : observations) {
-      problem.observations.emplace_back(z.range_m, z.bearing_rad);
-      problem.observation_covariances.push_back(z.covariance);
-    }
-    for (const RangeBearingPrediction& pred : predictions) problem.predictions.push_back(pred.z);
-    problem.prediction_covariance.resize(2 * m, 2 * m);
-    for (int a = 0; a < m; ++a) {
-      for (int b = a; b < m; ++b) {
-        const Eigen::Matrix2d s = block(a, b);
-        problem.prediction_covariance.block<2, 2>(2 * a, 2 * b) = s;
-        problem.prediction_covariance.block<2, 2>(2 * b, 2 * a) = s.transpose();
-      }
-    }
-    const Association association =
-        options_.association == LandmarkAssociationMethod::kNearestNeighbour
-            ? NearestNeighbour(problem)
-            : JointCompatibility(problem);
-    for (int i = 0; i < n_obs; ++i) {
-      const int a = association.landmark_of_observation[i];
-      if (a >= 0) out.landmark_of_observation[i] = candidates[a];
-    }
-    Update(observations, out.landmark_of_observation, &out);
-  }
+  Nearby nearby = PredictNearby(reach);
+  if (!nearby.landmarks.empty() && n_obs > 0) Associate(observations, nearby, &out);
 
   // Unpaired observations: ambiguous near a landmark (after the update), else a sighting of a
   // tentative landmark, which enters the state once seen in min_sightings scans.
@@ -296,50 +352,14 @@ LandmarkUpdate EkfSlam::Observe(const std::vector<LandmarkObservation>& observat
     if (out.landmark_of_observation[i] >= 0) continue;
     const LandmarkObservation& obs = observations[i];
     const Eigen::Vector2d z(obs.range_m, obs.bearing_rad);
-    bool ambiguous = false;
-    for (int a = 0; a < m && !ambiguous; ++a) {
-      const RangeBearingPrediction pred = PredictRangeBearing(now, landmark(candidates[a]));
-      predictions[a] = pred;
-      const Eigen::Matrix2d s = block(a, a) + obs.covariance;
-      Eigen::Vector2d v = z - pred.z;
-      v(1) = NormalizeAngle(v(1));
-      ambiguous = v.dot(s.ldlt().solve(v)) < new_gate;
-    }
-    if (ambiguous) {
+    if (Ambiguous(obs, z, now, new_gate, &nearby)) {
       ++out.ambiguous;
       continue;
     }
-    const Eigen::Vector2d position = InverseRangeBearing(now, z).position;
-    Tentative* seen = nullptr;
-    for (Tentative& t : tentative_) {
-      if ((t.position - position).norm() < options_.tentative_radius_m) {
-        seen = &t;
-        break;
-      }
-    }
-    if (!seen) {
-      tentative_.push_back({position, 0, 0, {}, {}, 0.0, 0.0, 0, 0});
-      seen = &tentative_.back();
-    }
-    if (seen->sightings > 0 && seen->last_scan == scans_) continue;  // once per scan
-    ++seen->sightings;
-    seen->last_scan = scans_;
-    seen->radii.push_back(obs.radius_m);
-    seen->radius_variances.push_back(obs.radius_variance_m2);
-    seen->circle_sse += obs.circle_sse_m2;
-    seen->circle_dof += obs.circle_dof;
-    seen->lines_sse += obs.lines.sse_m2;
-    seen->lines_dof += obs.lines.dof;
-    if (seen->sightings >= options_.min_sightings && !LooksRound(*seen)) {
-      // Not one round object: forget what was seen, so that only sightings from here on count.
-      ++inconsistent_tentatives_;
-      *seen = {position, 0, scans_, {}, {}, 0.0, 0.0, 0, 0};
-      continue;
-    }
-    if (seen->sightings >= options_.min_sightings) {
-      out.landmark_of_observation[i] = Augment(z, obs.covariance);
+    const int id = Sight(obs, z, now);
+    if (id >= 0) {
+      out.landmark_of_observation[i] = id;
       ++out.new_landmarks;
-      tentative_.erase(tentative_.begin() + (seen - tentative_.data()));
     }
   }
   std::erase_if(tentative_, [&](const Tentative& t) {

@@ -116,6 +116,27 @@ class EkfSlam {
   void Update(const std::vector<LandmarkObservation>& observations,
               const std::vector<int>& landmark_of_observation, LandmarkUpdate* out);
 
+  /// The landmarks within `reach_m` of the pose, with their predicted observations.
+  struct Nearby {
+    std::vector<int> landmarks;
+    std::vector<RangeBearingPrediction> predictions;
+  };
+  Nearby PredictNearby(double reach_m) const;
+  /// The 2 x 2 block (a, b) of H P H^T for nearby landmarks a and b (H is sparse: the pose and
+  /// one landmark per row pair).
+  Eigen::Matrix2d PredictionBlock(const Nearby& nearby, int a, int b) const;
+  /// Pairs the observations with nearby landmarks (the association method) and updates the
+  /// state with the pairs.
+  void Associate(const std::vector<LandmarkObservation>& observations, const Nearby& nearby,
+                 LandmarkUpdate* out);
+  /// Whether an unpaired observation `z` falls within the new-landmark gate of a nearby
+  /// landmark, predicted again from `now` (after the update).
+  bool Ambiguous(const LandmarkObservation& obs, const Eigen::Vector2d& z, const Pose2& now,
+                 double gate, Nearby* nearby) const;
+  /// Counts a sighting of the tentative landmark at `z` seen from `now`; the index of the
+  /// landmark it becomes in the state, or -1.
+  int Sight(const LandmarkObservation& obs, const Eigen::Vector2d& z, const Pose2& now);
+
   /// Whether the sightings' fitted radii are consistent with one radius.
   bool RadiiAgree(const Tentative& t) const;
   /// Whether the sightings, pooled, look round: their radii agree, and lines fit them no better.

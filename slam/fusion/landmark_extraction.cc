@@ -84,9 +84,7 @@ void FitCluster(const std::vector<Eigen::Vector2d>& hits, std::size_t first_beam
   const Eigen::Vector2d mid = hits[hits.size() / 2];
   if (fit->center.norm() <= mid.norm()) return;
   const Pose2& mount = scan.base_from_laser;
-  const double c = std::cos(mount.theta()), s = std::sin(mount.theta());
-  Eigen::Matrix2d rotation;
-  rotation << c, -s, s, c;
+  const Eigen::Matrix2d rotation = mount.Rotation();
   const Eigen::Vector2d center_then = mount.translation() + rotation * fit->center;
   // base_link at the scan's time from base_link at the middle beam's: an arc at constant speed.
   const double dt = static_cast<double>(first_beam + hits.size() / 2) * scan.time_increment_s;
@@ -94,9 +92,7 @@ void FitCluster(const std::vector<Eigen::Vector2d>& hits, std::size_t first_beam
   const double travel = velocity.forward_m_s * dt;
   const Pose2 start_from_then(travel * std::cos(0.5 * turn), travel * std::sin(0.5 * turn), turn);
   const Eigen::Vector2d center = start_from_then * center_then;
-  const double ct = std::cos(turn), st = std::sin(turn);
-  Eigen::Matrix2d turn_rotation;
-  turn_rotation << ct, -st, st, ct;
+  const Eigen::Matrix2d turn_rotation = RotationMatrix(turn);
   const Eigen::Matrix2d center_covariance = turn_rotation * rotation * fit->center_covariance *
                                             rotation.transpose() * turn_rotation.transpose();
   LandmarkObservation z;
@@ -161,7 +157,7 @@ std::vector<std::string> LandmarkExtractionOptions::Validate() const {
 std::vector<LandmarkObservation> ExtractLandmarks(const LaserScan& scan,
                                                   const LandmarkExtractionOptions& options,
                                                   const BaseVelocity& velocity) {
-  SLAMRIG_CHECK(options.Validate().empty(), "ExtractLandmarks: invalid options");
+  SLAMRIG_CHECK_VALID(options, "LandmarkExtractionOptions");
   std::vector<LandmarkObservation> out;
   std::vector<Eigen::Vector2d> cluster;
   std::size_t first = 0;  // the cluster's first beam

@@ -33,7 +33,7 @@ Eigen::MatrixXd JosephUpdate(const Eigen::MatrixXd& p, const Eigen::MatrixXd& k,
 }
 
 PoseEkf::PoseEkf(const PoseEkfOptions& options) : options_(options) {
-  SLAMRIG_CHECK(options.Validate().empty(), "PoseEkf: invalid options");
+  SLAMRIG_CHECK_VALID(options, "PoseEkfOptions");
   p_(kBias, kBias) = Squared(options.gyro_bias_sigma_rad_s);
   p_(kScale, kScale) = Squared(options.gyro_scale_sigma);
 }
@@ -162,9 +162,7 @@ double PoseEkf::InflateMotion(const Eigen::VectorXd& innovation, const Eigen::Ma
   relative(2, 2) = -1.0;
   relative(2, kYaw) = 1.0;
   const Eigen::Matrix3d motion = relative * p_ * relative.transpose();
-  Eigen::Matrix3d g = Eigen::Matrix3d::Identity();
-  g.topLeftCorner<2, 2>() << c, -s, s, c;
-  const Eigen::Matrix3d added = g * motion * g.transpose();
+  const Eigen::Matrix3d added = RotateCovariance(motion, x_(2));
   // What a unit of extra motion noise adds to the innovation's covariance.
   const Eigen::MatrixXd h_pose = h.middleCols<3>(3);
   const Eigen::MatrixXd a = h_pose * added * h_pose.transpose();
@@ -194,9 +192,8 @@ Eigen::Matrix3d PoseEkf::MatcherPoseJacobianFrame() const {
 }
 
 Eigen::Matrix3d PoseEkf::MatcherPoseJacobianPose() const {
-  const double c = std::cos(x_(kFrame + 2)), s = std::sin(x_(kFrame + 2));
   Eigen::Matrix3d j = Eigen::Matrix3d::Identity();
-  j.topLeftCorner<2, 2>() << c, -s, s, c;
+  j.topLeftCorner<2, 2>() = RotationMatrix(x_(kFrame + 2));
   return j;
 }
 
@@ -208,8 +205,7 @@ void PoseEkf::AnchorMatcherFrame(const Pose2& z, const Eigen::Matrix3d& r) {
   // correlations are dropped) plus the match's own noise.
   const Eigen::Vector2d lever = RotatedDerivative(frame.theta(), x_.segment<2>(3));
   Eigen::Matrix3d j_pose = -Eigen::Matrix3d::Identity();
-  const double c = std::cos(frame.theta()), s = std::sin(frame.theta());
-  j_pose.topLeftCorner<2, 2>() << -c, s, -s, -c;
+  j_pose.topLeftCorner<2, 2>() = -frame.Rotation();
   j_pose.block<2, 1>(0, 2) = lever;
   Eigen::Matrix3d j_z = Eigen::Matrix3d::Identity();
   j_z.block<2, 1>(0, 2) = -lever;

@@ -91,72 +91,49 @@ std::vector<Eigen::Vector2d> Thinned(const std::vector<Eigen::Vector2d>& points,
 }  // namespace
 
 std::vector<std::string> GraphSlamOptions::Validate() const {
-  std::vector<std::string> errors;
+  Rules rules;
   const std::string prefix = "icp_odometry.";
   for (std::string e : odometry.Validate()) {
-    errors.push_back("odometry_icp." + (e.rfind(prefix, 0) == 0 ? e.substr(prefix.size()) : e));
+    rules.Add("odometry_icp." + (e.rfind(prefix, 0) == 0 ? e.substr(prefix.size()) : e));
   }
-  auto positive = [&](const char* field, double value) {
-    if (!(value > 0.0)) errors.push_back(RuleViolation(field, value, "must be > 0"));
-  };
-  auto non_negative = [&](const char* field, double value) {
-    if (!(value >= 0.0)) errors.push_back(RuleViolation(field, value, "must be >= 0"));
-  };
-  non_negative("keyframe_distance_m", keyframe_distance_m);
-  non_negative("keyframe_angle_rad", keyframe_angle_rad);
-  non_negative("edge_sigma_xy_per_m", edge_sigma_xy_per_m);
-  positive("edge_sigma_xy_floor_m", edge_sigma_xy_floor_m);
-  non_negative("edge_sigma_yaw_per_rad", edge_sigma_yaw_per_rad);
-  non_negative("edge_sigma_yaw_per_m", edge_sigma_yaw_per_m);
-  positive("edge_sigma_yaw_floor_rad", edge_sigma_yaw_floor_rad);
-  if (odometry_check_nodes < 0) {
-    errors.push_back(RuleViolation("odometry_check_nodes", odometry_check_nodes, "must be >= 0"));
-  }
-  positive("odometry_check_window_m", odometry_check_window_m);
-  positive("odometry_check_window_rad", odometry_check_window_rad);
-  non_negative("odometry_check_min_gain", odometry_check_min_gain);
-  non_negative("odometry_check_wide_below", odometry_check_wide_below);
-  non_negative("node_below_match_score", node_below_match_score);
-  positive("odometry_check_wide_window_m", odometry_check_wide_window_m);
-  non_negative("odometry_check_wide_min_score", odometry_check_wide_min_score);
-  if (loop_skip_keyframes < 1) {
-    errors.push_back(RuleViolation("loop_skip_keyframes", loop_skip_keyframes, "must be >= 1"));
-  }
-  non_negative("loop_search_radius_m", loop_search_radius_m);
-  non_negative("loop_radius_sigmas", loop_radius_sigmas);
-  positive("loop_max_search_radius_m", loop_max_search_radius_m);
-  if (loop_max_candidates < 0) {
-    errors.push_back(RuleViolation("loop_max_candidates", loop_max_candidates, "must be >= 0"));
-  }
-  if (submap_half_keyframes < 0) {
-    errors.push_back(RuleViolation("submap_half_keyframes", submap_half_keyframes, "must be >= 0"));
-  }
-  positive("submap_resolution_m", submap_resolution_m);
-  positive("submap_blur_m", submap_blur_m);
-  if (query_keyframes < 1) {
-    errors.push_back(RuleViolation("query_keyframes", query_keyframes, "must be >= 1"));
-  }
-  AppendErrors(&errors, correlative.Validate());
-  for (std::string e : loop_icp.Validate()) errors.push_back("loop_" + e);
-  if (!(loop_min_icp_score >= 0.0 && loop_min_icp_score <= 1.0)) {
-    errors.push_back(RuleViolation("loop_min_icp_score", loop_min_icp_score, "must be in [0, 1]"));
-  }
-  positive("loop_max_refinement_m", loop_max_refinement_m);
-  positive("loop_max_search_stddev_m", loop_max_search_stddev_m);
-  if (!(loop_max_covariance_ratio > 1.0)) {
-    errors.push_back(
-        RuleViolation("loop_max_covariance_ratio", loop_max_covariance_ratio, "must be > 1"));
-  }
-  positive("loop_chi2_gate", loop_chi2_gate);
-  positive("loop_pairwise_chi2", loop_pairwise_chi2);
-  positive("loop_sigma_xy_floor_m", loop_sigma_xy_floor_m);
-  positive("loop_sigma_yaw_floor_rad", loop_sigma_yaw_floor_rad);
-  if (optimize_every_keyframes < 1) {
-    errors.push_back(
-        RuleViolation("optimize_every_keyframes", optimize_every_keyframes, "must be >= 1"));
-  }
-  AppendErrors(&errors, PrefixErrors("optimizer", optimizer.Validate()));
-  return errors;
+  rules.NonNegative("keyframe_distance_m", keyframe_distance_m)
+      .NonNegative("keyframe_angle_rad", keyframe_angle_rad)
+      .NonNegative("edge_sigma_xy_per_m", edge_sigma_xy_per_m)
+      .Positive("edge_sigma_xy_floor_m", edge_sigma_xy_floor_m)
+      .NonNegative("edge_sigma_yaw_per_rad", edge_sigma_yaw_per_rad)
+      .NonNegative("edge_sigma_yaw_per_m", edge_sigma_yaw_per_m)
+      .Positive("edge_sigma_yaw_floor_rad", edge_sigma_yaw_floor_rad)
+      .NonNegative("odometry_check_nodes", odometry_check_nodes)
+      .Positive("odometry_check_window_m", odometry_check_window_m)
+      .Positive("odometry_check_window_rad", odometry_check_window_rad)
+      .NonNegative("odometry_check_min_gain", odometry_check_min_gain)
+      .NonNegative("odometry_check_wide_below", odometry_check_wide_below)
+      .NonNegative("node_below_match_score", node_below_match_score)
+      .Positive("odometry_check_wide_window_m", odometry_check_wide_window_m)
+      .NonNegative("odometry_check_wide_min_score", odometry_check_wide_min_score)
+      .AtLeast("loop_skip_keyframes", loop_skip_keyframes, 1)
+      .NonNegative("loop_search_radius_m", loop_search_radius_m)
+      .NonNegative("loop_radius_sigmas", loop_radius_sigmas)
+      .Positive("loop_max_search_radius_m", loop_max_search_radius_m)
+      .NonNegative("loop_max_candidates", loop_max_candidates)
+      .NonNegative("submap_half_keyframes", submap_half_keyframes)
+      .Positive("submap_resolution_m", submap_resolution_m)
+      .Positive("submap_blur_m", submap_blur_m)
+      .AtLeast("query_keyframes", query_keyframes, 1)
+      .Nested("", correlative.Validate());
+  for (std::string e : loop_icp.Validate()) rules.Add("loop_" + e);
+  rules.Fraction("loop_min_icp_score", loop_min_icp_score)
+      .Positive("loop_max_refinement_m", loop_max_refinement_m)
+      .Positive("loop_max_search_stddev_m", loop_max_search_stddev_m)
+      .Require(loop_max_covariance_ratio > 1.0, "loop_max_covariance_ratio",
+               loop_max_covariance_ratio, "must be > 1")
+      .Positive("loop_chi2_gate", loop_chi2_gate)
+      .Positive("loop_pairwise_chi2", loop_pairwise_chi2)
+      .Positive("loop_sigma_xy_floor_m", loop_sigma_xy_floor_m)
+      .Positive("loop_sigma_yaw_floor_rad", loop_sigma_yaw_floor_rad)
+      .AtLeast("optimize_every_keyframes", optimize_every_keyframes, 1)
+      .Nested("optimizer", optimizer.Validate());
+  return rules.errors();
 }
 
 GraphSlam::GraphSlam(const GraphSlamOptions& options)
@@ -164,7 +141,7 @@ GraphSlam::GraphSlam(const GraphSlamOptions& options)
       odometry_(options.odometry),
       optimizer_(options.optimizer),
       consistency_(options.loop_pairwise_chi2) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid GraphSlamOptions");
+  SLAMRIG_CHECK_VALID(options_, "GraphSlamOptions");
 }
 
 Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment) {

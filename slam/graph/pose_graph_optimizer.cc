@@ -202,7 +202,7 @@ ceres::Solver::Options SolverOptions(const PoseGraphOptimizerOptions& o) {
 
 PoseGraphOptimizer::PoseGraphOptimizer(const PoseGraphOptimizerOptions& options)
     : options_(options) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "PoseGraphOptimizer: invalid options");
+  SLAMRIG_CHECK_VALID(options_, "PoseGraphOptimizerOptions");
 }
 
 PoseGraphSummary PoseGraphOptimizer::Optimize(PoseGraph* graph) const {

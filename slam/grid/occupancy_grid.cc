@@ -43,7 +43,7 @@ std::vector<std::string> OccupancyGridOptions::Validate() const {
 }
 
 OccupancyGrid::OccupancyGrid(const OccupancyGridOptions& options) : options_(options) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid OccupancyGridOptions");
+  SLAMRIG_CHECK_VALID(options_, "OccupancyGridOptions");
 }
 
 OccupancyGrid::OccupancyGrid(const OccupancyGridOptions& options, const Eigen::Vector2d& origin,

@@ -43,7 +43,7 @@ thread_local ScanStamps scan_stamps;
 
 TiledGrid::TiledGrid(const OccupancyGridOptions& options, const Eigen::Vector2d& origin)
     : options_(options), origin_(origin) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid OccupancyGridOptions");
+  SLAMRIG_CHECK_VALID(options_, "OccupancyGridOptions");
 }
 
 void TiledGrid::EnsureCells(const Eigen::Array2i& lo, const Eigen::Array2i& hi) {

@@ -193,6 +193,178 @@ std::string FindOne(const std::string& dir, const std::string& npz, const std::s
   return "";
 }
 
+// A record with its sort key: time, then encoders/IMU before a scan, a scan before a frame, of
+// the same stamp.
+struct KeyedRecord {
+  double time_s;
+  int order;
+  Record record;
+};
+
+// Encoders: counts (4, N) [FR, FL, RR, RL] since the previous reading.
+void ReadEncoders(const std::string& path, std::vector<KeyedRecord>* keyed) {
+  std::vector<double> t;
+  std::vector<std::array<double, 4>> counts;
+  if (IsNpz(path)) {
+    const auto arrays = ReadNpz(path);
+    t = Stamps(arrays, "time_stamps", path);
+    const NpyArray& c = Matrix(arrays, "counts", 4, t.size(), path);
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      counts.push_back({c.values[i], c.values[t.size() + i], c.values[2 * t.size() + i],
+                        c.values[3 * t.size() + i]});
+    }
+  } else {
+    for (const auto& row : ReadCsv(path, 5)) {
+      t.push_back(row[0]);
+      counts.push_back({row[1], row[2], row[3], row[4]});
+    }
+  }
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    CheckStamp(t[i], path, i);
+    for (int k = 0; k < 4; ++k) {
+      CheckFinite(counts[i][static_cast<std::size_t>(k)], path, "counts", i);
+    }
+    const auto tick = [&](int k) {
+      return static_cast<std::int32_t>(std::lround(counts[i][static_cast<std::size_t>(k)]));
+    };
+    keyed->push_back(
+        {t[i], 0, WheelTicks{Time::FromSeconds(t[i]), {tick(0), tick(2)}, {tick(1), tick(3)}}});
+  }
+}
+
+// IMU: angular velocity (3, N) rad/s and linear acceleration (3, N) in g.
+void ReadImu(const std::string& path, double gravity_m_s2, std::vector<KeyedRecord>* keyed) {
+  std::vector<double> t;
+  std::vector<std::array<double, 6>> rows;  // ax ay az wx wy wz
+  if (IsNpz(path)) {
+    const auto arrays = ReadNpz(path);
+    t = Stamps(arrays, "time_stamps", path);
+    const NpyArray& w = Matrix(arrays, "angular_velocity", 3, t.size(), path);
+    const NpyArray& a = Matrix(arrays, "linear_acceleration", 3, t.size(), path);
+    const std::size_t n = t.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      rows.push_back({a.values[i], a.values[n + i], a.values[2 * n + i], w.values[i],
+                      w.values[n + i], w.values[2 * n + i]});
+    }
+  } else {
+    for (const auto& row : ReadCsv(path, 7)) {
+      t.push_back(row[0]);
+      rows.push_back({row[1], row[2], row[3], row[4], row[5], row[6]});
+    }
+  }
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    CheckStamp(t[i], path, i);
+    for (std::size_t k = 0; k < 6; ++k) CheckFinite(rows[i][k], path, "imu", i);
+    ImuSample imu;
+    imu.time = Time::FromSeconds(t[i]);
+    imu.linear_acceleration_m_s2 =
+        Eigen::Vector3d(rows[i][0], rows[i][1], rows[i][2]) * gravity_m_s2;
+    imu.angular_velocity_rad_s = Eigen::Vector3d(rows[i][3], rows[i][4], rows[i][5]);
+    keyed->push_back({t[i], 0, imu});
+  }
+}
+
+// Hokuyo: ranges (1081, N) float32 metres, scalar angle/range limits.
+void ReadHokuyo(const std::string& path, const Ece276aReadOptions& options,
+                std::vector<KeyedRecord>* keyed, std::vector<std::string>* notes) {
+  const auto arrays = ReadNpz(path);
+  const std::vector<double> t = Stamps(arrays, "time_stamps", path);
+  const NpyArray& ranges = Array(arrays, "ranges", path);
+  if (ranges.shape.size() != 2 || ranges.shape[1] != t.size() || ranges.shape[0] < 2) {
+    throw ParseError(path + ": ranges: expected shape (beams, " + std::to_string(t.size()) + ")");
+  }
+  const std::size_t beams = ranges.shape[0];
+  LaserScan prototype;
+  prototype.angle_min_rad = Scalar(arrays, "angle_min", path);
+  const double angle_max = Scalar(arrays, "angle_max", path);
+  prototype.angle_increment_rad =
+      arrays.count("angle_increment") > 0
+          ? Scalar(arrays, "angle_increment", path)
+          : (angle_max - prototype.angle_min_rad) / static_cast<double>(beams - 1);
+  prototype.range_min_m = Scalar(arrays, "range_min", path);
+  prototype.range_max_m = Scalar(arrays, "range_max", path);
+  prototype.base_from_laser = options.base_from_lidar;
+  int nan_beams = 0;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    CheckStamp(t[i], path, i);
+    LaserScan scan = prototype;
+    scan.time = Time::FromSeconds(t[i]);
+    scan.ranges_m.resize(beams);
+    for (std::size_t b = 0; b < beams; ++b) {
+      double r = ranges.values[b * t.size() + i];
+      // NaN/inf readings are no-returns: counted, never passed on.
+      if (!std::isfinite(r)) {
+        r = prototype.range_max_m;
+        ++nan_beams;
+      }
+      scan.ranges_m[b] = static_cast<float>(r);
+    }
+    keyed->push_back({t[i], 1, std::move(scan)});
+  }
+  if (nan_beams > 0) {
+    notes->push_back(std::to_string(nan_beams) + " non-finite Hokuyo ranges read as no return");
+  }
+}
+
+// Kinect: each disparity image with the RGB image nearest in time, as the reports pair them.
+void ReadKinect(const Ece276aFiles& files, const Ece276aReadOptions& options,
+                std::vector<KeyedRecord>* keyed, std::vector<std::string>* notes) {
+  const std::string& path = files.kinect;
+  if (options.kinect_every < 1) {
+    throw ConfigError("kinect_every = " + std::to_string(options.kinect_every) + "; must be >= 1");
+  }
+  const auto arrays = ReadNpz(path);
+  const std::vector<double> td = SortedStamps(arrays, "disparity_time_stamps", path);
+  const std::vector<double> tr = SortedStamps(arrays, "rgb_time_stamps", path);
+  if (tr.empty() && !td.empty()) {
+    throw ParseError(path + ": rgb_time_stamps: empty, but there are disparity images");
+  }
+  const std::string n = std::to_string(files.dataset);
+  const fs::path images(files.kinect_images);
+  int width = 0, height = 0;
+  double widest_gap_s = 0.0;
+  std::size_t invalid = 0, frames = 0;
+  for (std::size_t i = 0; i < td.size(); i += static_cast<std::size_t>(options.kinect_every)) {
+    std::size_t j =
+        static_cast<std::size_t>(std::lower_bound(tr.begin(), tr.end(), td[i]) - tr.begin());
+    if (j == tr.size() || (j > 0 && td[i] - tr[j - 1] <= tr[j] - td[i])) --j;
+    widest_gap_s = std::max(widest_gap_s, std::abs(tr[j] - td[i]));
+    const std::string di = std::to_string(i + 1), rj = std::to_string(j + 1);
+    const cv::Mat disparity = ReadKinectImage(
+        (images / ("Disparity" + n) / ("disparity" + n + "_" + di + ".png")).string(), CV_16UC1,
+        "disparity image " + di + " of " + path, &width, &height);
+    const cv::Mat bgr = ReadKinectImage(
+        (images / ("RGB" + n) / ("rgb" + n + "_" + rj + ".png")).string(), CV_8UC3,
+        "RGB image " + rj + " of " + path + ", nearest disparity image " + di, &width, &height);
+    RgbdFrame frame;
+    frame.time = Time::FromSeconds(td[i]);
+    frame.width = width;
+    frame.height = height;
+    frame.intrinsics = options.camera_intrinsics;
+    frame.base_from_camera = options.base_from_camera;
+    frame.depth_offset_x_m = options.depth_offset_x_m;
+    cv::Mat rgb;
+    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+    frame.rgb.assign(rgb.data, rgb.data + rgb.total() * 3);
+    frame.depth_m.resize(static_cast<std::size_t>(width) * height);
+    for (int v = 0; v < height; ++v) {
+      for (int u = 0; u < width; ++u) {
+        const std::uint16_t d = disparity.at<std::uint16_t>(v, u);
+        const double z = d >= kKinectNoDisparity ? 0.0 : KinectDepthFromDisparity(d);
+        if (z == 0.0) ++invalid;
+        frame.depth_m[static_cast<std::size_t>(v) * width + u] = static_cast<float>(z);
+      }
+    }
+    keyed->push_back({td[i], 2, std::move(frame)});
+    ++frames;
+  }
+  std::ostringstream note;
+  note << frames << " Kinect frames (every " << options.kinect_every
+       << ". disparity image, the nearest RGB image at most " << widest_gap_s * 1e3 << " ms away); "
+       << invalid << " pixels without a depth reading";
+  notes->push_back(note.str());
+}
+
 }  // namespace
 
 bool LooksLikeEce276a(const std::string& path) {
@@ -222,188 +394,22 @@ Ece276aFiles FindEce276aFiles(const std::string& path) {
 }
 
 Dataset ReadEce276a(const Ece276aFiles& files, const Ece276aReadOptions& options) {
-  // Each record with a sort key: time, then encoders/IMU before a scan of the same stamp.
-  struct Keyed {
-    double time_s;
-    int order;
-    Record record;
-  };
-  std::vector<Keyed> keyed;
+  std::vector<KeyedRecord> keyed;
   Dataset data;
   data.source = files.encoders;
-
-  // Encoders: counts (4, N) [FR, FL, RR, RL] since the previous reading.
-  {
-    std::vector<double> t;
-    std::vector<std::array<double, 4>> counts;
-    if (IsNpz(files.encoders)) {
-      const auto arrays = ReadNpz(files.encoders);
-      t = Stamps(arrays, "time_stamps", files.encoders);
-      const NpyArray& c = Matrix(arrays, "counts", 4, t.size(), files.encoders);
-      for (std::size_t i = 0; i < t.size(); ++i) {
-        counts.push_back({c.values[i], c.values[t.size() + i], c.values[2 * t.size() + i],
-                          c.values[3 * t.size() + i]});
-      }
-    } else {
-      for (const auto& row : ReadCsv(files.encoders, 5)) {
-        t.push_back(row[0]);
-        counts.push_back({row[1], row[2], row[3], row[4]});
-      }
-    }
-    for (std::size_t i = 0; i < t.size(); ++i) {
-      CheckStamp(t[i], files.encoders, i);
-      for (int k = 0; k < 4; ++k) {
-        CheckFinite(counts[i][static_cast<std::size_t>(k)], files.encoders, "counts", i);
-      }
-      const auto tick = [&](int k) {
-        return static_cast<std::int32_t>(std::lround(counts[i][static_cast<std::size_t>(k)]));
-      };
-      keyed.push_back(
-          {t[i], 0, WheelTicks{Time::FromSeconds(t[i]), {tick(0), tick(2)}, {tick(1), tick(3)}}});
-    }
-  }
-
-  // IMU: angular velocity (3, N) rad/s and linear acceleration (3, N) in g.
-  if (!files.imu.empty()) {
-    std::vector<double> t;
-    std::vector<std::array<double, 6>> rows;  // ax ay az wx wy wz
-    if (IsNpz(files.imu)) {
-      const auto arrays = ReadNpz(files.imu);
-      t = Stamps(arrays, "time_stamps", files.imu);
-      const NpyArray& w = Matrix(arrays, "angular_velocity", 3, t.size(), files.imu);
-      const NpyArray& a = Matrix(arrays, "linear_acceleration", 3, t.size(), files.imu);
-      const std::size_t n = t.size();
-      for (std::size_t i = 0; i < n; ++i) {
-        rows.push_back({a.values[i], a.values[n + i], a.values[2 * n + i], w.values[i],
-                        w.values[n + i], w.values[2 * n + i]});
-      }
-    } else {
-      for (const auto& row : ReadCsv(files.imu, 7)) {
-        t.push_back(row[0]);
-        rows.push_back({row[1], row[2], row[3], row[4], row[5], row[6]});
-      }
-    }
-    for (std::size_t i = 0; i < t.size(); ++i) {
-      CheckStamp(t[i], files.imu, i);
-      for (std::size_t k = 0; k < 6; ++k) CheckFinite(rows[i][k], files.imu, "imu", i);
-      ImuSample imu;
-      imu.time = Time::FromSeconds(t[i]);
-      imu.linear_acceleration_m_s2 =
-          Eigen::Vector3d(rows[i][0], rows[i][1], rows[i][2]) * options.gravity_m_s2;
-      imu.angular_velocity_rad_s = Eigen::Vector3d(rows[i][3], rows[i][4], rows[i][5]);
-      keyed.push_back({t[i], 0, imu});
-    }
-  }
-
-  // Hokuyo: ranges (1081, N) float32 metres, scalar angle/range limits.
+  ReadEncoders(files.encoders, &keyed);
+  if (!files.imu.empty()) ReadImu(files.imu, options.gravity_m_s2, &keyed);
   if (!files.hokuyo.empty()) {
-    const auto arrays = ReadNpz(files.hokuyo);
-    const std::string& path = files.hokuyo;
-    const std::vector<double> t = Stamps(arrays, "time_stamps", path);
-    const NpyArray& ranges = Array(arrays, "ranges", path);
-    if (ranges.shape.size() != 2 || ranges.shape[1] != t.size() || ranges.shape[0] < 2) {
-      throw ParseError(path + ": ranges: expected shape (beams, " + std::to_string(t.size()) + ")");
-    }
-    const std::size_t beams = ranges.shape[0];
-    LaserScan prototype;
-    prototype.angle_min_rad = Scalar(arrays, "angle_min", path);
-    const double angle_max = Scalar(arrays, "angle_max", path);
-    prototype.angle_increment_rad =
-        arrays.count("angle_increment") > 0
-            ? Scalar(arrays, "angle_increment", path)
-            : (angle_max - prototype.angle_min_rad) / static_cast<double>(beams - 1);
-    prototype.range_min_m = Scalar(arrays, "range_min", path);
-    prototype.range_max_m = Scalar(arrays, "range_max", path);
-    prototype.base_from_laser = options.base_from_lidar;
-    int nan_beams = 0;
-    for (std::size_t i = 0; i < t.size(); ++i) {
-      CheckStamp(t[i], path, i);
-      LaserScan scan = prototype;
-      scan.time = Time::FromSeconds(t[i]);
-      scan.ranges_m.resize(beams);
-      for (std::size_t b = 0; b < beams; ++b) {
-        double r = ranges.values[b * t.size() + i];
-        // NaN/inf readings are no-returns: counted, never passed on.
-        if (!std::isfinite(r)) {
-          r = prototype.range_max_m;
-          ++nan_beams;
-        }
-        scan.ranges_m[b] = static_cast<float>(r);
-      }
-      keyed.push_back({t[i], 1, std::move(scan)});
-    }
-    if (nan_beams > 0) {
-      data.notes.push_back(std::to_string(nan_beams) +
-                           " non-finite Hokuyo ranges read as no return");
-    }
+    ReadHokuyo(files.hokuyo, options, &keyed, &data.notes);
   } else {
     data.notes.push_back("no Hokuyo file: encoders and IMU only (dead reckoning, no map)");
   }
-
-  // Kinect: each disparity image with the RGB image nearest in time, as the reports pair them.
-  if (!files.kinect.empty()) {
-    const std::string& path = files.kinect;
-    if (options.kinect_every < 1) {
-      throw ConfigError("kinect_every = " + std::to_string(options.kinect_every) +
-                        "; must be >= 1");
-    }
-    const auto arrays = ReadNpz(path);
-    const std::vector<double> td = SortedStamps(arrays, "disparity_time_stamps", path);
-    const std::vector<double> tr = SortedStamps(arrays, "rgb_time_stamps", path);
-    if (tr.empty() && !td.empty()) {
-      throw ParseError(path + ": rgb_time_stamps: empty, but there are disparity images");
-    }
-    const std::string n = std::to_string(files.dataset);
-    const fs::path images(files.kinect_images);
-    int width = 0, height = 0;
-    double widest_gap_s = 0.0;
-    std::size_t invalid = 0, frames = 0;
-    for (std::size_t i = 0; i < td.size(); i += static_cast<std::size_t>(options.kinect_every)) {
-      std::size_t j =
-          static_cast<std::size_t>(std::lower_bound(tr.begin(), tr.end(), td[i]) - tr.begin());
-      if (j == tr.size() || (j > 0 && td[i] - tr[j - 1] <= tr[j] - td[i])) --j;
-      widest_gap_s = std::max(widest_gap_s, std::abs(tr[j] - td[i]));
-      const std::string di = std::to_string(i + 1), rj = std::to_string(j + 1);
-      const cv::Mat disparity = ReadKinectImage(
-          (images / ("Disparity" + n) / ("disparity" + n + "_" + di + ".png")).string(), CV_16UC1,
-          "disparity image " + di + " of " + path, &width, &height);
-      const cv::Mat bgr = ReadKinectImage(
-          (images / ("RGB" + n) / ("rgb" + n + "_" + rj + ".png")).string(), CV_8UC3,
-          "RGB image " + rj + " of " + path + ", nearest disparity image " + di, &width, &height);
-      RgbdFrame frame;
-      frame.time = Time::FromSeconds(td[i]);
-      frame.width = width;
-      frame.height = height;
-      frame.intrinsics = options.camera_intrinsics;
-      frame.base_from_camera = options.base_from_camera;
-      frame.depth_offset_x_m = options.depth_offset_x_m;
-      cv::Mat rgb;
-      cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
-      frame.rgb.assign(rgb.data, rgb.data + rgb.total() * 3);
-      frame.depth_m.resize(static_cast<std::size_t>(width) * height);
-      for (int v = 0; v < height; ++v) {
-        for (int u = 0; u < width; ++u) {
-          const std::uint16_t d = disparity.at<std::uint16_t>(v, u);
-          const double z = d >= kKinectNoDisparity ? 0.0 : KinectDepthFromDisparity(d);
-          if (z == 0.0) ++invalid;
-          frame.depth_m[static_cast<std::size_t>(v) * width + u] = static_cast<float>(z);
-        }
-      }
-      keyed.push_back({td[i], 2, std::move(frame)});
-      ++frames;
-    }
-    std::ostringstream note;
-    note << frames << " Kinect frames (every " << options.kinect_every
-         << ". disparity image, the nearest RGB image at most " << widest_gap_s * 1e3
-         << " ms away); " << invalid << " pixels without a depth reading";
-    data.notes.push_back(note.str());
-  }
-
-  std::stable_sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
+  if (!files.kinect.empty()) ReadKinect(files, options, &keyed, &data.notes);
+  std::stable_sort(keyed.begin(), keyed.end(), [](const KeyedRecord& a, const KeyedRecord& b) {
     return a.time_s != b.time_s ? a.time_s < b.time_s : a.order < b.order;
   });
   data.records.reserve(keyed.size());
-  for (Keyed& k : keyed) data.records.push_back(std::move(k.record));
+  for (KeyedRecord& k : keyed) data.records.push_back(std::move(k.record));
   return data;
 }
 

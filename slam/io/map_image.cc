@@ -21,15 +21,12 @@ double NiceLength(double target_m) {
   return power;
 }
 
-}  // namespace
-
-std::string RenderMapPng(const OccupancyGrid& grid, const std::vector<TrajectoryOverlay>& overlays,
-                         const MapImageOptions& options) {
-  const double res = grid.resolution();
-  // World region: where the walls are and the trajectories, plus a margin. Walls are cells hit
-  // at least twice more than passed through, between the 0.5 and 99.5 percentiles, so that stray
-  // returns far away (a lidar's random readings, each hit once) do not shrink the building to a
-  // dot.
+// The world region to draw: where the walls are and the trajectories, plus `margin_m`. Walls
+// are cells hit at least twice more than passed through, between the 0.5 and 99.5 percentiles, so
+// that stray returns far away (a lidar's random readings, each hit once) do not shrink the
+// building to a dot.
+Eigen::AlignedBox2d MapRegion(const OccupancyGrid& grid,
+                              const std::vector<TrajectoryOverlay>& overlays, double margin_m) {
   Eigen::AlignedBox2d region;
   std::vector<double> xs, ys;
   const float wall = std::min(2.0f * grid.options().hit_log_odds, grid.options().max_log_odds);
@@ -61,8 +58,45 @@ std::string RenderMapPng(const OccupancyGrid& grid, const std::vector<Trajectory
     for (const auto& p : overlay.trajectory->poses()) region.extend(p.pose.translation());
   }
   if (region.isEmpty()) region.extend(Eigen::Vector2d::Zero());
-  region.min() -= Eigen::Vector2d::Constant(options.margin_m);
-  region.max() += Eigen::Vector2d::Constant(options.margin_m);
+  region.min() -= Eigen::Vector2d::Constant(margin_m);
+  region.max() += Eigen::Vector2d::Constant(margin_m);
+  return region;
+}
+
+// The legend above the map (`legend_h` pixels): title, one line per trajectory, scale bar.
+void DrawLegend(const std::vector<TrajectoryOverlay>& overlays, const std::string& title,
+                double px_per_m, int legend_h, cv::Mat* image) {
+  cv::Mat& image_out = *image;
+  const int width = image_out.cols;
+  int y = 24;
+  if (!title.empty()) {
+    cv::putText(image_out, title, {10, y}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(0, 0, 0), 1,
+                cv::LINE_AA);
+    y += 28;
+  }
+  for (const auto& overlay : overlays) {
+    const cv::Scalar colour(overlay.blue, overlay.green, overlay.red);
+    cv::line(image_out, {10, y - 6}, {40, y - 6}, colour, 3, cv::LINE_AA);
+    cv::putText(image_out, overlay.label, {50, y}, cv::FONT_HERSHEY_SIMPLEX, 0.55,
+                cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    y += 28;
+  }
+  const double bar_m = NiceLength(0.25 * width / px_per_m);
+  const int bar_px = static_cast<int>(std::lround(bar_m * px_per_m));
+  cv::rectangle(image_out, {10, y - 4}, {10 + bar_px, y + 4}, cv::Scalar(0, 0, 0), cv::FILLED);
+  char label[32];
+  std::snprintf(label, sizeof(label), "%g m", bar_m);
+  cv::putText(image_out, label, {16 + bar_px, y + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.55,
+              cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  cv::line(image_out, {0, legend_h - 1}, {width, legend_h - 1}, cv::Scalar(160, 160, 160), 1);
+}
+
+}  // namespace
+
+std::string RenderMapPng(const OccupancyGrid& grid, const std::vector<TrajectoryOverlay>& overlays,
+                         const MapImageOptions& options) {
+  const double res = grid.resolution();
+  const Eigen::AlignedBox2d region = MapRegion(grid, overlays, options.margin_m);
 
   const int cells_x = static_cast<int>(std::ceil(region.sizes().x() / res));
   const int cells_y = static_cast<int>(std::ceil(region.sizes().y() / res));
@@ -119,28 +153,7 @@ std::string RenderMapPng(const OccupancyGrid& grid, const std::vector<Trajectory
              cv::Scalar(segment.blue, segment.green, segment.red), std::max(1, thickness / 2),
              cv::LINE_AA);
   }
-  // Legend: title, one line per trajectory, scale bar.
-  int y = 24;
-  if (!options.title.empty()) {
-    cv::putText(image, options.title, {10, y}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(0, 0, 0),
-                1, cv::LINE_AA);
-    y += 28;
-  }
-  for (const auto& overlay : overlays) {
-    const cv::Scalar colour(overlay.blue, overlay.green, overlay.red);
-    cv::line(image, {10, y - 6}, {40, y - 6}, colour, 3, cv::LINE_AA);
-    cv::putText(image, overlay.label, {50, y}, cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0),
-                1, cv::LINE_AA);
-    y += 28;
-  }
-  const double bar_m = NiceLength(0.25 * width / px_per_m);
-  const int bar_px = static_cast<int>(std::lround(bar_m * px_per_m));
-  cv::rectangle(image, {10, y - 4}, {10 + bar_px, y + 4}, cv::Scalar(0, 0, 0), cv::FILLED);
-  char label[32];
-  std::snprintf(label, sizeof(label), "%g m", bar_m);
-  cv::putText(image, label, {16 + bar_px, y + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.55,
-              cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  cv::line(image, {0, legend_h - 1}, {width, legend_h - 1}, cv::Scalar(160, 160, 160), 1);
+  DrawLegend(overlays, options.title, px_per_m, legend_h, &image);
 
   std::vector<std::uint8_t> png;
   if (!cv::imencode(".png", image, png)) throw std::runtime_error("PNG encoding failed");

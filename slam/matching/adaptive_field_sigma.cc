@@ -26,7 +26,7 @@ std::vector<std::string> AdaptiveSigmaOptions::Validate() const {
 }
 
 AdaptiveFieldSigma::AdaptiveFieldSigma(const AdaptiveSigmaOptions& options) : options_(options) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid AdaptiveSigmaOptions");
+  SLAMRIG_CHECK_VALID(options_, "AdaptiveSigmaOptions");
 }
 
 std::optional<double> AdaptiveFieldSigma::MedianWallDistance(

@@ -58,7 +58,7 @@ std::vector<std::string> CorrelativeMatcherOptions::Validate() const {
 CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
                                        const GridView& raster)
     : options_(options), origin_(raster.origin), resolution_(raster.resolution) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid CorrelativeMatcherOptions");
+  SLAMRIG_CHECK_VALID(options_, "CorrelativeMatcherOptions");
   std::vector<float> values(static_cast<std::size_t>(raster.width) * raster.height);
   for (int y = 0; y < raster.height; ++y) {
     for (int x = 0; x < raster.width; ++x) {
@@ -71,7 +71,7 @@ CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
 CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
                                        const OccupancyGrid& grid, int decimation)
     : options_(options), origin_(grid.origin()), resolution_(grid.resolution() * decimation) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid CorrelativeMatcherOptions");
+  SLAMRIG_CHECK_VALID(options_, "CorrelativeMatcherOptions");
   SLAMRIG_CHECK(decimation >= 1, "CorrelativeMatcher: decimation must be >= 1");
   const int d = decimation;
   const int width = (grid.width() + d - 1) / d, height = (grid.height() + d - 1) / d;
@@ -131,6 +131,97 @@ std::optional<MatchResult> CorrelativeMatcher::Match(std::span<const Eigen::Vect
   return best.front();
 }
 
+struct CorrelativeMatcher::DiscreteScan {
+  int n = 0;                          // points
+  int half_steps = 0;                 // yaws k in [-half_steps, half_steps]
+  std::vector<Eigen::Array2i> cells;  // per yaw, n cells relative to the raster's cell (0, 0)
+  std::vector<Eigen::Array4i> boxes;  // per yaw: min x, y, max x, y of its cells
+};
+
+CorrelativeMatcher::DiscreteScan CorrelativeMatcher::Discretise(
+    std::span<const Eigen::Vector2d> points_base, const Pose2& initial, double step,
+    int half_steps) const {
+  DiscreteScan scan;
+  const int n = static_cast<int>(points_base.size());
+  const int wk = half_steps;
+  const int num_angles = 2 * wk + 1;
+  scan.n = n;
+  scan.half_steps = wk;
+  scan.cells.resize(static_cast<std::size_t>(num_angles) * n);
+  scan.boxes.resize(static_cast<std::size_t>(num_angles));
+  for (int k = -wk; k <= wk; ++k) {
+    const Pose2 pose(initial.x(), initial.y(), initial.theta() + k * step);
+    Eigen::Array2i* out = &scan.cells[static_cast<std::size_t>(k + wk) * n];
+    Eigen::Array4i box(INT_MAX, INT_MAX, INT_MIN, INT_MIN);
+    for (int p = 0; p < n; ++p) {
+      const Eigen::Vector2d w = pose * points_base[static_cast<std::size_t>(p)];
+      out[p] = Eigen::Array2i(static_cast<int>(std::floor((w.x() - origin_.x()) / resolution_)),
+                              static_cast<int>(std::floor((w.y() - origin_.y()) / resolution_)));
+      box = Eigen::Array4i(std::min(box[0], out[p].x()), std::min(box[1], out[p].y()),
+                           std::max(box[2], out[p].x()), std::max(box[3], out[p].y()));
+    }
+    scan.boxes[static_cast<std::size_t>(k + wk)] = box;
+  }
+  return scan;
+}
+
+float CorrelativeMatcher::ScoreAt(const DiscreteScan& scan, int level, int k, int i, int j) const {
+  const int n = scan.n, wk = scan.half_steps;
+  const Level& l = levels_[static_cast<std::size_t>(level)];
+  const Eigen::Array2i* c = &scan.cells[static_cast<std::size_t>(k + wk) * n];
+  const Eigen::Array4i& box = scan.boxes[static_cast<std::size_t>(k + wk)];
+  const int dx = i + l.offset, dy = j + l.offset;
+  float sum = 0.0f;
+  // The bounds check is skipped when the whole shifted box lies inside the level (same sum
+  // either way).
+  if (box[0] + dx >= 0 && box[1] + dy >= 0 && box[2] + dx < l.width && box[3] + dy < l.height) {
+    const std::ptrdiff_t shift = static_cast<std::ptrdiff_t>(dy) * l.width + dx;
+    const float* values = l.values.data();
+    for (int p = 0; p < n; ++p) {
+      sum += values[shift + static_cast<std::ptrdiff_t>(c[p].y()) * l.width + c[p].x()];
+    }
+    return sum;
+  }
+  for (int p = 0; p < n; ++p) {
+    const int x = c[p].x() + dx, y = c[p].y() + dy;
+    if (static_cast<unsigned>(x) < static_cast<unsigned>(l.width) &&
+        static_cast<unsigned>(y) < static_cast<unsigned>(l.height)) {
+      sum += l.values[static_cast<std::size_t>(y) * l.width + x];
+    }
+  }
+  return sum;
+}
+
+Eigen::Matrix3d CorrelativeMatcher::OlsonCovariance(const DiscreteScan& scan, int k, int i, int j,
+                                                    double score, double step) const {
+  // The offsets are relative to the best pose so that the sums stay well conditioned.
+  const int n = scan.n, wk = scan.half_steps;
+  const int cc = options_.covariance_half_cells, cs = options_.covariance_half_steps;
+  Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  double total = 0.0;
+  for (int dk = -cs; dk <= cs; ++dk) {
+    const int kk = k + dk;
+    if (kk < -wk || kk > wk) continue;
+    for (int dj = -cc; dj <= cc; ++dj) {
+      for (int di = -cc; di <= cc; ++di) {
+        const double s = static_cast<double>(ScoreAt(scan, 0, kk, i + di, j + dj)) / n;
+        const double w = std::exp((s - score) / options_.covariance_score_scale);
+        const Eigen::Vector3d x(di * resolution_, dj * resolution_, dk * step);
+        total += w;
+        mean += w * x;
+        moment += w * x * x.transpose();
+      }
+    }
+  }
+  mean /= total;
+  Eigen::Matrix3d covariance = moment / total - mean * mean.transpose();
+  covariance(0, 0) += resolution_ * resolution_ / 12.0;
+  covariance(1, 1) += resolution_ * resolution_ / 12.0;
+  covariance(2, 2) += step * step / 12.0;
+  return covariance;
+}
+
 std::vector<MatchResult> CorrelativeMatcher::MatchDistinct(
     std::span<const Eigen::Vector2d> points_base, const Pose2& initial, int count,
     double min_distance_m, double min_angle_rad) const {
@@ -140,51 +231,10 @@ std::vector<MatchResult> CorrelativeMatcher::MatchDistinct(
   const double step = AngularStep(points_base);
   const int wk = static_cast<int>(std::ceil(options_.angular_window_rad / step - 1e-9));
   const int wxy = static_cast<int>(std::ceil(options_.linear_window_m / resolution_ - 1e-9));
-  const int num_angles = 2 * wk + 1;
   const std::int64_t side = 2 * wxy + 1;
 
-  // The discretised scan at every yaw (cells relative to the raster's cell (0, 0)), with the
-  // cells' bounding box per yaw.
-  std::vector<Eigen::Array2i> cells(static_cast<std::size_t>(num_angles) * n);
-  std::vector<Eigen::Array4i> boxes(static_cast<std::size_t>(num_angles));  // min x, y, max x, y
-  for (int k = -wk; k <= wk; ++k) {
-    const Pose2 pose(initial.x(), initial.y(), initial.theta() + k * step);
-    Eigen::Array2i* out = &cells[static_cast<std::size_t>(k + wk) * n];
-    Eigen::Array4i box(INT_MAX, INT_MAX, INT_MIN, INT_MIN);
-    for (int p = 0; p < n; ++p) {
-      const Eigen::Vector2d w = pose * points_base[static_cast<std::size_t>(p)];
-      out[p] = Eigen::Array2i(static_cast<int>(std::floor((w.x() - origin_.x()) / resolution_)),
-                              static_cast<int>(std::floor((w.y() - origin_.y()) / resolution_)));
-      box = Eigen::Array4i(std::min(box[0], out[p].x()), std::min(box[1], out[p].y()),
-                           std::max(box[2], out[p].x()), std::max(box[3], out[p].y()));
-    }
-    boxes[static_cast<std::size_t>(k + wk)] = box;
-  }
-  // Sum of level `level` over the scan at yaw k shifted by (i, j), in point order; the bounds
-  // check is skipped when the whole shifted box lies inside the level (same sum either way).
-  auto score = [&](int level, int k, int i, int j) {
-    const Level& l = levels_[static_cast<std::size_t>(level)];
-    const Eigen::Array2i* c = &cells[static_cast<std::size_t>(k + wk) * n];
-    const Eigen::Array4i& box = boxes[static_cast<std::size_t>(k + wk)];
-    const int dx = i + l.offset, dy = j + l.offset;
-    float sum = 0.0f;
-    if (box[0] + dx >= 0 && box[1] + dy >= 0 && box[2] + dx < l.width && box[3] + dy < l.height) {
-      const std::ptrdiff_t shift = static_cast<std::ptrdiff_t>(dy) * l.width + dx;
-      const float* values = l.values.data();
-      for (int p = 0; p < n; ++p) {
-        sum += values[shift + static_cast<std::ptrdiff_t>(c[p].y()) * l.width + c[p].x()];
-      }
-      return sum;
-    }
-    for (int p = 0; p < n; ++p) {
-      const int x = c[p].x() + dx, y = c[p].y() + dy;
-      if (static_cast<unsigned>(x) < static_cast<unsigned>(l.width) &&
-          static_cast<unsigned>(y) < static_cast<unsigned>(l.height)) {
-        sum += l.values[static_cast<std::size_t>(y) * l.width + x];
-      }
-    }
-    return sum;
-  };
+  const DiscreteScan scan = Discretise(points_base, initial, step, wk);
+  auto score = [&](int level, int k, int i, int j) { return ScoreAt(scan, level, k, i, j); };
   auto index_of = [&](int k, int i, int j) {
     return (static_cast<std::int64_t>(k + wk) * side + (j + wxy)) * side + (i + wxy);
   };
@@ -260,31 +310,7 @@ std::vector<MatchResult> CorrelativeMatcher::MatchDistinct(
     result.correspondences = n;
     result.converged = true;
 
-    // Covariance from the score-weighted spread around the best (Olson 2009), with the
-    // offsets relative to the best pose so the sums stay well conditioned.
-    const int cc = options_.covariance_half_cells, cs = options_.covariance_half_steps;
-    Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    double total = 0.0;
-    for (int dk = -cs; dk <= cs; ++dk) {
-      const int k = best.k + dk;
-      if (k < -wk || k > wk) continue;
-      for (int dj = -cc; dj <= cc; ++dj) {
-        for (int di = -cc; di <= cc; ++di) {
-          const double s = static_cast<double>(score(0, k, best.i + di, best.j + dj)) / n;
-          const double w = std::exp((s - result.score) / options_.covariance_score_scale);
-          const Eigen::Vector3d x(di * resolution_, dj * resolution_, dk * step);
-          total += w;
-          mean += w * x;
-          moment += w * x * x.transpose();
-        }
-      }
-    }
-    mean /= total;
-    result.covariance = moment / total - mean * mean.transpose();
-    result.covariance(0, 0) += resolution_ * resolution_ / 12.0;
-    result.covariance(1, 1) += resolution_ * resolution_ / 12.0;
-    result.covariance(2, 2) += step * step / 12.0;
+    result.covariance = OlsonCovariance(scan, best.k, best.i, best.j, result.score, step);
     results.push_back(result);
   }
   return results;

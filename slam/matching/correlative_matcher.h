@@ -101,6 +101,16 @@ class CorrelativeMatcher {
     std::vector<float> values;
   };
   void Precompute(std::vector<float> values, int width, int height);
+  // A scan's points as raster cells at each yaw of the window, with their bounding boxes.
+  struct DiscreteScan;
+  DiscreteScan Discretise(std::span<const Eigen::Vector2d> points_base, const Pose2& initial,
+                          double step, int half_steps) const;
+  // The sum of level `level` over the scan at yaw k shifted by (i, j) cells, in point order.
+  float ScoreAt(const DiscreteScan& scan, int level, int k, int i, int j) const;
+  // The covariance of the pose (k, i, j) that scored `score` per point, from the score-weighted
+  // spread of the poses around it (Olson 2009).
+  Eigen::Matrix3d OlsonCovariance(const DiscreteScan& scan, int k, int i, int j, double score,
+                                  double step) const;
 
   CorrelativeMatcherOptions options_;
   Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();

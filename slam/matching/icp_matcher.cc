@@ -199,7 +199,7 @@ std::vector<std::string> IcpOptions::Validate() const {
 
 IcpMatcher::IcpMatcher(const IcpOptions& options, std::vector<Eigen::Vector2d> reference)
     : options_(options), tree_(std::move(reference)) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid IcpOptions");
+  SLAMRIG_CHECK_VALID(options_, "IcpOptions");
   if (options_.metric != IcpMetric::kPointToLine) return;
   // Normals: the minor principal axis of each point's neighbourhood.
   const auto& points = tree_.points();

@@ -43,7 +43,7 @@ std::vector<std::string> IcpOdometryOptions::Validate() const {
 }
 
 IcpOdometry::IcpOdometry(const IcpOdometryOptions& options) : options_(options) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid IcpOdometryOptions");
+  SLAMRIG_CHECK_VALID(options_, "IcpOdometryOptions");
 }
 
 const std::vector<Eigen::Vector2d>& IcpOdometry::local_map() const {

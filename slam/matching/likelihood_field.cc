@@ -25,7 +25,7 @@ std::vector<std::string> LikelihoodFieldOptions::Validate() const {
 }
 
 LikelihoodField::LikelihoodField(const LikelihoodFieldOptions& options) : options_(options) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid LikelihoodFieldOptions");
+  SLAMRIG_CHECK_VALID(options_, "LikelihoodFieldOptions");
 }
 
 double LikelihoodField::Score(double distance_m) const {

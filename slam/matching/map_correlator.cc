@@ -159,7 +159,7 @@ std::vector<std::string> MapCorrelatorOptions::Validate() const {
 }
 
 MapCorrelator::MapCorrelator(const MapCorrelatorOptions& options) : options_(options) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid MapCorrelatorOptions");
+  SLAMRIG_CHECK_VALID(options_, "MapCorrelatorOptions");
 }
 
 CorrelationResult MapCorrelator::Correlate(const GridView& grid,
@@ -181,6 +181,8 @@ CorrelationResult MapCorrelator::Correlate(const GridView& grid, const OccupiedM
   return CorrelateImpl(grid, &mask, points_base, world_from_base, table);
 }
 
+// function-length: exception (the SIMD hot kernel of every particle's scan match: its scratch is
+// hoisted and its loops fused on purpose; splitting it costs measured time)
 CorrelationResult MapCorrelator::CorrelateImpl(const GridView& grid, const OccupiedMask* mask,
                                                std::span<const Eigen::Vector2d> points_base,
                                                const Pose2& world_from_base,

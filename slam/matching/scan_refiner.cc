@@ -88,7 +88,7 @@ std::vector<std::string> ScanRefinerOptions::Validate() const {
 }
 
 ScanRefiner::ScanRefiner(const ScanRefinerOptions& options) : options_(options) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid ScanRefinerOptions");
+  SLAMRIG_CHECK_VALID(options_, "ScanRefinerOptions");
 }
 
 double ScanRefiner::Score(const GridView& raster, std::span<const Eigen::Vector2d> points_base,

@@ -59,7 +59,7 @@ std::vector<std::string> ScanSyncOptions::Validate() const {
 
 ScanSynchronizer::ScanSynchronizer(const ScanSyncOptions& options, OdometrySource source)
     : options_(options), source_(source) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid ScanSyncOptions");
+  SLAMRIG_CHECK_VALID(options_, "ScanSyncOptions");
   SLAMRIG_CHECK(source != OdometrySource::kAuto, "ScanSynchronizer needs a resolved source");
 }
 
@@ -162,7 +162,7 @@ void ScanSynchronizer::CompletePending(const OdometryPose* next, std::vector<Syn
 }
 
 ScanSyncResult SyncToScans(const std::vector<Record>& records, const ScanSyncOptions& options) {
-  SLAMRIG_CHECK(options.Validate().empty(), "invalid ScanSyncOptions");
+  SLAMRIG_CHECK_VALID(options, "ScanSyncOptions");
   ScanSyncResult result;
   result.source_used = ResolveOdometrySource(records, options.source);
   ScanSynchronizer sync(options, result.source_used == OdometrySource::kAuto ? OdometrySource::kNone

@@ -36,7 +36,7 @@ std::vector<std::string> WheelOdometryOptions::Validate() const {
 }
 
 WheelOdometry::WheelOdometry(const WheelOdometryOptions& options) : options_(options) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid WheelOdometryOptions");
+  SLAMRIG_CHECK_VALID(options_, "WheelOdometryOptions");
 }
 
 void WheelOdometry::AddImu(const ImuSample& imu) {

@@ -26,6 +26,13 @@ namespace slamrig::slam {
 namespace {
 // Surface normals from the scan points within this distance along the scan.
 constexpr double kNeighbourM = 0.3;
+// A scan is judged (the lost test, the tracked hypothesis while lost) only when at least this
+// fraction of its points lands on observed map cells: unexplored space scores nothing anywhere.
+constexpr double kJudgedFraction = 0.5;
+// The global search needs this many points within search_max_range_m to place a scan.
+constexpr std::size_t kMinGlobalSearchPoints = 10;
+// The global search's yaw window: every heading.
+constexpr double kEveryHeadingRad = 3.14159265358979;
 }  // namespace
 
 Pose2 WeightedMeanPose(const std::vector<Particle>& particles) {
@@ -51,7 +58,7 @@ ParticleFilter::ParticleFilter(const ParticleFilterOptions& options)
       refiner_(options.refiner),
       rng_(options.seed),
       calibration_(options.odometry_calibration) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid ParticleFilterOptions");
+  SLAMRIG_CHECK_VALID(options_, "ParticleFilterOptions");
   if (options_.num_threads > 1) pool_ = std::make_unique<ThreadPool>(options_.num_threads);
   const int n = options_.num_particles;
   particles_.assign(static_cast<std::size_t>(n), Particle{Pose2(), 1.0 / n});
@@ -204,78 +211,106 @@ bool ParticleFilter::TrackQuality(double quality, Time now) {
     lost_since_ = now;
     lost_pose_ = last_step_.best_pose;
     ++lost_count_;
-    ClearCandidates();
+    ForgetSearch();
     unsupported_updates_ = 0;
-    global_matcher_.reset();
-    near_matcher_.reset();
   }
   return suspect;
 }
 
 bool ParticleFilter::Relocalise(const std::vector<Eigen::Vector2d>& points, const LaserScan& scan,
                                 ParticleFilterStep* step) {
-  const RelocalisationOptions& o = options_.relocalisation;
   step->lost = true;
-  if (points.empty()) {
-    GiveUpWhenLostTooLong(scan, step);
-    return true;
+  LostVerdict verdict{LostDecision::kStayLost, Pose2()};
+  if (!points.empty()) {
+    // Two hypotheses, judged alike and tracked in parallel: the filter's own (its cloud goes on
+    // being predicted, scan-matched and resampled while lost, only the map is frozen), and a
+    // place elsewhere on the map.
+    const ScoredPose tracked{step->best_pose, step->quality};
+    if (ObservedFraction(points, tracked.pose) < kJudgedFraction) {
+      // The tracked hypothesis's scan reaches mostly into ground the map has not seen: nothing
+      // can refute it there (the lost test itself is made only on mapped ground), and on a
+      // frozen map the filter would go on scoring against nothing. Tracking resumes and the new
+      // ground is mapped.
+      verdict = {LostDecision::kResume, Pose2()};
+    } else {
+      std::vector<Candidate> places = FollowCandidates(points);
+      GatherGlobalPlaces(points, &places);
+      verdict = Decide(points, tracked, std::move(places));
+    }
   }
-  // Two hypotheses, judged alike and tracked in parallel: the filter's own (its cloud goes on
-  // being predicted, scan-matched and resampled while lost, only the map is frozen), and a place
-  // elsewhere on the map. Carried by the odometry alone, as it was, the tracked hypothesis lost
-  // the scan within a few updates wherever the odometry is poor, and then anything that fitted
-  // better won: belgioioso (odometry off by up to 0.5 rad per update) took a global match 4-9 m
-  // away fitting 0.85 of the usual level on 5 updates in a row (ATE 17 m).
-  const ScoredPose tracked{step->best_pose, step->quality};
-  if (ObservedFraction(points, tracked.pose) < 0.5) {
-    // The tracked hypothesis's scan reaches mostly into ground the map has not seen: nothing can
-    // refute it there (the lost test itself is made only on mapped ground), and with the map
-    // frozen the filter would go on scoring against nothing. Belgioioso, lost while turning on
-    // the spot at the edge of its map, otherwise spent its remaining updates in global searches.
-    // Tracking resumes and the new ground is mapped.
-    ResumeTracking();
-    step->lost = false;
-    return false;
+  switch (verdict.decision) {
+    case LostDecision::kResume:
+      ResumeTracking();
+      step->lost = false;
+      return false;
+    case LostDecision::kCorrectSlip: {
+      // The best place near by fits better than the filter's: the odometry slipped, no
+      // kidnapping. Tracking resumes there.
+      const Pose2 correction = verdict.pose * step->best_pose.Inverse();
+      for (Particle& p : particles_) p.pose = correction * p.pose;
+      step->best_pose = correction * step->best_pose;
+      step->mean_pose = correction * step->mean_pose;
+      ResumeTracking();
+      step->lost = false;
+      return false;
+    }
+    case LostDecision::kStayLost:
+      GiveUpWhenLostTooLong(scan, step);
+      return true;
+    case LostDecision::kRelocalise:
+      RestartAt(verdict.pose, step);
+      return true;
   }
-  auto same_place = [&](const Pose2& a, const Pose2& b) {
-    return (a.translation() - b.translation()).norm() <= o.confirm_distance_m &&
-           std::abs(NormalizeAngle(a.theta() - b.theta())) <= o.confirm_angle_rad;
-  };
-  auto distinct = [&](const Pose2& a, const Pose2& b) {
-    return (a.translation() - b.translation()).norm() > o.distinct_radius_m ||
-           std::abs(NormalizeAngle(a.theta() - b.theta())) > o.distinct_angle_rad;
-  };
+  return true;
+}
+
+std::vector<ParticleFilter::Candidate> ParticleFilter::FollowCandidates(
+    const std::vector<Eigen::Vector2d>& points) {
   // The places of the previous updates, carried by the odometry (AddScan), must explain this scan
   // where the odometry put them: matched locally, each stays within confirm_distance_m and
   // confirm_angle_rad of that prediction and fits as well as a place must. A wrong place that
   // happens to fit one scan (an aliased corridor) rarely fits the next ones at the same relative
   // pose. Two that converge on one place are one.
+  const RelocalisationOptions& o = options_.relocalisation;
   std::vector<Candidate> places;
   for (const Candidate& c : candidates_) {
     const ScoredPose followed = LocalMatch(points, c.pose);
-    if (!same_place(followed.pose, c.pose) || !FitsAsPlace(followed.quality)) continue;
+    const bool stayed =
+        (followed.pose.translation() - c.pose.translation()).norm() <= o.confirm_distance_m &&
+        std::abs(NormalizeAngle(followed.pose.theta() - c.pose.theta())) <= o.confirm_angle_rad;
+    if (!stayed || !FitsAsPlace(followed.quality)) continue;
     bool merged = false;
     for (Candidate& p : places) {
-      if (distinct(p.pose, followed.pose)) continue;
+      if (DistinctPlaces(p.pose, followed.pose)) continue;
       merged = true;
       if (followed.quality > p.quality) p = Candidate{followed.pose, followed.quality, c.wins};
     }
     if (!merged) places.push_back(Candidate{followed.pose, followed.quality, c.wins});
   }
+  return places;
+}
+
+void ParticleFilter::GatherGlobalPlaces(const std::vector<Eigen::Vector2d>& points,
+                                        std::vector<Candidate>* places) {
   // The whole map is searched on every lost update for its best distinct places, so that a place
   // is judged against the best other explanation of this scan, not only against the ones it
   // was found with.
   std::vector<Eigen::Vector2d> near;
   for (const Eigen::Vector2d& p : points) {
-    if (p.norm() <= o.search_max_range_m) near.push_back(p);
+    if (p.norm() <= options_.relocalisation.search_max_range_m) near.push_back(p);
   }
-  if (near.size() >= 10) {
-    for (const ScoredPose& g : GlobalMatches(near, points)) {
-      bool known = false;
-      for (const Candidate& p : places) known = known || !distinct(p.pose, g.pose);
-      if (!known) places.push_back(Candidate{g.pose, g.quality, 0});
-    }
+  if (near.size() < kMinGlobalSearchPoints) return;
+  for (const ScoredPose& g : GlobalMatches(near, points)) {
+    bool known = false;
+    for (const Candidate& p : *places) known = known || !DistinctPlaces(p.pose, g.pose);
+    if (!known) places->push_back(Candidate{g.pose, g.quality, 0});
   }
+}
+
+ParticleFilter::LostVerdict ParticleFilter::Decide(const std::vector<Eigen::Vector2d>& points,
+                                                   const ScoredPose& tracked,
+                                                   std::vector<Candidate> places) {
+  const RelocalisationOptions& o = options_.relocalisation;
   // The leading place, and the best of the others.
   const Candidate* found = nullptr;
   double rival_quality = 0.0;
@@ -288,42 +323,29 @@ bool ParticleFilter::Relocalise(const std::vector<Eigen::Vector2d>& points, cons
     }
   }
   // The tracked hypothesis is the best explanation near the filter, not only at its pose: the
-  // odometry may have slipped by more than the shift search covers (a wheel on a threshold,
-  // belgioioso's 0.5 rad turns), and a kidnapping is far rarer than a slip. A place elsewhere must
-  // fit the scan clearly better than anything near by; a bad scan (people, glass, clutter) fits
-  // nowhere better than where the robot is.
+  // odometry may have slipped by more than the shift search covers (a wheel on a threshold, a
+  // fast turn), and a kidnapping is far rarer than a slip. A place elsewhere must fit the scan
+  // clearly better than anything near by; a bad scan (people, glass, clutter) fits nowhere better
+  // than where the robot is.
   const std::optional<ScoredPose> nearby = NearMatch(points, tracked.pose);
   const double near_quality = nearby ? std::max(nearby->quality, tracked.quality) : tracked.quality;
   const double slip = found ? (found->pose.translation() - tracked.pose.translation()).norm() : 0.0;
   const bool elsewhere = found && slip > o.slip_radius_m &&
                          found->quality >= near_quality + o.win_margin * quality_slow_;
   if (!elsewhere && nearby && nearby->quality > tracked.quality) {
-    // The best place near by fits better than the filter's: the odometry slipped, no
-    // kidnapping. Tracking resumes there.
-    const Pose2 correction = nearby->pose * tracked.pose.Inverse();
-    for (Particle& p : particles_) p.pose = correction * p.pose;
-    step->best_pose = correction * step->best_pose;
-    step->mean_pose = correction * step->mean_pose;
-    ResumeTracking();
-    step->lost = false;
-    return false;
+    return {LostDecision::kCorrectSlip, nearby->pose};
   }
   if (!elsewhere) {
     ClearCandidates();
     ++unsupported_updates_;
     // The test is sequential both ways: a place elsewhere must win on confirm_updates updates in
     // a row, and resume_updates updates in a row on which nothing elsewhere fits better keep the
-    // filter where it is, even when it fits poorly there (a young or changed part of the map:
-    // intel-corrected, lost at 2263 s with the filter at 0.55 of its usual quality and no
-    // other place fitting, drifted 3 m on the frozen map until max_lost_s gave up). So does a
-    // tracked hypothesis that fits as well as usual again: the alarm was a bad scan or two.
+    // filter where it is, even when it fits poorly there (a young or changed part of the map).
+    // So does a tracked hypothesis that fits as well as usual again: the alarm was a bad scan.
     if (FitsAsPlace(tracked.quality) || unsupported_updates_ >= o.resume_updates) {
-      ResumeTracking();
-      step->lost = false;
-      return false;
+      return {LostDecision::kResume, Pose2()};
     }
-    GiveUpWhenLostTooLong(scan, step);
-    return true;
+    return {LostDecision::kStayLost, Pose2()};
   }
   unsupported_updates_ = 0;
   // A place elsewhere wins, but it wins outright only when no other distinct place fits nearly
@@ -333,38 +355,40 @@ bool ParticleFilter::Relocalise(const std::vector<Eigen::Vector2d>& points, cons
   const Candidate winner = *found;
   for (Candidate& p : places) p.wins = 0;
   candidates_ = std::move(places);
-  if (!clear) {
-    GiveUpWhenLostTooLong(scan, step);
-    return true;
-  }
+  if (!clear) return {LostDecision::kStayLost, Pose2()};
   const int wins = winner.wins + 1;
   for (Candidate& p : candidates_) {
     if (p.pose == winner.pose) p.wins = wins;
   }
-  if (wins < o.confirm_updates) {
-    GiveUpWhenLostTooLong(scan, step);
-    return true;
-  }
+  if (wins < o.confirm_updates) return {LostDecision::kStayLost, Pose2()};
+  return {LostDecision::kRelocalise, winner.pose};
+}
+
+void ParticleFilter::RestartAt(const Pose2& place, ParticleFilterStep* step) {
+  const RelocalisationOptions& o = options_.relocalisation;
   const double uniform = 1.0 / options_.num_particles;
   for (Particle& p : particles_) {
-    p.pose = Pose2(winner.pose.x() + o.reset_sigma_xy_m * StandardNormal(rng_),
-                   winner.pose.y() + o.reset_sigma_xy_m * StandardNormal(rng_),
-                   winner.pose.theta() + o.reset_sigma_yaw_rad * StandardNormal(rng_));
+    p.pose = Pose2(place.x() + o.reset_sigma_xy_m * StandardNormal(rng_),
+                   place.y() + o.reset_sigma_xy_m * StandardNormal(rng_),
+                   place.theta() + o.reset_sigma_yaw_rad * StandardNormal(rng_));
     p.weight = uniform;
   }
   std::fill(log_weights_.begin(), log_weights_.end(), 0.0);
   lost_ = false;
-  ClearCandidates();
-  global_matcher_.reset();
-  near_matcher_.reset();
+  ForgetSearch();
   quality_fast_ = quality_slow_;
   ++relocalisation_count_;
   step->lost = false;
   step->relocalised = true;
-  step->best_pose = winner.pose;
-  step->mean_pose = winner.pose;
+  step->best_pose = place;
+  step->mean_pose = place;
   step->neff = static_cast<double>(options_.num_particles);
-  return true;
+}
+
+bool ParticleFilter::DistinctPlaces(const Pose2& a, const Pose2& b) const {
+  const RelocalisationOptions& o = options_.relocalisation;
+  return (a.translation() - b.translation()).norm() > o.distinct_radius_m ||
+         std::abs(NormalizeAngle(a.theta() - b.theta())) > o.distinct_angle_rad;
 }
 
 double ParticleFilter::ObservedFraction(const std::vector<Eigen::Vector2d>& points,
@@ -388,11 +412,15 @@ double ParticleFilter::ObservedFraction(const std::vector<Eigen::Vector2d>& poin
 
 void ParticleFilter::ClearCandidates() { candidates_.clear(); }
 
-void ParticleFilter::ResumeTracking() {
-  lost_ = false;
+void ParticleFilter::ForgetSearch() {
   ClearCandidates();
   global_matcher_.reset();
   near_matcher_.reset();
+}
+
+void ParticleFilter::ResumeTracking() {
+  lost_ = false;
+  ForgetSearch();
   quality_fast_ = quality_slow_;
   ++resumed_count_;
 }
@@ -401,9 +429,7 @@ void ParticleFilter::GiveUpWhenLostTooLong(const LaserScan& scan, ParticleFilter
   if (SecondsBetween(scan.time, lost_since_) <= options_.relocalisation.max_lost_s) return;
   // Nowhere on the map fits: the robot is somewhere new, map on from the odometry.
   lost_ = false;
-  ClearCandidates();
-  global_matcher_.reset();
-  near_matcher_.reset();
+  ForgetSearch();
   tracked_updates_ = 0;
   step->lost = false;
   map_.InsertScan(scan, step->best_pose);
@@ -439,7 +465,7 @@ std::vector<ParticleFilter::ScoredPose> ParticleFilter::GlobalMatches(
     search_centre_ = 0.5 * (a + b);
     CorrelativeMatcherOptions m;
     m.linear_window_m = 0.5 * (b - a).cwiseMax(0.0).maxCoeff();
-    m.angular_window_rad = 3.14159265358979;  // every heading
+    m.angular_window_rad = kEveryHeadingRad;
     m.min_score = 0.0;
     const int decimation =
         std::max(1, static_cast<int>(std::lround(o.search_resolution_m / map_.resolution())));
@@ -489,51 +515,86 @@ bool ParticleFilter::FitsAsPlace(double quality) const {
 }
 
 ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
-  ParticleFilterStep step;
-  if (!started_) {
-    // Step 1 of Zafari's summary: particles at the origin; the first scan starts the map.
-    started_ = true;
-    map_.InsertScan(scan, Pose2());
-    step.neff = static_cast<double>(options_.num_particles);
-    step.updated = true;
-    last_step_ = step;
-    return step;
-  }
-  // Too little motion since the last update: no filtering, poses follow the odometry.
+  if (!started_) return Start(scan);
   pending_motion_ = pending_motion_ * odometry_increment;
-  const bool moved_enough =
-      pending_motion_.translation().norm() >= options_.min_update_distance_m ||
-      std::abs(pending_motion_.theta()) >= options_.min_update_angle_rad;
-  if (!moved_enough) {
-    step = last_step_;
-    const Pose2 motion = calibration_.Correct(pending_motion_);
-    step.best_pose = last_step_.best_pose * motion;
-    step.mean_pose = last_step_.mean_pose * motion;
-    step.resampled = false;
-    step.updated = false;
-    return step;
-  }
+  if (!MovedEnough()) return FollowOdometry();
   const Pose2 raw_motion = pending_motion_;
   const Pose2 motion = calibration_.Correct(raw_motion);
   Predict(motion);
   for (Candidate& c : candidates_) c.pose = c.pose * motion;
   pending_motion_ = Pose2();
-  step.updated = true;
 
+  ParticleFilterStep step;
+  step.updated = true;
   const std::vector<Eigen::Vector2d> all_points = ScanToBasePoints(scan, options_.points);
   const SelectedPoints selected = DropGrazingPoints(
       all_points, SurfaceNormals(all_points, kNeighbourM), options_.max_incidence_rad);
   const std::vector<Eigen::Vector2d>& points = selected.points;
   step.points_used = static_cast<int>(points.size());
-  bool degenerate = false;
-  MatchConstraints constraints;
   // The cloud's mean as the odometry moved it: along a degenerate direction it stays the estimate.
   const Pose2 predicted_mean = WeightedMeanPose(particles_);
-  if (!points.empty()) {
+  MatchConstraints constraints;
+  if (!points.empty())
     constraints = DecomposeInformation(ScanInformation(points, selected.normals));
-    degenerate =
-        options_.degeneracy_ratio > 0.0 && constraints.WeakCount(options_.degeneracy_ratio) > 0;
-    const std::vector<double> scores = Score(points, constraints, predicted_mean, &step.best_score);
+  const bool degenerate = !points.empty() && options_.degeneracy_ratio > 0.0 &&
+                          constraints.WeakCount(options_.degeneracy_ratio) > 0;
+  const std::vector<double> weights = UpdateWeights(points, constraints, predicted_mean, &step);
+  ChooseEstimate(constraints, degenerate, predicted_mean, &step);
+  step.quality = Quality(step.best_score, points.size());
+  step.neff = EffectiveSampleSize(weights);
+  if (!UpdateMapAndLostState(scan, points, &step)) {
+    last_step_ = step;
+    return step;
+  }
+  if (step.neff < options_.resample_neff_ratio * options_.num_particles) {
+    ResampleCloud(weights);
+    step.resampled = true;
+  }
+  if (degenerate) HoldMeanAlongWeakDirections(predicted_mean, constraints);
+  // The calibration learns from updates that tracked on both ends: a loss, a relocalisation or a
+  // slip correction moves the estimate by more than the odometry's error.
+  if (!points.empty() && !step.lost && !step.relocalised && !last_step_.lost &&
+      !last_step_.relocalised) {
+    calibration_.Observe(raw_motion, last_step_.best_pose.Inverse() * step.best_pose);
+  }
+  last_step_ = step;
+  return step;
+}
+
+ParticleFilterStep ParticleFilter::Start(const LaserScan& scan) {
+  // Step 1 of Zafari's summary: particles at the origin; the first scan starts the map.
+  started_ = true;
+  map_.InsertScan(scan, Pose2());
+  ParticleFilterStep step;
+  step.neff = static_cast<double>(options_.num_particles);
+  step.updated = true;
+  last_step_ = step;
+  return step;
+}
+
+bool ParticleFilter::MovedEnough() const {
+  return pending_motion_.translation().norm() >= options_.min_update_distance_m ||
+         std::abs(pending_motion_.theta()) >= options_.min_update_angle_rad;
+}
+
+ParticleFilterStep ParticleFilter::FollowOdometry() const {
+  // Too little motion since the last update: no filtering, poses follow the odometry.
+  ParticleFilterStep step = last_step_;
+  const Pose2 motion = calibration_.Correct(pending_motion_);
+  step.best_pose = last_step_.best_pose * motion;
+  step.mean_pose = last_step_.mean_pose * motion;
+  step.resampled = false;
+  step.updated = false;
+  return step;
+}
+
+std::vector<double> ParticleFilter::UpdateWeights(const std::vector<Eigen::Vector2d>& points,
+                                                  const MatchConstraints& constraints,
+                                                  const Pose2& predicted_mean,
+                                                  ParticleFilterStep* step) {
+  if (!points.empty()) {
+    const std::vector<double> scores =
+        Score(points, constraints, predicted_mean, &step->best_score);
     for (std::size_t i = 0; i < scores.size(); ++i) {
       log_weights_[i] += options_.observation_scale * scores[i];
     }
@@ -547,90 +608,83 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
     log_weights_[i] =
         weights[i] > 0.0 ? std::log(weights[i]) : -std::numeric_limits<double>::infinity();
   }
-  step.best_pose = particles_[best].pose;
-  step.mean_pose = WeightedMeanPose(particles_);
-  if (!degenerate && Unimodal(step.mean_pose)) {
+  step->best_pose = particles_[best].pose;
+  return weights;
+}
+
+void ParticleFilter::ChooseEstimate(const MatchConstraints& constraints, bool degenerate,
+                                    const Pose2& predicted_mean, ParticleFilterStep* step) const {
+  step->mean_pose = WeightedMeanPose(particles_);
+  if (!degenerate && Unimodal(step->mean_pose)) {
     // One mode: its weighted mean is a better estimate than any one member (the scan-matched
     // particles scatter around the optimum by the refiner's convergence and the prediction's
     // noise), and the map built from it is smoother. Not along a degenerate direction: there the
-    // particles keep their odometry, and the mean of that spread built a worse corridor map (ATE
-    // 0.24 -> 0.37 m).
-    step.best_pose = step.mean_pose;
+    // particles keep their odometry, and the mean of that spread builds a worse corridor map.
+    step->best_pose = step->mean_pose;
   }
   if (degenerate) {
     // Along the directions the scan leaves open the estimate is the cloud's mean where the
     // odometry put it, not any one particle's place there: the particles keep their own sampled
     // motion along the axis (the spread later scans can correct), and which of them carries the
     // most weight says nothing about it.
-    step.best_pose = RemapAlongWeakDirections(predicted_mean, step.best_pose, constraints,
-                                              options_.degeneracy_ratio);
-    step.mean_pose = RemapAlongWeakDirections(predicted_mean, step.mean_pose, constraints,
-                                              options_.degeneracy_ratio);
+    step->best_pose = RemapAlongWeakDirections(predicted_mean, step->best_pose, constraints,
+                                               options_.degeneracy_ratio);
+    step->mean_pose = RemapAlongWeakDirections(predicted_mean, step->mean_pose, constraints,
+                                               options_.degeneracy_ratio);
   }
-  step.quality = Quality(step.best_score, points.size());
+}
+
+bool ParticleFilter::UpdateMapAndLostState(const LaserScan& scan,
+                                           const std::vector<Eigen::Vector2d>& points,
+                                           ParticleFilterStep* step) {
+  if (lost_) {
+    // Lost since an earlier update: the map stays frozen until the filter resumes (the scan fits
+    // where the filter is, or next to it, and is mapped as usual) or relocalises (a new cloud).
+    if (!Relocalise(points, scan, step)) map_.InsertScan(scan, step->best_pose);
+    return !step->relocalised;
+  }
   // The lost test is made only when most of the scan lands where the map has been observed:
   // points in unexplored space score nothing wherever the robot is, so a scan reaching mostly
   // into new ground (a first pass, an outdoor log's far returns) scores low without being lost.
   // (Scoring only the observed points instead would hide a kidnapping: a displaced scan's
   // points also leave the map.)
-  const bool judged = !points.empty() && ObservedFraction(points, step.best_pose) >= 0.5;
-  step.neff = EffectiveSampleSize(weights);
+  const bool judged =
+      !points.empty() && ObservedFraction(points, step->best_pose) >= kJudgedFraction;
   // How far this scan's points lie from the map's walls, read before the scan is inserted.
   std::optional<double> wall_distance;
-  if (judged && !lost_ && options_.observation == ObservationModel::kLikelihoodField &&
+  if (judged && options_.observation == ObservationModel::kLikelihoodField &&
       options_.adaptive_sigma.enabled) {
     likelihood_field_.Follow(map_);
-    wall_distance = field_sigma_.MedianWallDistance(likelihood_field_, points, step.best_pose);
+    wall_distance = field_sigma_.MedianWallDistance(likelihood_field_, points, step->best_pose);
   }
-  if (lost_) {
-    // Lost since an earlier update: the map stays frozen until the filter resumes (the scan fits
-    // where the filter is, or next to it, and is mapped as usual) or relocalises (a new cloud).
-    if (!Relocalise(points, scan, &step)) map_.InsertScan(scan, step.best_pose);
-    if (step.relocalised) {
-      last_step_ = step;
-      return step;
-    }
-  } else {
-    // A scan that matches the map much worse than usual is not inserted: after a kidnapping it
-    // would paint the new place onto the old one before the averages call the filter lost.
-    const bool suspect = judged && TrackQuality(step.quality, scan.time);
-    step.lost = lost_;
-    if (!suspect) map_.InsertScan(scan, step.best_pose);
-    // A scan that tracked as usual tells how sharp the map is; the field follows (its next
-    // Follow recomputes it everywhere).
-    if (!suspect && !lost_ && wall_distance) {
-      if (const std::optional<double> sigma =
-              field_sigma_.Observe(*wall_distance, likelihood_field_.sigma_m())) {
-        likelihood_field_.SetSigma(*sigma);
-      }
-    }
-    if (lost_) {
-      // Just lost: the weights say nothing now; keep the cloud for the odometry to carry.
-      last_step_ = step;
-      return step;
+  // A scan that matches the map much worse than usual is not inserted: after a kidnapping it
+  // would paint the new place onto the old one before the averages call the filter lost.
+  const bool suspect = judged && TrackQuality(step->quality, scan.time);
+  step->lost = lost_;
+  if (!suspect) map_.InsertScan(scan, step->best_pose);
+  // A scan that tracked as usual tells how sharp the map is; the field follows (its next
+  // Follow recomputes it everywhere).
+  if (!suspect && !lost_ && wall_distance) {
+    if (const std::optional<double> sigma =
+            field_sigma_.Observe(*wall_distance, likelihood_field_.sigma_m())) {
+      likelihood_field_.SetSigma(*sigma);
     }
   }
-  if (step.neff < options_.resample_neff_ratio * options_.num_particles) {
-    const std::vector<int> keep = Resample(weights, options_.resampling, rng_);
-    std::vector<Particle> resampled;
-    resampled.reserve(particles_.size());
-    const double uniform = 1.0 / options_.num_particles;
-    for (const int k : keep)
-      resampled.push_back(Particle{particles_[static_cast<std::size_t>(k)].pose, uniform});
-    particles_ = std::move(resampled);
-    std::fill(log_weights_.begin(), log_weights_.end(), 0.0);
-    step.resampled = true;
-    ++resample_count_;
+  // Just lost: the weights say nothing now; keep the cloud for the odometry to carry.
+  return !lost_;
+}
+
+void ParticleFilter::ResampleCloud(const std::vector<double>& weights) {
+  const std::vector<int> keep = Resample(weights, options_.resampling, rng_);
+  std::vector<Particle> resampled;
+  resampled.reserve(particles_.size());
+  const double uniform = 1.0 / options_.num_particles;
+  for (const int k : keep) {
+    resampled.push_back(Particle{particles_[static_cast<std::size_t>(k)].pose, uniform});
   }
-  if (degenerate) HoldMeanAlongWeakDirections(predicted_mean, constraints);
-  // The calibration learns from updates that tracked on both ends: a loss, a relocalisation or a
-  // slip correction moves the estimate by more than the odometry's error.
-  if (!points.empty() && !step.lost && !step.relocalised && !last_step_.lost &&
-      !last_step_.relocalised) {
-    calibration_.Observe(raw_motion, last_step_.best_pose.Inverse() * step.best_pose);
-  }
-  last_step_ = step;
-  return step;
+  particles_ = std::move(resampled);
+  std::fill(log_weights_.begin(), log_weights_.end(), 0.0);
+  ++resample_count_;
 }
 
 }  // namespace slamrig::slam

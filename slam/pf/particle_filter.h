@@ -73,6 +73,47 @@ class ParticleFilter {
   double odometry_drift_rad_per_m() const { return calibration_.drift_rad_per_m(); }
 
  private:
+  // A place elsewhere on the map, carried by the odometry from update to update.
+  struct Candidate {
+    Pose2 pose;
+    double quality = 0.0;  // on the latest update
+    int wins = 0;          // lost updates in a row on which it won clearly
+  };
+  // What one lost update decides.
+  enum class LostDecision {
+    kResume,       // tracking resumes where the filter is
+    kCorrectSlip,  // tracking resumes at the better place near by (the odometry slipped)
+    kStayLost,     // still lost: the search goes on (or gives up after max_lost_s)
+    kRelocalise,   // a place elsewhere won clearly, confirm_updates times: the cloud moves there
+  };
+  struct LostVerdict {
+    LostDecision decision = LostDecision::kStayLost;
+    Pose2 pose;  // the place near by (kCorrectSlip) or elsewhere (kRelocalise)
+  };
+
+  // AddScan's steps. The first scan starts the map at the identity.
+  ParticleFilterStep Start(const LaserScan& scan);
+  // The odometry since the last update reaches min_update_distance_m or min_update_angle_rad.
+  bool MovedEnough() const;
+  // The last update's step carried on by the odometry since (no filtering).
+  ParticleFilterStep FollowOdometry() const;
+  // Scores the particles' scans into their log-weights and normalises them; sets the step's
+  // best_pose (the highest weight) and best_score. The normalised weights.
+  std::vector<double> UpdateWeights(const std::vector<Eigen::Vector2d>& points,
+                                    const MatchConstraints& constraints,
+                                    const Pose2& predicted_mean, ParticleFilterStep* step);
+  // The step's mean_pose and the estimate (best_pose): the mean of one tight mode, held at the
+  // odometry's prediction along the scan's weak directions.
+  void ChooseEstimate(const MatchConstraints& constraints, bool degenerate,
+                      const Pose2& predicted_mean, ParticleFilterStep* step) const;
+  // Inserts the scan into the map unless it is suspect or the filter is lost (then it relocalises
+  // or resumes), and follows the lost test. False when the update ends here: the filter has just
+  // been found lost, or has been relocalised.
+  bool UpdateMapAndLostState(const LaserScan& scan, const std::vector<Eigen::Vector2d>& points,
+                             ParticleFilterStep* step);
+  // Draws a new cloud of equal weights from `weights` (ParticleFilterOptions::resampling).
+  void ResampleCloud(const std::vector<double>& weights);
+
   void Predict(const Pose2& odometry_increment);
   double Quality(float score, std::size_t num_points) const;
   // Every particle that carries weight lies within unimodal_radius_m / unimodal_yaw_rad of `mean`.
@@ -90,9 +131,25 @@ class ParticleFilter {
   };
   // Forgets the places followed while lost.
   void ClearCandidates();
-  // One update while lost; false when tracking resumes and the scan is to be filtered as usual.
+  // Forgets the places and the search grids of the lost state.
+  void ForgetSearch();
+  // One update while lost: follow the candidate places, gather the map's best places, decide.
+  // False when tracking resumes and the scan is to be filtered as usual.
   bool Relocalise(const std::vector<Eigen::Vector2d>& points, const LaserScan& scan,
                   ParticleFilterStep* step);
+  // The candidates that still explain this scan where the odometry carried them, merged.
+  std::vector<Candidate> FollowCandidates(const std::vector<Eigen::Vector2d>& points);
+  // Adds the map's best distinct places for this scan (a global search) to `places`.
+  void GatherGlobalPlaces(const std::vector<Eigen::Vector2d>& points,
+                          std::vector<Candidate>* places);
+  // Judges `places` against the tracked hypothesis and the best place near it; keeps the
+  // candidates for the next lost update.
+  LostVerdict Decide(const std::vector<Eigen::Vector2d>& points, const ScoredPose& tracked,
+                     std::vector<Candidate> places);
+  // A new cloud around `place` (reset_sigma_*), tracking from there.
+  void RestartAt(const Pose2& place, ParticleFilterStep* step);
+  // Farther apart than distinct_radius_m or distinct_angle_rad.
+  bool DistinctPlaces(const Pose2& a, const Pose2& b) const;
   void ResumeTracking();
   // The fraction of `points` seen from `pose` that land on observed map cells.
   double ObservedFraction(const std::vector<Eigen::Vector2d>& points, const Pose2& pose) const;
@@ -142,12 +199,6 @@ class ParticleFilter {
   Time lost_since_;
   Pose2 lost_pose_;  // the best pose at the last update before the loss
   Eigen::Vector2d search_centre_ = Eigen::Vector2d::Zero();
-  // A place elsewhere on the map, carried by the odometry from update to update.
-  struct Candidate {
-    Pose2 pose;
-    double quality = 0.0;  // on the latest update
-    int wins = 0;          // lost updates in a row on which it won clearly
-  };
   std::vector<Candidate> candidates_;  // distinct places, followed while lost
   int unsupported_updates_ = 0;        // lost updates in a row with no place elsewhere winning
   std::unique_ptr<CorrelativeMatcher> global_matcher_;

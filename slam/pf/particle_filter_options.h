@@ -42,10 +42,8 @@ struct RelocalisationOptions {
   /// (new ground says nothing). While lost the filter goes on tracking (only the map is frozen),
   /// and a loss ends in a relocalisation only when a place elsewhere fits clearly better than
   /// anything near the filter on confirm_updates updates in a row, followed through the odometry;
-  /// otherwise tracking resumes. On the ten corrected logs (seed 1) this relocalises twice:
-  /// freiburg-079, rightly, after its estimate ran 3.5 m off, and infinite-corridor (a log the pf
-  /// fails either way; README, "lost-filter detection"). Only the likelihood-field
-  /// observation model has a quality in [0, 1] to watch.
+  /// otherwise tracking resumes. Only the likelihood-field observation model has a quality in
+  /// [0, 1] to watch.
   bool enabled = true;
   /// alpha_fast of the short-term average of the quality: 1 reacts to the first bad scan (a
   /// kidnapped filter soon fits the scan somewhere near by, in a self-similar building, and the dip
@@ -65,7 +63,7 @@ struct RelocalisationOptions {
   /// A place elsewhere must beat the tracked hypothesis (the filter's best particle, or the best
   /// place within slip_radius_m and slip_angle_rad of it) by this fraction of the long-term
   /// quality, on this many lost updates in a row, followed through the odometry, before the cloud
-  /// is put there. 2 updates relocalise the kidnapped office within 1.8 s.
+  /// is put there.
   double win_margin = 0.1;
   int confirm_updates = 2;
   /// The global search returns this many distinct places (non-maximum suppression: apart by more
@@ -80,8 +78,7 @@ struct RelocalisationOptions {
   /// and waits for a scan that tells them apart (or for max_lost_s).
   double ambiguity_margin = 0.05;
   /// Lost updates in a row on which no place elsewhere wins after which tracking resumes where
-  /// the filter is, however poorly it fits there: no evidence for a kidnapping came. Intel,
-  /// falsely lost once at 2263 s: 0.186 m ATE with 4, 0.171 with 2 (0.174 with relocalisation off).
+  /// the filter is, however poorly it fits there: no evidence for a kidnapping came.
   int resume_updates = 2;
   /// A place within this of the tracked one that fits better than it (and nothing elsewhere
   /// clearly better still) is the odometry slipping by more than the shift search covers, not a
@@ -92,10 +89,7 @@ struct RelocalisationOptions {
   /// The global search's raster: the map max-pooled to this (rounded to a whole number of map
   /// cells, at least one), each place it finds then matched at the map's resolution (the shift
   /// search and refinement that tracking uses). The search's cost falls with the cube of the
-  /// ratio (translations in x and y, and headings, whose step follows the resolution): at the
-  /// map's 0.05 m each distinct place cost 1.6-2.4 s of CPU on intel's map, three quarters of a
-  /// default run (17.0 s -> 4.3 s at 0.2 m). On the ten corrected logs and the kidnapping
-  /// scenario 0.2 m relocalises where 0.05 m did, on the same scans.
+  /// ratio (translations in x and y, and headings, whose step follows the resolution).
   double search_resolution_m = 0.2;
   /// The global search covers x and y within this of where the filter was lost (all of a
   /// building's floor; it bounds the cost on a city-sized map), every heading.
@@ -140,9 +134,8 @@ void VisitFields(V& v, RelocalisationOptions& o) {
 
 /// Everything the particle filter can be told. Defaults are the improved filter (likelihood
 /// field, x/y/yaw search, best-shift moves, Gauss-Newton refinement, rot-trans-rot noise,
-/// systematic resampling, updates every 0.25 m or 0.1 rad; tuned on intel-corrected over 16
-/// seeds, ATE 0.07-0.12 m, and on the simulated office, ATE ~0.02 m);
-/// `ReportsPreset()` reproduces the ECE276A reports.
+/// systematic resampling, updates every 0.25 m or 0.1 rad); `ReportsPreset()` reproduces the
+/// ECE276A reports.
 struct ParticleFilterOptions {
   int num_particles = 100;
   std::uint64_t seed = 1;  ///< one RNG stream for prediction and resampling
@@ -150,19 +143,34 @@ struct ParticleFilterOptions {
   MotionNoiseModel motion_noise = MotionNoiseModel::kRotTransRot;
   double sigma_xy_m = 0.01;      ///< kGaussianPerStep: per step, x and y (world frame)
   double sigma_yaw_rad = 0.005;  ///< kGaussianPerStep: per step, yaw
-  RotTransRotNoise rot_trans_rot{0.02, 0.01, 0.01, 0.0005, 0.005, 0.003};  ///< kRotTransRot
+  RotTransRotNoise rot_trans_rot{.alpha1 = 0.02,
+                                 .alpha2 = 0.01,
+                                 .alpha3 = 0.01,
+                                 .alpha4 = 0.0005,
+                                 .min_trans_sigma_m = 0.005,
+                                 .min_rot_sigma_rad = 0.003};  ///< kRotTransRot
   /// The odometry's heading drift per metre, fitted online and taken out of the prediction.
   OdometryCalibrationOptions odometry_calibration;
 
   ObservationModel observation = ObservationModel::kLikelihoodField;
-  ScanPointsOptions points{0.1, 30.0, 1, 0.05};  ///< beams used for weighting (voxel-filtered)
+  /// The beams used for weighting (voxel-filtered).
+  ScanPointsOptions points{
+      .min_range_m = 0.1, .max_range_m = 30.0, .beam_stride = 1, .voxel_size_m = 0.05};
   /// The shift search: 9x9 cells and 9 yaws 0.0075 rad apart. With kLikelihoodField its `value`
   /// must be kRawValue.
-  MapCorrelatorOptions correlation{4, 4, 0.0075, CorrelationValue::kRawValue, 0.0f};
+  MapCorrelatorOptions correlation{.xy_half_width_cells = 4,
+                                   .yaw_half_steps = 4,
+                                   .yaw_step_rad = 0.0075,
+                                   .value = CorrelationValue::kRawValue,
+                                   .occupied_threshold = 0.0f};
   /// The field's sigma: likelihood_field.sigma_m to start with, then following the map's own
   /// sharpness (AdaptiveSigmaOptions; `adaptive_sigma.enabled: false` keeps it). Needs the
   /// likelihood-field observation model: with `observation: correlation` turn it off.
-  LikelihoodFieldOptions likelihood_field{0.08, 0.9, 0.1, 0.0f, 3.0};
+  LikelihoodFieldOptions likelihood_field{.sigma_m = 0.08,
+                                          .z_hit = 0.9,
+                                          .z_rand = 0.1,
+                                          .occupied_threshold = 0.0f,
+                                          .cutoff_sigmas = 3.0};
   AdaptiveSigmaOptions adaptive_sigma;
   /// log-weight += observation_scale * score (the softmax temperature; 1 in the reports).
   double observation_scale = 0.5;
@@ -182,21 +190,14 @@ struct ParticleFilterOptions {
   /// Beams meeting their surface at a larger incidence angle (beam to surface normal, the normal
   /// from the neighbouring points) are left out of the weighting and the degeneracy analysis.
   /// pi / 2 (the default) keeps every point: with the degeneracy handling on, dropping grazing
-  /// points also drops the near walls' constraints and did worse in the corridor.
+  /// points also drops the near walls' constraints, which the corridor needs.
   double max_incidence_rad = 1.5707963267948966;
 
   /// When every particle that carries weight lies within unimodal_radius_m and unimodal_yaw_rad
-  /// of the weighted mean, the mean is the estimate and the map is updated there (intel-corrected,
-  /// 100 particles, seeds 1-4: ATE 0.075-0.174 -> 0.068-0.086 m; seeds 5-8: 0.071-0.082 m); a
-  /// spread-out or split cloud, or a scan with a degenerate direction, keeps its best particle.
-  /// 0 = always the best particle: the default, because with 0.1 the simulated office's map F1
-  /// fell below 0.7 (0.68) and infinite-corridor went 4.96 -> 8.27 m, acapulco (seed 1) 0.081 ->
-  /// 0.180 m, while fhw 0.219 -> 0.126, aces 0.930 -> 0.366 and freiburg-079 1.31 -> 1.26 m.
-  /// 0.05 is no safer (seed 1): intel 0.174 -> 0.081 m, aces 0.26, but acapulco 0.164,
-  /// belgioioso 0.191 -> 0.662 and edmonton 0.669 -> 1.579 m. Intel seed 1's 0.174 m is a slow
-  /// heading drift (~0.02 rad) on the first lap's new ground (scans 52-95), closed at scan 96 in
-  /// one update but left in the map, so later passes follow the bent part; no corridor slide
-  /// (weak-to-strong ratios there 0.14-0.89) and no best-particle switch (the mean ends the same).
+  /// of the weighted mean, the mean is the estimate and the map is updated there; a spread-out or
+  /// split cloud, or a scan with a degenerate direction, keeps its best particle. 0 = always the
+  /// best particle: the default, because the mean helps some logs and hurts others as much
+  /// (docs/studies/from-code-comments.md).
   double unimodal_radius_m = 0.0;
   double unimodal_yaw_rad = 0.1;
 
@@ -210,13 +211,13 @@ struct ParticleFilterOptions {
 
   /// Filter only after the robot moved this far or turned this much since the last update
   /// (GMapping's linear/angular update); in between, poses follow the odometry and the map is
-  /// left alone (inserting every 40 Hz scan wore walls away: office ATE 0.025 -> 0.16 m).
-  /// 0 and 0: every scan, as in the reports.
+  /// left alone (inserting every scan of a 40 Hz lidar wears the walls away). 0 and 0: every
+  /// scan, as in the reports.
   double min_update_distance_m = 0.25;
   double min_update_angle_rad = 0.1;
 
-  int num_threads =
-      1;  ///< worker threads for the per-particle scoring (results do not depend on it)
+  /// Worker threads for the per-particle scoring (results do not depend on it).
+  int num_threads = 1;
 
   /// The ECE276A reports' method: Gaussian prediction noise, all beams, 9x9 x/y shifts, no yaw
   /// shift, softmax of correlations, stratified resampling at Neff < N/2, particles not moved,

@@ -28,7 +28,7 @@ RbpfPoseNode::~RbpfPoseNode() {
 
 Rbpf::Rbpf(const RbpfOptions& options)
     : options_(options), matcher_(options.matcher), rng_(options.seed) {
-  SLAMRIG_CHECK(options_.Validate().empty(), "invalid RbpfOptions");
+  SLAMRIG_CHECK_VALID(options_, "RbpfOptions");
   if (options_.num_threads > 1) pool_ = std::make_unique<ThreadPool>(options_.num_threads);
 }
 
@@ -157,8 +157,7 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
   //    eps / window area (yaw still from the Gaussian: the failures this guards against, slip
   //    and a reversal counted as forward motion, are of the translation).
   // Each is scored by its observation likelihood (observation_scale, untempered: tempered like
-  // the weights, the check missed freiburg-079's reversals and ended 4.17 m off) times that
-  // density.
+  // the weights, the check misses reversals counted as forward motion) times that density.
   // Without a failure the window's best match is the prediction's or one the density ratio
   // outweighs (a corridor's axis gives equal likelihoods: the odometry wins there).
   const RbpfParticle& best = particles_[best_];
@@ -228,8 +227,8 @@ Pose2 Rbpf::RemapDegenerate(const TiledGrid& map, const std::vector<MatchPoint>&
   // translation Hessian of its log-likelihood at the far match) is a small fraction of its
   // information along the best-determined one, the scan cannot place the robot (a corridor's
   // axis), so the far match's displacement from the near one is dropped there and the odometry
-  // stands. On intel the check otherwise moved the robot 1.3 m along a corridor whose far end
-  // the scan matched a little better.
+  // stands: otherwise the check moves the robot along a corridor whose far end the scan happens
+  // to match a little better.
   const double ratio = options_.odometry_degenerate_ratio;
   if (ratio <= 0.0) return far;
   const double h = options_.map.resolution_m;

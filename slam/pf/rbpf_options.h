@@ -42,7 +42,9 @@ struct RbpfOptions {
   int num_particles = 30;
   std::uint64_t seed = 1;  ///< seeds one stream per particle and step, and the resampling
 
-  ScanPointsOptions points{0.1, 30.0, 1, 0.05};  ///< beams used for matching (voxel-filtered)
+  /// The beams used for matching (voxel-filtered).
+  ScanPointsOptions points{
+      .min_range_m = 0.1, .max_range_m = 30.0, .beam_stride = 1, .voxel_size_m = 0.05};
   RbpfMatcherOptions matcher;
   RbpfMotionNoise motion;
   /// The proposal's sample points: a 3 x 3 x 3 grid of these steps around the match (GMapping's
@@ -60,9 +62,9 @@ struct RbpfOptions {
   /// The importance weight is multiplied by eta ^ weight_exponent, not by eta: a tempered weight
   /// (GMapping flattens its weights in the same way, obsSigmaGain), on top of the independent-point
   /// factor below. The proposal and the odometry check keep the full observation_scale (a
-  /// tempered check missed freiburg-079's reversals). 1 = no further tempering (the default: a
-  /// uniform 0.25 or 0.5 flattens the sparse scans of open halls as much as the dense ones of
-  /// corridors, and lost aces and edmonton; README "Rao-Blackwellised particle filter").
+  /// tempered check misses reversals the odometry reports as forward motion). 1 = no further
+  /// tempering (the default: a uniform exponent flattens the sparse scans of open halls as much
+  /// as the dense ones of corridors).
   double weight_exponent = 1.0;
   /// Tempering from the scan's independent points: end points closer than this to each other
   /// count as one piece of evidence (CountIndependentPoints), and the weight takes eta ^ (e *
@@ -72,12 +74,8 @@ struct RbpfOptions {
   /// share their errors (Thrun, Burgard, Fox, Probabilistic Robotics, Sec. 6.4 and 6.8: beam
   /// dependence, met by subsampling or damping). So a dense scan (many beams on a few walls) is
   /// flattened to the number of points it holds at this spacing, a sparse one (15 end points in
-  /// an open hall) is left untempered. 0 = off. Default 0.1 m (twice likelihood_sigma_m), with
-  /// cell_hit_means: untempered, intel with 100 particles resamples at 598 of 909 updates and ends
-  /// 0.085-0.210 m off over seeds 1-5; with both 0.055-0.067 m. At 30 particles on the ten
-  /// corrected logs it is better on seven (edmonton over seven seeds), the same on freiburg-101
-  /// and seattle, and worse on acapulco by 0.024 m in the mean over nine seeds (README, "The
-  /// study that decides the default").
+  /// an open hall) is left untempered. 0 = off. Default 0.1 m (twice likelihood_sigma_m), the
+  /// setting docs/studies/from-code-comments.md compares.
   double weight_correlation_length_m = 0.1;
   /// How weight_correlation_length_m tempers: false, one factor for the whole scan (above); true,
   /// per point (AssignIndependenceWeights): each point's log-likelihood in the weight counts 1 /
@@ -85,9 +83,8 @@ struct RbpfOptions {
   /// evidence and an isolated far point fully, where the scan's factor discounts both alike. The
   /// weight's eta is then the proposal grid's mean of the tempered likelihood times the motion
   /// prior; the proposal, the odometry check and the best path keep the untempered likelihood.
-  /// Not the default: with cell_hit_means and 0.1 m it keeps acapulco (30 particles, seeds 1-3
-  /// median 0.144 m, the scan's factor 0.217) but freiburg-079 diverges on two seeds of three
-  /// (README, "Tempering per point").
+  /// Not the default: it diverges on logs whose odometry reverses (docs/studies/
+  /// from-code-comments.md).
   bool weight_correlation_per_point = false;
 
   /// The odometry check: the odometry model is a mixture, with this probability of a failed

@@ -13,6 +13,22 @@ inline double NormalizeAngle(double angle_rad) {
   return a;
 }
 
+/// The matrix that rotates a vector by `yaw_rad`: [cos -sin; sin cos].
+inline Eigen::Matrix2d RotationMatrix(double yaw_rad) {
+  const double c = std::cos(yaw_rad), s = std::sin(yaw_rad);
+  Eigen::Matrix2d r;
+  r << c, -s, s, c;
+  return r;
+}
+
+/// A covariance of (x, y, yaw) expressed in a frame rotated by `yaw_rad`: J P J^T with
+/// J = diag(R(yaw_rad), 1). The yaw variance is unchanged.
+inline Eigen::Matrix3d RotateCovariance(const Eigen::Matrix3d& covariance, double yaw_rad) {
+  Eigen::Matrix3d j = Eigen::Matrix3d::Identity();
+  j.topLeftCorner<2, 2>() = RotationMatrix(yaw_rad);
+  return j * covariance * j.transpose();
+}
+
 /// A rigid transform in SE(2): rotation by `theta` then translation by (x, y).
 /// Read `a_from_b` as the pose of frame b expressed in frame a, so that
 /// `world_from_robot * robot_from_laser == world_from_laser`. `theta` is always in (-pi, pi].
@@ -26,6 +42,8 @@ class Pose2 {
   double y() const { return y_; }
   double theta() const { return theta_; }
   Eigen::Vector2d translation() const { return {x_, y_}; }
+  /// The rotation part as a matrix: R(theta), so that (*this) * p == R p + translation().
+  Eigen::Matrix2d Rotation() const { return RotationMatrix(theta_); }
 
   /// Composition: (*this) followed by `other`, i.e. a_from_c = a_from_b * b_from_c.
   Pose2 operator*(const Pose2& other) const {

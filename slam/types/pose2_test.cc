@@ -91,5 +91,39 @@ TEST(Pose2Test, HandComputedComposition) {
   EXPECT_NEAR(hit.y(), 3.0, 1e-12);
 }
 
+TEST(Pose2Test, RotationMatchesPointTransform) {
+  std::mt19937_64 rng(6);
+  std::uniform_real_distribution<double> xy(-10.0, 10.0);
+  for (int i = 0; i < kNumTrials; ++i) {
+    const Pose2 a = RandomPose(rng);
+    const Eigen::Vector2d p(xy(rng), xy(rng));
+    ASSERT_NEAR((a * p - (a.Rotation() * p + a.translation())).norm(), 0.0, 1e-9);
+    ASSERT_NEAR((a.Rotation().transpose() * a.Rotation() - Eigen::Matrix2d::Identity()).norm(), 0.0,
+                1e-12);
+  }
+  // A quarter turn maps +x onto +y.
+  const Eigen::Vector2d y = RotationMatrix(kPi / 2) * Eigen::Vector2d(1.0, 0.0);
+  EXPECT_NEAR(y.x(), 0.0, 1e-15);
+  EXPECT_NEAR(y.y(), 1.0, 1e-15);
+}
+
+TEST(Pose2Test, RotateCovarianceTurnsTheTranslationBlockOnly) {
+  // Variance 4 along x and 1 along y, turned by a quarter turn: 1 along x and 4 along y, and the
+  // x-yaw correlation becomes a y-yaw one.
+  Eigen::Matrix3d p;
+  p << 4.0, 0.0, 0.5, 0.0, 1.0, 0.0, 0.5, 0.0, 0.25;
+  const Eigen::Matrix3d q = RotateCovariance(p, kPi / 2);
+  Eigen::Matrix3d expected;
+  expected << 1.0, 0.0, 0.0, 0.0, 4.0, 0.5, 0.0, 0.5, 0.25;
+  EXPECT_NEAR((q - expected).norm(), 0.0, 1e-12);
+  // Turning there and back is the identity.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> angle(-4.0, 4.0);
+  for (int i = 0; i < 1000; ++i) {
+    const double a = angle(rng);
+    ASSERT_NEAR((RotateCovariance(RotateCovariance(p, a), -a) - p).norm(), 0.0, 1e-12);
+  }
+}
+
 }  // namespace
 }  // namespace slamrig
