@@ -32,6 +32,30 @@ void CheckNonNegative(std::vector<std::string>* errors, const char* field, doubl
   }
 }
 
+// The standard normal draws of the odometry noise. One set serves every odometry record between
+// two scans (the records' noise is fully correlated within a scan interval), so an increment
+// between scans, the motion SLAM sees, gets sigma = noise_per_m * |t| whatever the odometry
+// rate of the log; a log without scans draws anew for each record.
+class NoiseDraws {
+ public:
+  NoiseDraws(RandomStream* rng, bool per_record) : rng_(rng), per_record_(per_record) {}
+  void NewInterval() { stale_ = true; }
+  const Eigen::Vector3d& Get() {
+    if (stale_ || per_record_) {
+      const double x = rng_->Gaussian(), y = rng_->Gaussian(), r = rng_->Gaussian();
+      draws_ = {x, y, r};
+      stale_ = false;
+    }
+    return draws_;
+  }
+
+ private:
+  RandomStream* rng_;
+  bool per_record_;
+  bool stale_ = true;
+  Eigen::Vector3d draws_ = Eigen::Vector3d::Zero();
+};
+
 // A perturbed increment.
 struct Step {
   Eigen::Vector2d translation;
@@ -41,26 +65,28 @@ struct Step {
 // The increment (t, theta) perturbed: noise on both axes of t when `lateral` (else along x only),
 // rotation noise proportional to `rotation_for_noise`.
 Step PerturbStep(const OdometryPerturbation& p, const Eigen::Vector2d& t, double theta,
-                 double rotation_for_noise, bool lateral, RandomStream* rng) {
+                 double rotation_for_noise, bool lateral, NoiseDraws* draws) {
+  const Eigen::Vector3d& n = draws->Get();
   const double length = t.norm();
-  Eigen::Vector2d noise(rng->Gaussian(), lateral ? rng->Gaussian() : 0.0);
   Step s;
-  s.translation = p.scale * t + p.noise_per_m * length * noise;
-  s.theta = theta + p.bias_rad_per_m * length +
-            p.noise_per_rad * std::abs(rotation_for_noise) * rng->Gaussian();
+  s.translation =
+      p.scale * t + p.noise_per_m * length * Eigen::Vector2d(n.x(), lateral ? n.y() : 0.0);
+  s.theta =
+      theta + p.bias_rad_per_m * length + p.noise_per_rad * std::abs(rotation_for_noise) * n.z();
   return s;
 }
 
 // OdometryPose streams: perturb each increment, re-accumulate from the first pose.
-void PerturbPoses(std::vector<Record>* records, const OdometryPerturbation& p, RandomStream* rng) {
+void PerturbPoses(std::vector<Record>* records, const OdometryPerturbation& p, NoiseDraws* draws) {
   std::optional<Pose2> previous_original, previous_perturbed;
   for (Record& r : *records) {
+    if (std::holds_alternative<LaserScan>(r)) draws->NewInterval();
     auto* odometry = std::get_if<OdometryPose>(&r);
     if (odometry == nullptr) continue;
     const Pose2 original = odometry->odom_from_base;
     if (previous_original) {
       const Pose2 u = previous_original->Between(original);
-      const Step s = PerturbStep(p, u.translation(), u.theta(), u.theta(), true, rng);
+      const Step s = PerturbStep(p, u.translation(), u.theta(), u.theta(), true, draws);
       odometry->odom_from_base =
           *previous_perturbed * Pose2(s.translation.x(), s.translation.y(), s.theta);
     }
@@ -84,12 +110,13 @@ void AddTicks(std::vector<std::int32_t>* wheels, double delta, double* carry) {
 // gyro rates of the IMU samples in its interval (those after the previous ticks record, stamped
 // after it: the ones WheelOdometry integrates with it).
 void PerturbTicks(std::vector<Record>* records, const OdometryPerturbation& p,
-                  const DiffDriveParams& robot, RandomStream* rng) {
+                  const DiffDriveParams& robot, NoiseDraws* draws) {
   const double metres_per_tick = robot.MetresPerTick();
   double carry_right = 0.0, carry_left = 0.0;
   std::optional<Time> previous_time;
   std::vector<ImuSample*> interval_imu;
   for (Record& r : *records) {
+    if (std::holds_alternative<LaserScan>(r)) draws->NewInterval();
     if (auto* imu = std::get_if<ImuSample>(&r)) {
       if (!previous_time || imu->time > *previous_time) interval_imu.push_back(imu);
       continue;
@@ -113,7 +140,7 @@ void PerturbTicks(std::vector<Record>* records, const OdometryPerturbation& p,
       gyro_yaw *= dt / static_cast<double>(interval_imu.size());
     }
     const Step s =
-        PerturbStep(p, Eigen::Vector2d(distance, 0.0), yaw, gyro ? gyro_yaw : yaw, false, rng);
+        PerturbStep(p, Eigen::Vector2d(distance, 0.0), yaw, gyro ? gyro_yaw : yaw, false, draws);
     const double yaw_change = s.theta - yaw;
     const double right_new = s.translation.x() + 0.5 * robot.track_width_m * s.theta;
     const double left_new = s.translation.x() - 0.5 * robot.track_width_m * s.theta;
@@ -294,16 +321,28 @@ LogPerturbation LogPerturbationFromFlags(const std::vector<std::string>& flags) 
 void ApplyLogPerturbation(Dataset* data, const LogPerturbation& p, std::uint64_t seed,
                           const DiffDriveParams& robot) {
   if (!p.Active() || data->records.empty()) return;
+  const std::size_t records_before = data->records.size();
   const OdometryPerturbation& o = p.odometry;
   if (o.noise_per_m != 0.0 || o.noise_per_rad != 0.0 || o.scale != 1.0 || o.bias_rad_per_m != 0.0) {
+    const bool has_scans =
+        std::any_of(data->records.begin(), data->records.end(),
+                    [](const Record& r) { return std::holds_alternative<LaserScan>(r); });
     RandomStream rng(seed, "perturb.odometry");
-    PerturbPoses(&data->records, o, &rng);
-    PerturbTicks(&data->records, o, robot, &rng);
+    NoiseDraws pose_draws(&rng, !has_scans);
+    PerturbPoses(&data->records, o, &pose_draws);
+    NoiseDraws tick_draws(&rng, !has_scans);
+    PerturbTicks(&data->records, o, robot, &tick_draws);
   }
-  if (!o.lost.empty()) DropLostOdometry(&data->records, o, RecordTime(data->records.front()));
+  std::size_t lost = 0, dropped = 0;
+  if (!o.lost.empty()) {
+    DropLostOdometry(&data->records, o, RecordTime(data->records.front()));
+    lost = records_before - data->records.size();
+  }
   if (p.scans.drop_fraction > 0.0) {
     RandomStream rng(seed, "perturb.scans");
+    const std::size_t before = data->records.size();
     DropScans(data, p.scans.drop_fraction, &rng);
+    dropped = before - data->records.size();
   }
   if (p.range.noise_m > 0.0 || p.range.max_m > 0.0 || p.beams.drop_every > 0 ||
       p.beams.drop_fraction > 0.0) {
@@ -312,6 +351,9 @@ void ApplyLogPerturbation(Dataset* data, const LogPerturbation& p, std::uint64_t
       if (auto* scan = std::get_if<LaserScan>(&r)) PerturbScan(scan, p, &range_rng, &beam_rng);
     }
   }
+  data->notes.push_back("records perturbed at read time (seed " + std::to_string(seed) +
+                        "; the reference is not): " + std::to_string(dropped) + " scans dropped, " +
+                        std::to_string(lost) + " odometry records removed in lost intervals");
 }
 
 OdometryNoiseMeasurement MeasureOdometryNoise(const Dataset& data, const ScanSyncOptions& sync) {

@@ -104,6 +104,11 @@ LogPerturbation LogPerturbationFromFlags(const std::vector<std::string>& flags);
 /// Applies `perturbation` to `data.records` in place, drawing from RandomStreams of `seed`
 /// named "perturb.odometry", "perturb.scans", "perturb.range" and "perturb.beams" (so the same
 /// seed gives the same perturbation, and each kind's draws do not depend on the others).
+/// The odometry noise is drawn once per scan interval: every odometry record between two scans
+/// uses the same standard normal draws, so the increment between two scans (what SLAM sees, and
+/// what MeasureOdometryNoise measures) gets sigma = noise_per_m * |t| and noise_per_rad * |theta|
+/// whatever the log's odometry rate (independent draws per record would shrink it by the square
+/// root of the records per scan). A log without scans draws per record.
 /// Odometry is perturbed in the form each record has:
 /// - OdometryPose streams (CARMEN ODOM, a bag's /odom): each increment u = O_{k-1}^-1 O_k gets
 ///   t' = scale * t + N(0, (noise_per_m |t|)^2) per axis and theta' = theta + bias * |t| +

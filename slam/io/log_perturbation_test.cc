@@ -437,6 +437,29 @@ TEST(LogPerturbationTest, BadKeysAndValuesNameTheKeyInOneLine) {
   EXPECT_EQ(ok.odometry.lost[1], Eigen::Vector2d(4, 5));
 }
 
+// Four odometry poses per scan: the noise is drawn per scan interval, so the increments between
+// scans carry the requested sigma (independent draws per record would carry half of it).
+TEST(LogPerturbationTest, NoisePerScanIntervalWhateverTheOdometryRate) {
+  Dataset d;
+  Pose2 pose;
+  for (int k = 0; k < 20000; ++k) {
+    const double t = 0.025 * k;
+    pose = pose * Pose2(0.1, 0.0, 0.02 * std::sin(0.01 * k));
+    d.records.push_back(OdometryPose{Time::FromSeconds(t), pose});
+    if (k % 4 == 3) {
+      d.records.push_back(MakeScan(t, 1));
+      d.reference.push_back({Time::FromSeconds(t), pose});
+    }
+  }
+  LogPerturbation p;
+  p.odometry.noise_per_m = 0.05;
+  ApplyLogPerturbation(&d, p, 6);
+  ScanSyncOptions sync;
+  sync.source = OdometrySource::kOdometryPoses;
+  const OdometryNoiseMeasurement m = MeasureOdometryNoise(d, sync);
+  EXPECT_NEAR(m.noise_per_m, 0.05, 0.002);
+}
+
 // The measurement recovers the noise ApplyLogPerturbation added to a noise-free log.
 TEST(LogPerturbationTest, MeasurementRecoversAddedNoise) {
   Dataset d = PoseLog(5000, 2);
