@@ -30,6 +30,8 @@ const std::vector<Command>& Commands() {
       {"sweep", "run a scenario over a grid of parameters and seeds, all cores", RunSweepCommand},
       {"optimize", "optimise a 2D pose graph (g2o file) with Ceres: chi2, iterations, time",
        RunOptimizeCommand},
+      {"odometry-noise", "a log's own odometry error per scan against its reference",
+       RunOdometryNoiseCommand},
   };
   return commands;
 }

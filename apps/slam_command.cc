@@ -20,6 +20,7 @@
 #include "slam/eval/trajectory_metrics.h"
 #include "slam/fusion/consistency.h"
 #include "slam/io/atomic_file.h"
+#include "slam/io/log_perturbation.h"
 #include "slam/io/log_reader.h"
 #include "slam/io/map_image.h"
 #include "slam/io/map_server.h"
@@ -129,7 +130,7 @@ slam::EstimatorConfig ConfigFromFlags(
 int RunSlamCommand(const std::vector<std::string>& args) {
   std::string log_path, out_dir, algorithm = "pf", preset, odometry = "auto";
   std::string truth_map_path, particles, threads, resolution;
-  std::vector<std::string> sets, topic_flags;
+  std::vector<std::string> sets, topic_flags, perturb_flags;
   int clouds = 0, max_scans = 0;
   std::uint64_t seed = 1;
   bool no_gyro = false, lenient = false, quiet = false;
@@ -172,6 +173,12 @@ int RunSlamCommand(const std::vector<std::string>& args) {
                      "a ROS 2 bag's topic to read, e.g. scan=/front/scan (keys: " +
                          std::string(slam::BagTopicNames::Keys()) + ")",
                      &topic_flags);
+  parser.AddRepeated("perturb", "KEY=VALUE",
+                     "perturb the log's records as read, seeded by --seed (odometry.noise_per_m, "
+                     "odometry.noise_per_rad, odometry.scale, odometry.bias_rad_per_m, "
+                     "odometry.lost=[[T0, T1]], scans.drop_fraction, range.noise_m, range.max_m, "
+                     "beams.drop_every, beams.drop_fraction); the reference is not perturbed",
+                     &perturb_flags);
   parser.AddFlag("quiet", "no progress output", &quiet);
   if (!parser.Parse(args)) return 0;
   if (out_dir.empty()) throw ConfigError("slamrig slam: --out DIR is required");
@@ -188,13 +195,15 @@ int RunSlamCommand(const std::vector<std::string>& args) {
     fields.push_back({"map.resolution_m=" + resolution, "--resolution " + resolution});
   for (const std::string& s : sets) fields.push_back({s, "--set " + s});
   const slam::EstimatorConfig base = ConfigFromFlags(algorithm, preset, fields, odometry, no_gyro);
+  const slam::LogPerturbation perturbation = slam::LogPerturbationFromFlags(perturb_flags);
 
   // Read and run everything before creating any output, so bad input leaves nothing behind.
   slam::LogReadOptions read;
   read.lenient = lenient;
   read.topics = ParseTopicFlags("slamrig slam", topic_flags);
   const std::string path = slam::ResolveLogPath(log_path);
-  const slam::Dataset data = slam::ReadLog(path, read);
+  slam::Dataset data = slam::ReadLog(path, read);
+  slam::ApplyLogPerturbation(&data, perturbation, seed, base.odometry.robot);
   slam::EstimatorConfig config = base;
   Trajectory reference;
   for (const GroundTruthPose& g : data.reference) reference.Append(g.time, g.map_from_base);

@@ -444,7 +444,8 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
 }
 
 ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
-  const slam::Dataset data = slam::ReadLog(spec.log->path, spec.log->read);
+  slam::Dataset data = slam::ReadLog(spec.log->path, spec.log->read);
+  slam::ApplyLogPerturbation(&data, spec.log->perturb, spec.seed, spec.log->robot);
   ScenarioResult result;
   result.spec = &spec;
   result.notes = data.notes;

@@ -340,7 +340,15 @@ std::string ResolvedYaml(const ScenarioSpec& spec, const std::vector<std::string
                             "tf_static", "clock", "rgb", "depth", "camera_info"}) {
       out << YAML::Key << key << YAML::Value << *topics.Find(key);
     }
-    out << YAML::EndMap << YAML::EndMap;
+    out << YAML::EndMap;
+    if (spec.log->perturb.Active()) {
+      out << YAML::Key << "perturb" << YAML::Value << YAML::BeginMap;
+      FieldWriter writer(&out);
+      slam::LogPerturbation perturb = spec.log->perturb;
+      VisitFields(writer, perturb);
+      out << YAML::EndMap;
+    }
+    out << YAML::EndMap;
   }
   if (spec.simulated && spec.simulated->options.robot.camera) {
     out << YAML::Key << "texture" << YAML::Value << YAML::Load(ToYaml(spec.texture, ""));
@@ -425,6 +433,8 @@ LogSource ReadLogSource(const YamlNode& root, const YamlNode& source, const std:
     }
     topics->ThrowIfInvalid(log.read.topics.Validate());
   }
+  if (const auto perturb = source.Optional("perturb"))
+    log.perturb = slam::ParseLogPerturbation(*perturb);
   if (const auto robot_node = root.Optional("robot")) {
     YamlNode robot = WorldOrRobot(*robot_node, path, "robots");
     for (const auto& [k, v] : sets.robot) robot.Override(k, v, "--set robot." + k + "=" + v);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "sim/simulator.h"
+#include "slam/io/log_perturbation.h"
 #include "slam/io/log_reader.h"
 #include "slam/pipeline/estimator_config.h"
 #include "slam/texture/texture_map.h"
@@ -44,7 +45,8 @@ struct SimulatedSource {
 struct LogSource {
   std::string path;  ///< as resolved (ResolveLogPath)
   slam::LogReadOptions read;
-  slam::DiffDriveParams robot;  ///< wheel geometry for logs with encoder ticks (ECE276A default)
+  slam::LogPerturbation perturb;  ///< applied to the records as read (none by default)
+  slam::DiffDriveParams robot;    ///< wheel geometry for logs with encoder ticks (ECE276A default)
 };
 
 /// The texture map options a scenario uses unless its `texture:` block says otherwise: every

@@ -58,6 +58,32 @@ TEST(ScenarioSpecTest, BadTopicNamesNameFileLineAndKey) {
   EXPECT_NE(not_map.find("topics is a map"), std::string::npos) << not_map;
 }
 
+TEST(ScenarioSpecTest, LogSourceTakesAPerturbation) {
+  const ScenarioSpec spec = LoadScenario(
+      WriteScenario("perturb",
+                    "{log: run.mcap, perturb: {odometry: {noise_per_m: 0.1, lost: [[5, 8]]}, "
+                    "scans: {drop_fraction: 0.1}}}"));
+  ASSERT_TRUE(spec.log);
+  EXPECT_EQ(spec.log->perturb.odometry.noise_per_m, 0.1);
+  ASSERT_EQ(spec.log->perturb.odometry.lost.size(), 1u);
+  EXPECT_EQ(spec.log->perturb.scans.drop_fraction, 0.1);
+  // The resolved file carries it, so that it repeats the run.
+  const ScenarioSpec again = LoadScenario(WriteScenario("again", "{log: run.mcap}"));
+  EXPECT_NE(spec.resolved_yaml.find("perturb:"), std::string::npos) << spec.resolved_yaml;
+  EXPECT_NE(spec.resolved_yaml.find("drop_fraction: 0.1"), std::string::npos);
+  EXPECT_EQ(again.resolved_yaml.find("perturb:"), std::string::npos) << again.resolved_yaml;
+
+  const std::string unknown =
+      ErrorOf(WriteScenario("ptypo", "{log: run.mcap, perturb: {scans: {dropfraction: 1}}}"));
+  EXPECT_NE(unknown.find("s.yaml:2:"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("source.perturb.scans.dropfraction"), std::string::npos) << unknown;
+  const std::string bad =
+      ErrorOf(WriteScenario("pbad", "{log: run.mcap, perturb: {range: {noise_m: -1}}}"));
+  EXPECT_NE(bad.find("s.yaml:2:"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("source.perturb.range.noise_m = -1; must be in [0, 100]"), std::string::npos)
+      << bad;
+}
+
 // A path in a scenario's robot_overrides is relative to the scenario file, and errors about it
 // name the scenario's line, not the robot file's.
 TEST(ScenarioSpecTest, RobotOverridePathsAreRelativeToTheScenario) {

@@ -47,6 +47,8 @@ std::vector<std::string> LidarOptions::Validate() const {
                                          ")");
   require(range_noise_stddev_m >= 0.0,
           "range_noise_stddev_m = " + FormatNumber(range_noise_stddev_m) + "; must be >= 0");
+  require(range_noise_fraction >= 0.0 && range_noise_fraction <= 1.0,
+          "range_noise_fraction = " + FormatNumber(range_noise_fraction) + "; must be in [0, 1]");
   require(range_resolution_m >= 0.0,
           "range_resolution_m = " + FormatNumber(range_resolution_m) + "; must be >= 0");
   require(short_decay_per_m > 0.0,
@@ -87,7 +89,12 @@ double LidarModel::Measure(double true_range_m) {
     return o.range_max_m;
   } else {
     z = true_range_m;
-    if (o.range_noise_stddev_m > 0.0) z += o.range_noise_stddev_m * rng_.Gaussian();
+    if (o.range_noise_fraction > 0.0) {
+      z += std::hypot(o.range_noise_stddev_m, o.range_noise_fraction * true_range_m) *
+           rng_.Gaussian();
+    } else if (o.range_noise_stddev_m > 0.0) {
+      z += o.range_noise_stddev_m * rng_.Gaussian();
+    }
   }
   z = std::max(z, 0.0);
   if (o.range_resolution_m > 0.0) {

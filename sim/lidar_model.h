@@ -22,12 +22,15 @@ struct LidarOptions {
   double range_min_m = 0.1;            ///< shorter readings are invalid
   double range_max_m = 30.0;           ///< no return is reported as exactly this
   double range_noise_stddev_m = 0.01;  ///< Gaussian noise on a hit
-  double range_resolution_m = 0.001;   ///< readings are rounded to this (0: none)
-  double p_short = 0.005;              ///< probability of an unexpected short return
-  double short_decay_per_m = 0.5;      ///< rate of the exponential short-return distance
-  double p_max = 0.003;                ///< probability of a dropout (max-range reading)
-  double p_random = 0.002;             ///< probability of a uniform random reading
-  MountPose mount{0.133, 0.0, 0.0};    ///< base_from_laser
+  /// Gaussian noise on a hit proportional to its range (0.01: 1 % of the range, 1 sigma),
+  /// combined with range_noise_stddev_m as the root of the sum of squares.
+  double range_noise_fraction = 0.0;
+  double range_resolution_m = 0.001;  ///< readings are rounded to this (0: none)
+  double p_short = 0.005;             ///< probability of an unexpected short return
+  double short_decay_per_m = 0.5;     ///< rate of the exponential short-return distance
+  double p_max = 0.003;               ///< probability of a dropout (max-range reading)
+  double p_random = 0.002;            ///< probability of a uniform random reading
+  MountPose mount{0.133, 0.0, 0.0};   ///< base_from_laser
 
   /// Angle of beam 0 in the laser frame.
   double angle_min_rad() const;

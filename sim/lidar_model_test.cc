@@ -72,6 +72,37 @@ TEST(LidarModelTest, NoiseAndBeamMixtureHaveTheirRates) {
   EXPECT_NEAR(short_returns / n, 0.05 + 0.03 * 9.9 / 29.9, 0.004);
 }
 
+// Range-proportional noise (an RPLIDAR's "1 % of the range"): the empirical sigma at each range
+// is the root sum of squares of the fixed and the proportional part.
+TEST(LidarModelTest, RangeProportionalNoiseGrowsWithRange) {
+  LidarOptions o;
+  o.range_noise_stddev_m = 0.002;
+  o.range_noise_fraction = 0.01;
+  o.range_resolution_m = 0.0;
+  o.p_short = o.p_max = o.p_random = 0.0;
+  LidarModel model(o, 3);
+  for (const double range : {1.0, 5.0, 20.0}) {
+    std::vector<double> truth(static_cast<std::size_t>(o.num_beams), range);
+    double sum = 0.0, sum2 = 0.0;
+    int n = 0;
+    for (int k = 0; k < 10; ++k) {
+      const LaserScan scan = model.MakeScan(Time::FromSeconds(k), truth);
+      for (const float r : scan.ranges_m) {
+        sum += r - range;
+        sum2 += (r - range) * (r - range);
+        ++n;
+      }
+    }
+    const double expected = std::hypot(0.002, 0.01 * range);
+    // 10,810 samples: the sample sigma's standard error is 0.7 %; 4 % is > 5 of them.
+    EXPECT_NEAR(std::sqrt(sum2 / n), expected, 0.04 * expected) << range;
+    EXPECT_NEAR(sum / n, 0.0, 0.05 * expected) << range;
+  }
+  o.range_noise_fraction = -0.1;
+  ASSERT_EQ(o.Validate().size(), 1u);
+  EXPECT_EQ(o.Validate()[0], "range_noise_fraction = -0.1; must be in [0, 1]");
+}
+
 TEST(LidarModelTest, SameSeedSameNoiseOtherSeedOtherNoise) {
   const LidarOptions o;
   const std::vector<double> truth(static_cast<std::size_t>(o.num_beams), 5.0);

@@ -101,6 +101,7 @@ RobotSpec WithoutNoise(RobotSpec spec) {
   spec.imu.gyro = ImuNoise{};
   spec.imu.accel = ImuNoise{};
   spec.lidar.range_noise_stddev_m = 0.0;
+  spec.lidar.range_noise_fraction = 0.0;
   spec.lidar.range_resolution_m = 0.0;
   spec.lidar.p_short = 0.0;
   spec.lidar.p_max = 0.0;

@@ -115,6 +115,7 @@ void VisitFields(V& v, LidarOptions& l) {
   v("range_min_m", l.range_min_m);
   v("range_max_m", l.range_max_m);
   v("range_noise_stddev_m", l.range_noise_stddev_m);
+  v("range_noise_fraction", l.range_noise_fraction);
   v("range_resolution_m", l.range_resolution_m);
   v("p_short", l.p_short);
   v("short_decay_per_m", l.short_decay_per_m);

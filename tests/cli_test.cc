@@ -138,6 +138,18 @@ TEST(CliTest, BadFlagsFailWithUsageError) {
       Slamrig("slam " + log + " --algorithm rbpf --set weight_exponent=3 --out " + dir.File("o")));
   EXPECT_THAT(run.output, HasSubstr("--set weight_exponent=3: weight_exponent = 3; must be in"));
   EXPECT_FALSE(std::filesystem::exists(dir.File("o")));
+  // --perturb: an unknown key or a broken rule is one line naming the key; nothing written.
+  run = RunCommand(
+      Slamrig("slam " + log + " --perturb odometry.noise_pr_m=1 --out " + dir.File("o")));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, StartsWith("slamrig: error: --perturb odometry.noise_pr_m=1: "
+                                     "odometry.noise_pr_m: unknown key"));
+  EXPECT_EQ(CountLines(run.output), 1) << run.output;
+  run = RunCommand(
+      Slamrig("slam " + log + " --perturb scans.drop_fraction=2 --out " + dir.File("o")));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.output, HasSubstr("scans.drop_fraction = 2; must be in [0, 1]"));
+  EXPECT_FALSE(std::filesystem::exists(dir.File("o")));
 }
 
 TEST(CliTest, RunWritesAReportAndFailsOnAnUnmetExpectation) {
