@@ -33,8 +33,13 @@ def prose_lines(path):
                 yield number, line
 
 
+_ANCHORS = {}
+
+
 def anchors(path):
     """GitHub's anchors of a markdown file's headings (duplicates get -1, -2, ...)."""
+    if path in _ANCHORS:
+        return _ANCHORS[path]
     seen, result = {}, set()
     for _, line in prose_lines(path):
         match = re.match(r"^#{1,6}\s+(.*?)\s*#*\s*$", line)
@@ -44,6 +49,7 @@ def anchors(path):
         count = seen.get(slug, 0)
         seen[slug] = count + 1
         result.add(slug if count == 0 else f"{slug}-{count}")
+    _ANCHORS[path] = result
     return result
 
 
