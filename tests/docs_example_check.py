@@ -57,8 +57,13 @@ def check_blocks(root):
 
 def check_patch(root):
     patch = os.path.join(root, EXAMPLES, "register.patch")
-    run = subprocess.run(["patch", "--dry-run", "--batch", "-p1", "-d", root, "-i", patch],
-                         capture_output=True, text=True)
+    if shutil.which("patch"):
+        command = ["patch", "--dry-run", "--batch", "-p1", "-d", root, "-i", patch]
+    elif shutil.which("git"):
+        command = ["git", "-C", root, "apply", "--check", patch]
+    else:
+        return ["neither patch nor git is installed: cannot check register.patch"]
+    run = subprocess.run(command, capture_output=True, text=True)
     if run.returncode != 0:
         return [f"{EXAMPLES}/register.patch no longer applies to the tree: "
                 + " ".join((run.stdout + run.stderr).split())[:300]]
