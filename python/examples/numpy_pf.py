@@ -1,6 +1,6 @@
 """The ECE276A reports' particle-filter SLAM in vectorised NumPy, as a slamrig estimator.
 
-The method of the reports (../shared/references: Wang, Kansal, Zafari): particles move by the
+The method of the ECE276A reports (Wang, Kansal, Zafari): particles move by the
 synchronised odometry increment plus Gaussian noise; each particle's scan endpoints are
 correlated with the binary occupancy map (log-odds > 0) over a small grid of cell shifts, the
 best shift moves the particle; weights are multiplied by the softmax of the correlations; the
