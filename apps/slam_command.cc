@@ -133,7 +133,7 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   std::vector<std::string> sets, topic_flags, perturb_flags;
   int clouds = 0, max_scans = 0;
   std::uint64_t seed = 1;
-  bool no_gyro = false, lenient = false, quiet = false;
+  bool no_gyro = false, lenient = false, quiet = false, strict = false;
   ArgParser parser(
       "slamrig slam", "LOG --out DIR [options]",
       "Runs one estimator on a log and writes, into DIR: trajectory.tum (one pose per scan,\n"
@@ -169,6 +169,9 @@ int RunSlamCommand(const std::vector<std::string>& args) {
                    "(aligned by the ATE alignment; needs a log with a reference)",
                    &truth_map_path);
   parser.AddFlag("lenient", "skip and count malformed CARMEN lines instead of failing", &lenient);
+  parser.AddFlag("strict",
+                 "refuse a log cut short (a crashed recording) instead of reading it up to the cut",
+                 &strict);
   parser.AddRepeated("topic", "KEY=NAME",
                      "a ROS 2 bag's topic to read, e.g. scan=/front/scan (keys: " +
                          std::string(slam::BagTopicNames::Keys()) + ")",
@@ -200,9 +203,11 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   // Read and run everything before creating any output, so bad input leaves nothing behind.
   slam::LogReadOptions read;
   read.lenient = lenient;
+  read.strict = strict;
   read.topics = ParseTopicFlags("slamrig slam", topic_flags);
   const std::string path = slam::ResolveLogPath(log_path);
   slam::Dataset data = slam::ReadLog(path, read);
+  if (!data.truncated.empty()) std::fprintf(stderr, "note: %s\n", data.truncated.c_str());
   slam::ApplyLogPerturbation(&data, perturbation, seed, base.odometry.robot);
   slam::EstimatorConfig config = base;
   Trajectory reference;

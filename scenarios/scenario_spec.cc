@@ -332,7 +332,8 @@ std::string ResolvedYaml(const ScenarioSpec& spec, const std::vector<std::string
   } else {
     out << YAML::Key << "source" << YAML::Value << YAML::BeginMap << YAML::Key << "log"
         << YAML::Value << fs::absolute(spec.log->path).lexically_normal().string() << YAML::Key
-        << "lenient" << YAML::Value << spec.log->read.lenient;
+        << "lenient" << YAML::Value << spec.log->read.lenient << YAML::Key << "strict"
+        << YAML::Value << spec.log->read.strict;
     // Bag topic names, every one (the defaults too), so that the resolved file is complete.
     slam::BagTopicNames topics = spec.log->read.topics;
     out << YAML::Key << "topics" << YAML::Value << YAML::BeginMap;
@@ -421,6 +422,7 @@ LogSource ReadLogSource(const YamlNode& root, const YamlNode& source, const std:
   LogSource log;
   log.path = ResolveLog(source.Required("log"), path);
   source.Read("lenient", &log.read.lenient);
+  source.Read("strict", &log.read.strict);
   if (const auto topics = source.Optional("topics")) {
     if (!topics->IsMap()) topics->Fail("topics is a map (scan: /front/scan, ...)");
     for (const std::string& key : topics->Keys()) {

@@ -83,7 +83,8 @@ inline slam::TextureMapOptions DefaultScenarioTexture() {
 ///
 /// or, instead of world/robot/faults, a log: `source: {log:
 /// carmen_corrected/intel-corrected.log.gz}` (relative to this file or to SLAMRIG_DATA_DIR;
-/// `lenient: true` counts malformed lines; a ROS 2 bag's topics other than the defaults as
+/// `lenient: true` counts malformed lines; `strict: true` refuses a log cut short (else read up
+/// to the cut, with a note); a ROS 2 bag's topics other than the defaults as
 /// `topics: {scan: /front/scan, odom: /wheel_odom}`, keys as in slam::BagTopicNames).
 struct ScenarioSpec {
   std::string path;

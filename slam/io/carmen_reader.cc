@@ -7,6 +7,7 @@
 #include <optional>
 #include <string_view>
 
+#include "slam/io/dataset.h"
 #include "slam/io/line_reader.h"
 #include "slam/types/error.h"
 
@@ -127,6 +128,13 @@ bool IsBinary(std::string_view line) {
                                 [](char c) { return static_cast<unsigned char>(c) >= 0x80; });
 }
 
+// The message types ParseLine reads.
+bool IsKnownMessage(std::string_view type) {
+  return type == "FLASER" || type == "RLASER" || type == "ROBOTLASER1" || type == "ROBOTLASER2" ||
+         (type.starts_with("RAWLASER") && type.size() == 9 && type[8] >= '1' && type[8] <= '4') ||
+         type == "ODOM" || type == "TRUEPOS" || type == "PARAM";
+}
+
 // A message before times are fixed up: which list it went to and its raw stamp.
 struct Stamped {
   enum class Kind { kScan, kOdometry, kTruth } kind;
@@ -145,12 +153,15 @@ class CarmenParser {
     Fields f(line);
     if (f.size() == 0 || f[0].front() == '#') return;
     const std::string type(f[0]);
+    if (!IsKnownMessage(type)) {
+      ++log_.stats.unknown_messages[type];
+      return;
+    }
     if (type == "FLASER" || type == "RLASER") {
       ParseOldLaser(f, type, line_number);
     } else if (type == "ROBOTLASER1" || type == "ROBOTLASER2") {
       ParseRobotLaser(f, line_number);
-    } else if (type.starts_with("RAWLASER") && type.size() == 9 && type[8] >= '1' &&
-               type[8] <= '4') {
+    } else if (type.starts_with("RAWLASER")) {
       ParseRawLaser(f, line_number);
     } else if (type == "ODOM") {
       ParseOdometry(f, line_number);
@@ -162,12 +173,9 @@ class CarmenParser {
       Record(Stamped::Kind::kTruth, log_.true_poses.size(), f.Number(7, "ipc_timestamp"),
              line_number);
       log_.true_poses.push_back(truth);
-    } else if (type == "PARAM") {
+    } else {
       f.ExpectAtLeast(3, " for PARAM");
       log_.params[std::string(f[1])] = std::string(f[2]);
-    } else {
-      ++log_.stats.unknown_messages[type];
-      return;
     }
     ++log_.stats.messages[type];
     last_was_laser_ = type != "ODOM" && type != "PARAM" && type != "TRUEPOS";
@@ -202,8 +210,9 @@ class CarmenParser {
         n > 1 ? (n % 2 == 0 ? 180.0 * kDeg / n : 180.0 * kDeg / (n - 1)) : 0.0;
     s.scan.range_min_m = 1e-3;
     if (type == "RLASER") s.scan.base_from_laser = Pose2(0.0, 0.0, std::numbers::pi);
+    const double stamp = f.Number(p + 6, "ipc_timestamp");  // before anything is recorded
     rear_.push_back(type == "RLASER");
-    Record(Stamped::Kind::kScan, log_.scans.size(), f.Number(p + 6, "ipc_timestamp"), line_number);
+    Record(Stamped::Kind::kScan, log_.scans.size(), stamp, line_number);
     log_.scans.push_back(std::move(s));
   }
 
@@ -234,10 +243,11 @@ class CarmenParser {
     s.odom_pose = s.logged_pose;
     s.scan.base_from_laser = s.logged_pose.Inverse() * world_from_laser;
     for (std::size_t k = p + 6; k < p + 11; ++k) f.Number(k, "robot_state");
+    const double stamp = f.Number(p + 11, "ipc_timestamp");  // before anything is recorded
     s.line = line_number;
     rear_.push_back(false);
     explicit_max_.push_back(log_.scans.size());
-    Record(Stamped::Kind::kScan, log_.scans.size(), f.Number(p + 11, "ipc_timestamp"), line_number);
+    Record(Stamped::Kind::kScan, log_.scans.size(), stamp, line_number);
     log_.scans.push_back(std::move(s));
   }
 
@@ -246,10 +256,11 @@ class CarmenParser {
     const std::size_t p = ParseLaserConfig(f, std::string(f[0]), &s);
     f.ExpectCount(p + 3, " for " + std::string(f[0]));
     s.has_pose = false;
+    const double stamp = f.Number(p, "ipc_timestamp");  // before anything is recorded
     s.line = line_number;
     rear_.push_back(false);
     explicit_max_.push_back(log_.scans.size());
-    Record(Stamped::Kind::kScan, log_.scans.size(), f.Number(p, "ipc_timestamp"), line_number);
+    Record(Stamped::Kind::kScan, log_.scans.size(), stamp, line_number);
     log_.scans.push_back(std::move(s));
   }
 
@@ -403,13 +414,27 @@ class CarmenParser {
 }  // namespace
 
 CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options) {
-  LineReader reader(path);
+  LineReader reader(path, !options.strict);
   CarmenParser parser(path, options);
   std::string_view line;
   int lines = 0;
+  int cut_line = 0;  // the unfinished last line left out, if any
   while (reader.Next(&line)) {
     ++lines;
     const int number = reader.line_number();
+    // A last line without its end of line is where a log cut short stops, unless it is a whole
+    // message (a log without a final newline): a message's fields are counted, so one cut short
+    // fails to parse, and only a cut in the unread logger stamp at its end goes unnoticed.
+    // PARAM lines have no fixed count. A binary last line stays an error: a cut leaves text.
+    const bool unfinished = !options.strict && !reader.terminated();
+    if (unfinished && !IsBinary(line)) {
+      const Fields f(line);
+      const std::string_view type = f.size() > 0 ? f[0] : std::string_view("#");
+      if (type.front() != '#' && (reader.cut() || !IsKnownMessage(type) || type == "PARAM")) {
+        cut_line = number;
+        break;
+      }
+    }
     auto fail = [&](const std::string& field, const std::string& problem, const std::string& kind) {
       if (!options.lenient) {
         throw ParseError(path + ":" + std::to_string(number) + ": " + field + ": " + problem);
@@ -423,8 +448,12 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
     try {
       parser.ParseLine(line, number);
     } catch (const LineError& e) {
-      const std::string type{Fields(line)[0]};
-      fail(type + " " + e.field, e.problem, "malformed " + type);
+      if (unfinished) {
+        cut_line = number;
+        break;
+      }
+      const std::string type_name{Fields(line)[0]};
+      fail(type_name + " " + e.field, e.problem, "malformed " + type_name);
     } catch (const CarmenParser::Skip&) {
     }
   }
@@ -432,7 +461,17 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
   CarmenLog log = parser.Finish();
   if (log.stats.messages.empty()) {
     throw ParseError(path + ": no CARMEN messages (FLASER, ROBOTLASER1, ODOM, ...) in " +
-                     std::to_string(lines) + " lines");
+                     std::to_string(lines) + " lines" +
+                     (cut_line > 0 ? " (the last one cut short)" : ""));
+  }
+  if (cut_line > 0 || reader.cut()) {
+    log.truncated =
+        path +
+        (cut_line > 0 ? " truncated in line " + GroupedCount(cut_line)
+                      : ": compressed data cut short after line " + GroupedCount(lines)) +
+        ": recovered " + GroupedCount(log.scans.size()) +
+        " scans of an unknown total; the rest is lost";
+    log.notes.push_back(log.truncated);
   }
   return log;
 }

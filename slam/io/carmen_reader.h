@@ -14,6 +14,10 @@ struct CarmenReadOptions {
   bool lenient = false;
   /// Readings at or above this are "no return" codes whatever the log claims (SICK: 81.83 m).
   double no_return_range_m = 80.0;
+  /// A log cut short (a last line without its end of line that does not parse as a whole
+  /// message, a gzip stream that ends early) is an error, instead of read up to its last whole
+  /// line with CarmenLog::truncated saying so.
+  bool strict = false;
 };
 
 /// A laser message of the log with the poses logged beside it.
@@ -61,10 +65,17 @@ struct CarmenLog {
   bool timestamps_usable = true;
   CarmenStats stats;
   std::vector<std::string> notes;  ///< human-readable remarks about quirks found
+  /// Where a log cut short stopped and how many scans were recovered (also among `notes`); empty
+  /// for a whole log.
+  std::string truncated;
 };
 
 /// Reads a plain or gzip CARMEN log. Throws ParseError("file:line: field: problem") on a missing,
 /// empty, binary or malformed file (malformed lines become counted skips with `lenient`).
+/// A log cut short (see CarmenReadOptions::strict) is read up to its last whole line: a last
+/// line without an end of line is kept when it parses as a whole known message (a log that
+/// merely lacks its final newline), else dropped, as is an unfinished line of a gzip stream
+/// that ends early; CarmenLog::truncated then says where it stopped.
 ///
 /// Beam geometry of FLASER/RLASER, which carry no angles: a 180 degree field of view starting at
 /// -90 degrees (CARMEN's documented default, "assume 1 degree resolution"); n beams are spaced by

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -17,7 +18,15 @@ struct Dataset {
   std::string format;              ///< its format ("carmen", "ece276a"; see log_reader.h)
   std::string reference_kind;      ///< what `reference` is, e.g. "GMapping-corrected poses"
   std::vector<std::string> notes;  ///< quirks found while reading, for the user
+  /// One line when the log was cut short (a recording killed mid-way) and read up to the cut:
+  /// the file, where it stopped and what was recovered ("run.mcap truncated at byte 3,000,000:
+  /// recovered 2,411 scans of an unknown total; the rest is lost"); also among `notes`. Empty
+  /// for a whole log.
+  std::string truncated;
 };
+
+/// `n` with a comma between groups of three digits ("2,411"), as notes print counts.
+std::string GroupedCount(std::uint64_t n);
 
 /// Turns a CARMEN log into a Dataset.
 /// - GMapping-corrected logs: the scans' poses become the reference; the raw odometry is

@@ -10,7 +10,8 @@
 
 namespace slamrig::slam {
 
-LineReader::LineReader(std::string path) : path_(std::move(path)) {
+LineReader::LineReader(std::string path, bool recover_cut)
+    : path_(std::move(path)), recover_cut_(recover_cut) {
   std::error_code ec;
   if (!std::filesystem::exists(path_, ec)) throw ParseError(path_ + ": no such file");
   if (std::filesystem::is_directory(path_, ec)) throw ParseError(path_ + ": is a directory");
@@ -29,14 +30,21 @@ bool LineReader::Next(std::string_view* line) {
   buffer_.clear();
   char chunk[8192];
   bool got_any = false;
+  terminated_ = false;
   while (gzgets(f, chunk, sizeof(chunk)) != nullptr) {
     got_any = true;
     buffer_.append(chunk);
-    if (!buffer_.empty() && buffer_.back() == '\n') break;
+    if (!buffer_.empty() && buffer_.back() == '\n') {
+      terminated_ = true;
+      break;
+    }
   }
   int error = Z_OK;
   const char* message = gzerror(f, &error);
-  if (error != Z_OK && error != Z_STREAM_END) {
+  // zlib reports a stream that ends early as Z_BUF_ERROR, after handing out what it decompressed.
+  if (error == Z_BUF_ERROR && recover_cut_) {
+    cut_ = true;
+  } else if (error != Z_OK && error != Z_STREAM_END) {
     throw ParseError(path_ + ":" + std::to_string(line_number_ + 1) +
                      ": corrupt or truncated compressed data: " + message);
   }

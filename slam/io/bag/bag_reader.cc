@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 #include <numbers>
+#include <tuple>
 
 #include "slam/config/yaml_node.h"
 #include "slam/io/bag/cdr.h"
@@ -33,16 +34,115 @@ FileKind Sniff(const std::string& path) {
   return FileKind::kUnknown;
 }
 
-RawBag ReadFile(const std::string& path, std::string_view storage) {
+RawBag ReadFile(const std::string& path, std::string_view storage, bool recover_cut) {
   const FileKind kind = Sniff(path);
   if (kind == FileKind::kUnknown) {
-    throw ParseError(path + ": byte 0: neither MCAP nor sqlite3 (bad magic)");
+    throw ParseError(path + ": byte 0: not a bag: no MCAP magic, no SQLite header");
   }
   if (!storage.empty() && (storage == "mcap") != (kind == FileKind::kMcap)) {
     throw ParseError(path + ": metadata.yaml says storage '" + std::string(storage) +
                      "' but the file is " + (kind == FileKind::kMcap ? "MCAP" : "sqlite3"));
   }
-  return kind == FileKind::kMcap ? ReadMcapFile(path) : ReadSqliteBagFile(path);
+  return kind == FileKind::kMcap ? ReadMcapFile(path, recover_cut)
+                                 : ReadSqliteBagFile(path, recover_cut);
+}
+
+// A topic as the bag holds it, over all its files.
+struct SeenTopic {
+  std::string type;
+  std::size_t count = 0;
+};
+
+// "sensor_msgs/msg/LaserScan" -> "LaserScan".
+std::string ShortType(const std::string& type) {
+  const std::size_t slash = type.rfind('/');
+  return type.empty() ? "no type" : slash == std::string::npos ? type : type.substr(slash + 1);
+}
+
+// "/front/scan (LaserScan, 2,400), /odom (Odometry, 2,400)".
+std::string TopicList(const std::map<std::string, SeenTopic>& seen) {
+  std::string list;
+  for (const auto& [name, topic] : seen) {
+    list += (list.empty() ? "" : ", ") + name + " (" + ShortType(topic.type) + ", " +
+            GroupedCount(topic.count) + ")";
+  }
+  return list.empty() ? "no topics" : list;
+}
+
+// What the bag offers for the read topics that have no messages: per key whose topic is empty,
+// the other topics with messages of its type that no key names, as `--topic KEY=NAME` flags
+// (the first candidate), and the missing topics' descriptions.
+struct TopicHints {
+  std::vector<std::string> missing;  // "no sensor_msgs/msg/LaserScan on /scan"
+  std::vector<std::string> flags;    // "--topic scan=/front/scan"
+  bool scan_elsewhere = false;       // the scans are on another topic
+};
+
+TopicHints HintsFor(const BagTopicNames& n, const std::map<std::string, SeenTopic>& seen) {
+  // Each key with the word that marks its likeliest candidates.
+  const std::vector<std::tuple<const char*, const std::string*, RosType, const char*>> keys = {
+      {"scan", &n.scan, RosType::kLaserScan, "scan"},
+      {"joint_states", &n.joint_states, RosType::kJointState, "joint"},
+      {"odom", &n.odom, RosType::kOdometry, "odom"},
+      {"imu", &n.imu, RosType::kImu, "imu"},
+      {"ground_truth", &n.ground_truth, RosType::kOdometry, "truth"}};
+  TopicHints hints;
+  for (const auto& [key, name, type, word] : keys) {
+    const auto it = seen.find(*name);
+    if (it != seen.end() && it->second.count > 0) continue;
+    std::vector<std::string> candidates;
+    for (const auto& [other, topic] : seen) {
+      bool named = false;
+      for (const auto& [k, read, t, w] : keys) named = named || *read == other;
+      named = named || other == n.tf || other == n.tf_static || other == n.clock;
+      if (!named && topic.count > 0 && RosTypeFromName(topic.type) == type) {
+        candidates.push_back(other);
+      }
+    }
+    // Any odometry could stand in for ground truth: that one is never guessed.
+    if (candidates.empty() || std::string_view(key) == "ground_truth") continue;
+    // Names with the key's word first ("/wheel/odom" before "/truth" for odom), else by name.
+    std::stable_partition(candidates.begin(), candidates.end(),
+                          [&](const std::string& c) { return c.find(word) != std::string::npos; });
+    hints.missing.push_back("no " + std::string(RosTypeName(type)) + " on " + *name);
+    hints.flags.push_back("--topic " + std::string(key) + "=" + candidates.front());
+    hints.scan_elsewhere = hints.scan_elsewhere || type == RosType::kLaserScan;
+  }
+  return hints;
+}
+
+std::string Joined(const std::vector<std::string>& parts, const std::string& separator) {
+  std::string out;
+  for (const std::string& p : parts) out += (out.empty() ? "" : separator) + p;
+  return out;
+}
+
+// Fails when the bag holds messages the reader would have read under other topic names (the
+// scans, or any when nothing was read), naming what the bag has and the flags that map them;
+// else notes the other topics that --topic would add.
+void CheckTopics(const std::string& path, const BagTopicNames& n,
+                 const std::map<std::string, SeenTopic>& seen, Dataset* data) {
+  const TopicHints hints = HintsFor(n, seen);
+  std::size_t messages = 0;
+  for (const auto& [name, topic] : seen) messages += topic.count;
+  const bool nothing_read = data->records.empty() && data->reference.empty() && messages > 0;
+  if (hints.scan_elsewhere || (nothing_read && !hints.flags.empty())) {
+    throw ParseError(path + ": " + Joined(hints.missing, ", ") + "; the bag has " +
+                     TopicList(seen) + ": try " + Joined(hints.flags, " "));
+  }
+  for (std::size_t i = 0; i < hints.missing.size(); ++i) {
+    data->notes.push_back(hints.missing[i] + " (try " + hints.flags[i] + ")");
+  }
+}
+
+// The note for a file read up to its cut; throws when nothing before the cut could be read.
+std::string CutNote(const std::string& file, const RawBagCut& cut, std::size_t messages,
+                    std::size_t scans) {
+  const std::string what =
+      scans > 0 ? GroupedCount(scans) + " scans" : GroupedCount(messages) + " messages";
+  if (cut.all_messages) return file + " " + cut.where + ", after its last message: all " + what;
+  if (messages == 0) throw ParseError(file + ": " + cut.where + ", before its first message");
+  return file + " " + cut.where + ": recovered " + what + " of an unknown total; the rest is lost";
 }
 
 // The storage files of a bag folder and its storage identifier ("" if unknown).
@@ -220,8 +320,12 @@ Dataset ReadBag(const std::string& path, const BagReaderOptions& options) {
   std::map<std::string, std::size_t> skipped;
   std::map<std::string, std::string> skipped_type;
   Decoder decoder(options, &data);
+  std::map<std::string, SeenTopic> seen;
   for (const std::string& file : files) {
-    RawBag bag = ReadFile(file, storage);
+    RawBag bag = ReadFile(file, storage, !options.strict);
+    if (bag.cut && file != files.back()) {
+      throw ParseError(file + ": " + bag.cut->where + ", and it is not the bag's last file");
+    }
     custom_data.merge(bag.custom_data);  // metadata.yaml's entries win
     decoder.ticks_per_revolution = options.ticks_per_revolution;
     if (decoder.ticks_per_revolution == 0.0) {
@@ -259,11 +363,13 @@ Dataset ReadBag(const std::string& path, const BagReaderOptions& options) {
       std::size_t index;
     };
     std::vector<std::size_t> per_topic(bag.topics.size(), 0);
+    std::size_t scans = 0;
     std::vector<Item> items;
     items.reserve(bag.messages.size());
     for (std::size_t m = 0; m < bag.messages.size(); ++m) {
       const RawBagMessage& msg = bag.messages[m];
       const std::size_t index = per_topic[msg.topic]++;
+      scans += topic_type[msg.topic] == RosType::kLaserScan;
       if (!topic_type[msg.topic]) {
         ++skipped[bag.topics[msg.topic].name];
         skipped_type[bag.topics[msg.topic].name] = bag.topics[msg.topic].type;
@@ -283,6 +389,15 @@ Dataset ReadBag(const std::string& path, const BagReaderOptions& options) {
         throw ParseError(decoder.Where(topic, item.index) + e.what());
       }
     }
+    for (std::size_t i = 0; i < bag.topics.size(); ++i) {
+      SeenTopic& topic = seen[bag.topics[i].name];
+      topic.type = bag.topics[i].type;
+      topic.count += per_topic[i];
+    }
+    if (bag.cut) {
+      data.truncated = CutNote(file, *bag.cut, bag.messages.size(), scans);
+      data.notes.push_back(data.truncated);
+    }
   }
   std::stable_sort(data.records.begin(), data.records.end(),
                    [](const Record& a, const Record& b) { return RecordTime(a) < RecordTime(b); });
@@ -294,6 +409,7 @@ Dataset ReadBag(const std::string& path, const BagReaderOptions& options) {
     data.notes.push_back("skipped topic " + topic + " (" + skipped_type[topic] +
                          "): " + std::to_string(count) + " messages");
   }
+  CheckTopics(path, n, seen, &data);
   return data;
 }
 

@@ -17,6 +17,10 @@ struct BagReaderOptions {
   double ticks_per_revolution = 0.0;
   /// The robot's frame: /tf_static transforms from it give each scan's base_from_laser.
   std::string base_frame = "base_link";
+  /// A file cut short (a recording killed mid-way: no MCAP footer, a sqlite3 file shorter than
+  /// its header says or whose rows stop being readable) is an error, instead of read up to the
+  /// cut with Dataset::truncated saying so.
+  bool strict = false;
 
   /// One RuleViolation() message per broken rule; empty when valid.
   std::vector<std::string> Validate() const;
@@ -35,8 +39,16 @@ struct BagReaderOptions {
 ///   /ground_truth/odom Odometry -> Dataset::reference.
 /// /tf, /clock and any other topic are skipped and listed in the notes with their counts.
 /// Throws ParseError naming the file (and the topic and message index for a message that does
-/// not decode) for a truncated file, bad magic, a CRC mismatch, a chunk that does not
-/// decompress, a message too short or with a bad length, or a read topic of the wrong type.
+/// not decode) for bad magic, a CRC mismatch, a chunk that does not decompress, a message too
+/// short or with a bad length, or a read topic of the wrong type; for a truncated file only when
+/// `strict` or when nothing before the cut can be read, or when it is not the bag's last file
+/// (else the messages before the cut are read, and Dataset::truncated and a note say where it
+/// stopped and how many scans it recovered).
+/// Also a ParseError, listing every topic with its type and count and the `--topic KEY=NAME`
+/// flags that would map them, when the scans are on another topic than options.topics.scan or
+/// when none of the read topics has a message but other topics of their types do; another topic
+/// of a read type (odometry, wheel joints, IMU) beside an empty read topic gets a note with the
+/// flag.
 Dataset ReadBag(const std::string& path, const BagReaderOptions& options = {});
 
 /// True if `path` is a bag ReadBag would try to read: a folder with a metadata.yaml or with

@@ -1,3 +1,4 @@
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
@@ -72,9 +73,11 @@ void ExpectSameData(const Dataset& got, const Dataset& want) {
 }
 
 // The error ReadBag throws for `path`, or "" if it reads fine.
-std::string ReadError(const std::string& path) {
+std::string ReadError(const std::string& path, bool strict = false) {
   try {
-    ReadBag(path);
+    BagReaderOptions options;
+    options.strict = strict;
+    ReadBag(path, options);
   } catch (const ParseError& e) {
     return e.what();
   }
@@ -145,14 +148,11 @@ TEST(BagTest, OtherTopicNamesAndUnknownTopics) {
   BagWriterOptions options;
   options.topics.scan = "/base_scan";
   WriteBag(data, dir.File("b"), options);
-  // With the default names, /base_scan is an unknown topic: skipped and counted.
-  const Dataset plain = ReadBag(dir.File("b"));
-  EXPECT_EQ(std::count_if(plain.records.begin(), plain.records.end(),
-                          [](const Record& r) { return std::holds_alternative<LaserScan>(r); }),
-            0);
-  EXPECT_NE(std::find(plain.notes.begin(), plain.notes.end(),
-                      "skipped topic /base_scan (sensor_msgs/msg/LaserScan): 8 messages"),
-            plain.notes.end());
+  // With the default names, the scans on /base_scan are not read: the error names the flag.
+  EXPECT_THAT(ReadError(dir.File("b")),
+              ::testing::HasSubstr("no sensor_msgs/msg/LaserScan on /scan; the bag has "
+                                   "/base_scan (LaserScan, 8), /clock (Clock, 20), "));
+  EXPECT_THAT(ReadError(dir.File("b")), ::testing::EndsWith(": try --topic scan=/base_scan"));
   BagReaderOptions read_options;
   read_options.topics.scan = "/base_scan";
   ExpectSameData(ReadBag(dir.File("b"), read_options), data);
@@ -293,9 +293,9 @@ class CorruptMcapTest : public ::testing::Test {
     file_ = dir_.File("b/b_0.mcap");
     bytes_ = ReadAll(file_);
   }
-  std::string ErrorAfter(const std::string& bytes) {
+  std::string ErrorAfter(const std::string& bytes, bool strict = false) {
     WriteAll(file_, bytes);
-    return ReadError(dir_.File("b"));
+    return ReadError(dir_.File("b"), strict);
   }
 
   TempDir dir_;
@@ -303,12 +303,13 @@ class CorruptMcapTest : public ::testing::Test {
   std::string bytes_;
 };
 
+// Read strictly; bag_cut_test.cc reads cut files up to the cut.
 TEST_F(CorruptMcapTest, Truncated) {
   for (std::size_t n : {std::size_t{0}, std::size_t{5}, bytes_.size() / 2, bytes_.size() - 1}) {
-    const std::string e = ErrorAfter(bytes_.substr(0, n));
+    const std::string e = ErrorAfter(bytes_.substr(0, n), true);
     EXPECT_NE(e.find(file_), std::string::npos) << e;
     EXPECT_TRUE(e.find("truncated") != std::string::npos ||
-                e.find("bad magic") != std::string::npos)
+                e.find("no MCAP magic") != std::string::npos)
         << e;
   }
 }
@@ -316,7 +317,7 @@ TEST_F(CorruptMcapTest, Truncated) {
 TEST_F(CorruptMcapTest, BadMagic) {
   std::string b = bytes_;
   b[1] = 'X';
-  EXPECT_EQ(ErrorAfter(b), file_ + ": byte 0: neither MCAP nor sqlite3 (bad magic)");
+  EXPECT_EQ(ErrorAfter(b), file_ + ": byte 0: not a bag: no MCAP magic, no SQLite header");
   EXPECT_THROW(ReadMcapFile(file_), ParseError);
 }
 
@@ -431,7 +432,7 @@ TEST(CorruptBagTest, SqliteBadMessageAndBadFile) {
   const std::string garbage = dir.Write("g.db3", std::string("SQLite format 3\0", 16) + "junk");
   EXPECT_TRUE(ReadError(garbage).starts_with(garbage + ": sqlite3")) << ReadError(garbage);
   const std::string text = dir.Write("t.mcap", "hello");
-  EXPECT_EQ(ReadError(text), text + ": byte 0: neither MCAP nor sqlite3 (bad magic)");
+  EXPECT_EQ(ReadError(text), text + ": byte 0: not a bag: no MCAP magic, no SQLite header");
 }
 
 TEST(CorruptBagTest, BadMetadata) {
@@ -488,8 +489,16 @@ TEST(CorruptBagTest, RandomDamageIsAParseErrorOrHarmless) {
           b.resize(at(rng));
       }
       WriteAll(file, b);
+      // Read up to a cut, then strictly (a cut is an error).
       try {
         ReadBag(folder);
+      } catch (const ParseError& e) {
+        EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
+      }
+      try {
+        BagReaderOptions strict;
+        strict.strict = true;
+        ReadBag(folder, strict);
       } catch (const ParseError& e) {
         ++errors;
         EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();

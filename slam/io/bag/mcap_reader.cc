@@ -8,6 +8,7 @@
 
 #include "slam/io/bag/mcap_records.h"
 #include "slam/io/bag/raw_bag.h"
+#include "slam/io/dataset.h"
 #include "slam/types/error.h"
 
 namespace slamrig::slam {
@@ -22,7 +23,7 @@ class McapParser {
  public:
   explicit McapParser(std::string path) : path_(std::move(path)) {}
 
-  RawBag Parse() {
+  RawBag Parse(bool recover_cut) {
     std::ifstream in(path_, std::ios::binary);
     if (!in) throw ParseError(path_ + ": cannot open");
     std::ostringstream s;
@@ -33,22 +34,32 @@ class McapParser {
     if (file.size() < magic.size() || file.substr(0, magic.size()) != magic) {
       throw ParseError(path_ + ": byte 0: not an MCAP file (bad magic)");
     }
-    if (file.size() < 2 * magic.size() + 9 + 20 ||
-        file.substr(file.size() - magic.size()) != magic) {
+    const bool whole = file.size() >= 2 * magic.size() + 9 + 20 &&
+                       file.substr(file.size() - magic.size()) == magic;
+    if (!whole && !recover_cut) {
       throw ParseError(path_ + ": truncated: no Footer and closing magic at the end");
     }
-    CheckSummaryCrc();
+    if (whole) CheckSummaryCrc();
     std::size_t pos = magic.size();
     while (true) {
       const std::size_t start = pos;
+      if (!whole && !RecordFits(file, pos)) {
+        bag_.cut = RawBagCut{"truncated at byte " + GroupedCount(file.size()), false};
+        break;
+      }
       const auto [op, content] = NextRecord(file, &pos, 0);
-      if (op == mcap::kFooter) break;
+      if (op == mcap::kFooter) {
+        if (!whole) bag_.cut = RawBagCut{"truncated at byte " + GroupedCount(file.size()), true};
+        break;
+      }
       if (op == mcap::kDataEnd) {
         Cursor c{content, start + 9, this};
         const std::uint32_t crc = c.U32();
         if (crc != 0 && crc != Crc32(file.substr(0, start))) {
           throw ParseError(Where(start) + "data section CRC mismatch");
         }
+        // A file cut in its summary section still holds every message.
+        if (!whole) bag_.cut = RawBagCut{"truncated at byte " + GroupedCount(file.size()), true};
         break;
       }
       if (op == mcap::kChunk) {
@@ -93,6 +104,15 @@ class McapParser {
 
   std::string Where(std::size_t offset) const {
     return path_ + ": byte " + std::to_string(offset) + ": ";
+  }
+
+  // True if the whole record at `pos` of `data` (its 9-byte opcode and length, and the content)
+  // is there.
+  static bool RecordFits(std::string_view data, std::size_t pos) {
+    if (data.size() - pos < 9) return false;
+    std::uint64_t length;
+    std::memcpy(&length, data.data() + pos + 1, 8);
+    return length <= data.size() - pos - 9;
   }
 
   // Reads the record at *pos of `data` (whose first byte is at file offset `base`).
@@ -251,6 +271,8 @@ class McapParser {
 
 }  // namespace
 
-RawBag ReadMcapFile(const std::string& path) { return McapParser(path).Parse(); }
+RawBag ReadMcapFile(const std::string& path, bool recover_cut) {
+  return McapParser(path).Parse(recover_cut);
+}
 
 }  // namespace slamrig::slam
