@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <system_error>
+#include <type_traits>
 
 #include "sim/mount_pose.h"
 #include "slam/config/fields.h"
@@ -36,6 +37,13 @@ void VisitFields(V& v, ShapeSpec& s) {
       v("points_m", s.points_m);
       v("closed", s.closed);
       break;
+  }
+  // Written only when not matte, so that a world without materials resolves to the same text.
+  if (!std::is_same_v<V, FieldWriter> || s.material != SurfaceMaterial::kMatte) {
+    v.Enum("material", s.material,
+           {{SurfaceMaterial::kMatte, "matte"},
+            {SurfaceMaterial::kGlass, "glass"},
+            {SurfaceMaterial::kBlack, "black"}});
   }
 }
 
