@@ -145,7 +145,8 @@ std::vector<bool> ShutCorridors(const Layout& layout, int nx, int ny, double fra
   for (int k = static_cast<int>(inner.size()) - 1; k > 0; --k)
     std::swap(inner[k], inner[rng.Below(k + 1)]);
   const int loops = static_cast<int>(layout.edges.size() - layout.nodes.size()) + 1;
-  const int count = std::min(static_cast<int>(std::lround(fraction * static_cast<double>(inner.size()))), loops - 2);
+  const int count = std::min(
+      static_cast<int>(std::lround(fraction * static_cast<double>(inner.size()))), loops - 2);
   std::vector<bool> shut(layout.edges.size(), false);
   for (int k = 0; k < count; ++k) shut[inner[k]] = true;
   return shut;
@@ -228,13 +229,15 @@ Layout MakeCorridor(const CorridorOptions& o, const RouteOptions& route, Rng& rn
   const auto matte = [] { return SurfaceMaterial::kMatte; };
   // Sparse features along every face that lines a hallway: a glass stretch, a cabinet or a half
   // pillar, about every feature_spacing_m.
-  auto featured_face = [&](Eigen::Vector2d a, Eigen::Vector2d b, Eigen::Vector2d normal) {
+  // (The outer walls have nothing behind them to see through glass: no glass there.)
+  auto featured_face = [&](Eigen::Vector2d a, Eigen::Vector2d b, Eigen::Vector2d normal,
+                           bool glass_allowed) {
     const double length = (b - a).norm();
     const Eigen::Vector2d d = (b - a) / length;
     std::vector<Gap> glass;
     for (double s = o.feature_spacing_m * rng.Uniform(0.3, 1.0); s < length - 3.0;
          s += o.feature_spacing_m * rng.Uniform(0.5, 1.5)) {
-      if (rng.Chance(o.glass_fraction)) {
+      if (rng.Chance(o.glass_fraction) && glass_allowed) {
         const double stretch = std::min(rng.Uniform(2.0, 6.0), length - s - 1.0);
         glass.push_back({s, s + stretch, false});
       } else if (rng.Chance(0.5)) {
@@ -254,14 +257,14 @@ Layout MakeCorridor(const CorridorOptions& o, const RouteOptions& route, Rng& rn
     for (int bi = 0; bi < nx; ++bi) {
       const Eigen::Vector2d lo(xs[bi] + 0.5 * hw, ys[bj] + 0.5 * hw);
       const Eigen::Vector2d hi(xs[bi + 1] - 0.5 * hw, ys[bj + 1] - 0.5 * hw);
-      featured_face(lo, {hi.x(), lo.y()}, {0, -1});
-      featured_face({lo.x(), hi.y()}, hi, {0, 1});
+      featured_face(lo, {hi.x(), lo.y()}, {0, -1}, true);
+      featured_face({lo.x(), hi.y()}, hi, {0, 1}, true);
       AddFaceWall(lo, {lo.x(), hi.y()}, {-1, 0}, kBlockWallM, {}, matte, &layout);
       AddFaceWall({hi.x(), lo.y()}, hi, {1, 0}, kBlockWallM, {}, matte, &layout);
     }
   }
-  featured_face({0, 0}, {o.length_m, 0}, {0, 1});
-  featured_face({0, height}, {o.length_m, height}, {0, -1});
+  featured_face({0, 0}, {o.length_m, 0}, {0, 1}, false);
+  featured_face({0, height}, {o.length_m, height}, {0, -1}, false);
   return layout;
 }
 

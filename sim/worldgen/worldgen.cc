@@ -161,6 +161,8 @@ GeneratedWorld Generate(const GenerateSpec& spec) {
   w.drive.lookahead_m = spec.route.lookahead_m;
   // Turning on the spot at corners keeps the robot near the planned route.
   w.drive.turn_in_place_rad = 0.5;
+  // Dead ends (a maze's, a room's) are driven to their end before turning back.
+  w.drive.dead_end_reach_m = 0.25;
   return g;
 }
 
