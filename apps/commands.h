@@ -21,6 +21,7 @@ int RunRunCommand(const std::vector<std::string>& args);
 int RunSweepCommand(const std::vector<std::string>& args);
 int RunOptimizeCommand(const std::vector<std::string>& args);
 int RunOdometryNoiseCommand(const std::vector<std::string>& args);
+int RunWorldCommand(const std::vector<std::string>& args);
 
 /// All subcommands, in the order `slamrig --help` lists them.
 const std::vector<Command>& Commands();

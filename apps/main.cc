@@ -28,6 +28,8 @@ const std::vector<Command>& Commands() {
        RunEvalCommand},
       {"run", "run a scenario: simulation, SLAM, evaluation, report and verdict", RunRunCommand},
       {"sweep", "run a scenario over a grid of parameters and seeds, all cores", RunSweepCommand},
+      {"world", "generate a procedural world (office, warehouse, corridor, campus, maze)",
+       RunWorldCommand},
       {"optimize", "optimise a 2D pose graph (g2o file) with Ceres: chi2, iterations, time",
        RunOptimizeCommand},
       {"odometry-noise", "a log's own odometry error per scan against its reference",

@@ -12,6 +12,7 @@
 #include "sim/presets.h"
 #include "sim/robot_yaml.h"
 #include "sim/world_yaml.h"
+#include "sim/worldgen/worldgen.h"
 #include "slam/config/fields.h"
 #include "slam/io/ece276a_reader.h"
 #include "slam/types/error.h"
@@ -468,7 +469,10 @@ SimulatedSource ReadSimulatedSource(const YamlNode& root, const std::string& pat
   }
   for (const auto& [k, v] : sets.world) world.Override(k, v, "--set world." + k + "=" + v);
   for (const auto& [k, v] : sets.robot) robot.Override(k, v, "--set robot." + k + "=" + v);
-  sim_source.options.world = sim::ParseWorldSpec(world);
+  // `world: {generate: {kind: office, seed: 7, ...}}`: a procedural world, made here.
+  sim_source.options.world = world.IsMap() && world.Has("generate")
+                                 ? sim::worldgen::GenerateWorld(world.Required("generate"))
+                                 : sim::ParseWorldSpec(world);
   world.CheckAllKeysUsed();
   sim_source.options.robot = sim::ParseRobotSpec(robot);
   robot.CheckAllKeysUsed();

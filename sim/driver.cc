@@ -35,6 +35,9 @@ std::vector<std::string> DriveOptions::Validate() const {
     positive("max_yaw_rate_rad_s", max_yaw_rate_rad_s);
     positive("max_decel_m_s2", max_decel_m_s2);
     positive("goal_tolerance_m", goal_tolerance_m);
+    if (!(dead_end_reach_m >= 0.0)) {
+      errors.push_back("dead_end_reach_m = " + FormatNumber(dead_end_reach_m) + "; must be >= 0");
+    }
     if (!(turn_in_place_rad > 0.0 && turn_in_place_rad <= std::numbers::pi)) {
       errors.push_back("turn_in_place_rad = " + FormatNumber(turn_in_place_rad) +
                        "; must be in (0, pi]");
@@ -75,6 +78,29 @@ Driver::Driver(const DriveOptions& options) : options_(options) {
   }
   lap_length_m_ = cumulative_m_.back();
   end_m_ = lap_length_m_ * options_.laps;
+  if (options_.dead_end_reach_m > 0.0) {
+    const std::size_t n = path_.size();
+    for (std::size_t j = 1; j < n; ++j) {
+      if (j + 1 == n && !options_.closed) break;
+      const Eigen::Vector2d u = path_[j] - path_[j - 1];
+      const Eigen::Vector2d w = j + 1 < n ? path_[j + 1] - path_[j] : path_[1] - path_[0];
+      const double cross = u.x() * w.y() - u.y() * w.x();
+      if (u.dot(w) < 0.0 && std::abs(cross) <= 1e-9 * u.norm() * w.norm()) {
+        reversals_m_.push_back(cumulative_m_[j]);
+      }
+    }
+  }
+}
+
+double Driver::NextReversal() const {
+  if (reversals_m_.empty()) return std::numeric_limits<double>::infinity();
+  const int lap = static_cast<int>(std::floor(progress_m_ / lap_length_m_));
+  for (int k = lap; k <= lap + 1; ++k) {
+    for (const double s : reversals_m_) {
+      if (k * lap_length_m_ + s > progress_m_) return k * lap_length_m_ + s;
+    }
+  }
+  return std::numeric_limits<double>::infinity();
 }
 
 int Driver::laps_completed() const {
@@ -127,9 +153,16 @@ VelocityCommand Driver::FollowPath(const Pose2& map_from_base) {
   const Eigen::Vector2d position = map_from_base.translation();
   // Project onto the path within a window ahead of the current progress (never behind it by more
   // than a little, so a loop is not short-cut where the path passes near itself).
+  // At a dead end the way back lies on the way there: progress may pass the turning point only
+  // once the robot has reached it.
+  double reversal = NextReversal();
+  if (reversal <= end_m_ && (PointAt(reversal) - position).norm() <= options_.dead_end_reach_m) {
+    progress_m_ = reversal;
+    reversal = NextReversal();
+  }
   const double window_lo = std::max(0.0, progress_m_ - 0.25);
   const double window_hi =
-      std::min(end_m_, progress_m_ + std::max(2.0 * options_.lookahead_m, 1.0));
+      std::min({end_m_, progress_m_ + std::max(2.0 * options_.lookahead_m, 1.0), reversal});
   double best_s = progress_m_;
   double best_d2 = std::numeric_limits<double>::infinity();
   const int first_lap = static_cast<int>(std::floor(window_lo / lap_length_m_));
@@ -164,7 +197,7 @@ VelocityCommand Driver::FollowPath(const Pose2& map_from_base) {
   }
 
   // Lookahead point in the robot frame.
-  const Eigen::Vector2d target = PointAt(progress_m_ + options_.lookahead_m);
+  const Eigen::Vector2d target = PointAt(std::min(progress_m_ + options_.lookahead_m, reversal));
   const Eigen::Vector2d local = base_from_map * target;
   const double dist2 = std::max(local.squaredNorm(), 1e-9);
   const double bearing = std::atan2(local.y(), local.x());

@@ -46,7 +46,11 @@ struct DriveOptions {
   double goal_tolerance_m = 0.05;            ///< done when this close to the end of the path
   double turn_in_place_rad = 0.8;            ///< turn on the spot while the lookahead point is
                                              ///< further off the heading than this
-  std::vector<ScheduleSegment> schedule;     ///< schedule mode
+  /// > 0: where the path doubles back on itself (a dead end), the robot first drives to within
+  /// this of the turning point, then turns; 0: pure pursuit alone, which turns back up to half a
+  /// lookahead short of it (and may hesitate there, the way back being as near as the way there).
+  double dead_end_reach_m = 0.0;
+  std::vector<ScheduleSegment> schedule;  ///< schedule mode
 
   /// One message per broken rule, e.g. "laps = 0; must be >= 1".
   std::vector<std::string> Validate() const;
@@ -75,10 +79,13 @@ class Driver {
   VelocityCommand FollowPath(const Pose2& map_from_base);
   VelocityCommand FollowSchedule(Time time);
   Eigen::Vector2d PointAt(double s_m) const;
+  // Path length of the first dead-end turning point after the progress (beyond end_m_: none).
+  double NextReversal() const;
 
   DriveOptions options_;
   std::vector<Eigen::Vector2d> path_;  // vertices, closing vertex repeated for a closed path
   std::vector<double> cumulative_m_;   // arc length at each vertex
+  std::vector<double> reversals_m_;    // arc length of each dead-end vertex within a lap
   double lap_length_m_ = 0.0;
   double end_m_ = 0.0;  // total length to drive
   double progress_m_ = 0.0;

@@ -49,6 +49,33 @@ TEST(DriverTest, PurePursuitDrivesASquareTwiceAndStops) {
   EXPECT_NEAR(steps * dt, 32.0 / 0.5, 12.0);
 }
 
+// A square with a dead-end spur: (4, 0) -> (4, -3) and back. With dead_end_reach_m the robot
+// drives to the spur's end before it turns, and finishes the lap.
+TEST(DriverTest, DrivesIntoADeadEndAndBackOut) {
+  DriveOptions options;
+  options.mode = DriveMode::kWaypoints;
+  options.waypoints_m = {{0, 0}, {4, 0}, {4, -3}, {4, 0}, {4, 4}, {0, 4}};
+  options.speed_m_s = 0.5;
+  options.lookahead_m = 0.5;
+  options.turn_in_place_rad = 0.5;
+  options.dead_end_reach_m = 0.25;
+  Driver driver(options);
+  double x = 0.0, y = 0.0, yaw = 0.0, lowest_y = 0.0;
+  const double dt = 0.02;
+  int steps = 0;
+  for (; steps < 20000 && !driver.finished(); ++steps) {
+    const VelocityCommand c = driver.Update(Time::FromSeconds(steps * dt), Pose2(x, y, yaw));
+    x += c.v_m_s * std::cos(yaw) * dt;
+    y += c.v_m_s * std::sin(yaw) * dt;
+    yaw += c.omega_rad_s * dt;
+    lowest_y = std::min(lowest_y, y);
+  }
+  EXPECT_TRUE(driver.finished());
+  EXPECT_LT(lowest_y, -2.75);  // reached the dead end's last 0.25 m
+  EXPECT_LT(std::hypot(x, y), 0.3);
+  EXPECT_LT(steps * dt, 22.0 / 0.5 + 30.0);
+}
+
 TEST(DriverTest, ValidateNamesTheField) {
   DriveOptions options;
   options.mode = DriveMode::kWaypoints;

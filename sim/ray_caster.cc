@@ -86,7 +86,9 @@ class RayCaster::Query : public b2QueryCallback {
   std::vector<const FixtureShapes*>* out_;
 };
 
-RayCaster::RayCaster(b2World* world, const b2Body* ignore) : world_(world), ignore_(ignore) {
+RayCaster::RayCaster(b2World* world, const b2Body* ignore,
+                     const std::unordered_map<const b2Fixture*, SurfaceMaterial>* materials)
+    : world_(world), ignore_(ignore) {
   for (b2Body* body = world_->GetBodyList(); body != nullptr; body = body->GetNext()) {
     if (body == ignore_) continue;
     const bool is_static = body->GetType() == b2_staticBody;
@@ -94,6 +96,11 @@ RayCaster::RayCaster(b2World* world, const b2Body* ignore) : world_(world), igno
     for (b2Fixture* fixture = body->GetFixtureList(); fixture != nullptr;
          fixture = fixture->GetNext()) {
       if (fixture->IsSensor()) continue;
+      SurfaceMaterial material = SurfaceMaterial::kMatte;
+      if (materials != nullptr) {
+        if (const auto it = materials->find(fixture); it != materials->end()) material = it->second;
+      }
+      has_materials_ = has_materials_ || material != SurfaceMaterial::kMatte;
       FixtureShapes shapes;
       shapes.body = body;
       shapes.is_static = is_static;
@@ -105,7 +112,8 @@ RayCaster::RayCaster(b2World* world, const b2Body* ignore) : world_(world), igno
             const Eigen::Vector2d a = xf.Apply(ToEigen(polygon->m_vertices[i]));
             const Eigen::Vector2d b =
                 xf.Apply(ToEigen(polygon->m_vertices[(i + 1) % polygon->m_count]));
-            shapes.segments.push_back({a, b - a, xf.Rotate(ToEigen(polygon->m_normals[i])), true});
+            shapes.segments.push_back(
+                {a, b - a, xf.Rotate(ToEigen(polygon->m_normals[i])), true, material});
           }
           break;
         }
@@ -116,13 +124,13 @@ RayCaster::RayCaster(b2World* world, const b2Body* ignore) : world_(world), igno
           const Eigen::Vector2d e = b - a;
           // Box2D's one-sided edges are solid on the right of vertex1 -> vertex2.
           shapes.segments.push_back(
-              {a, e, Eigen::Vector2d(e.y(), -e.x()).normalized(), edge->m_oneSided});
+              {a, e, Eigen::Vector2d(e.y(), -e.x()).normalized(), edge->m_oneSided, material});
           break;
         }
         case b2Shape::e_circle: {
           const auto* circle = static_cast<const b2CircleShape*>(shape);
           shapes.circles.push_back(
-              {xf.Apply(ToEigen(circle->m_p)), static_cast<double>(circle->m_radius)});
+              {xf.Apply(ToEigen(circle->m_p)), static_cast<double>(circle->m_radius), material});
           break;
         }
         default:
@@ -173,6 +181,15 @@ void RayCaster::AddCircle(const Circle& c, double max_range_m) {
   candidates_.push_back({d - c.radius - spread_m_ - kDepthMargin, d, circles_.size() - 1, true});
 }
 
+void RayCaster::Hit(std::size_t k, double t, SurfaceMaterial material, double cos_incidence,
+                    std::span<double> ranges_m) {
+  static const double kReturnCos = std::cos(kSpecularReturnDeg * std::numbers::pi / 180.0);
+  const bool returns = cos_incidence >= kReturnCos;
+  if (!returns && material == SurfaceMaterial::kGlass) return;  // through the glass
+  ranges_m[k] = t;
+  absorbed_[k] = returns ? 0 : 1;
+}
+
 void RayCaster::CastSegment(const Segment& s, const Candidate& candidate, std::span<const Ray> rays,
                             std::span<double> ranges_m) {
   const double d = candidate.distance_m;
@@ -190,7 +207,12 @@ void RayCaster::CastSegment(const Segment& s, const Candidate& candidate, std::s
       if (t < 0.0 || t >= ranges_m[k]) continue;
       const double u = Cross(w, ray.direction) / denom;
       if (u < 0.0 || u > 1.0) continue;
-      ranges_m[k] = t;
+      if (s.material == SurfaceMaterial::kMatte) {
+        ranges_m[k] = t;
+        if (has_materials_) absorbed_[k] = 0;
+      } else {
+        Hit(k, t, s.material, std::abs(ray.direction.dot(s.normal)), ranges_m);
+      }
     }
   };
   const double x = spread_m_ / d;
@@ -227,7 +249,13 @@ void RayCaster::CastCircle(const Circle& c, const Candidate& candidate, std::spa
       // The entry point; negative when the ray starts inside (no hit, as in Box2D).
       const double t = -b - std::sqrt(disc);
       if (t < 0.0 || t >= ranges_m[k]) continue;
-      ranges_m[k] = t;
+      if (c.material == SurfaceMaterial::kMatte) {
+        ranges_m[k] = t;
+        if (has_materials_) absorbed_[k] = 0;
+      } else {
+        // The normal at the entry point is (w + t d) / r; its cosine with d is (b + t) / r.
+        Hit(k, t, c.material, std::abs(b + t) / c.radius, ranges_m);
+      }
     }
   };
   if (d <= (c.radius + spread_m_) * 1.01) {
@@ -247,6 +275,7 @@ void RayCaster::Cast(std::span<const Ray> rays, double max_range_m, std::span<do
   std::fill(ranges_m.begin(), ranges_m.end(), kInfinity);
   num_tests_ = 0;
   if (rays.empty()) return;
+  if (has_materials_) absorbed_.assign(rays.size(), 0);
 
   // The origins' bounding circle.
   Eigen::Vector2d lo = rays.front().origin, hi = rays.front().origin;
@@ -285,10 +314,11 @@ void RayCaster::Cast(std::span<const Ray> rays, double max_range_m, std::span<do
     } else {
       const Transform xf = FromB2(shapes->body->GetTransform());
       for (const Segment& s : shapes->segments) {
-        AddSegment({xf.Apply(s.a), xf.Rotate(s.e), xf.Rotate(s.normal), s.one_sided}, max_range_m);
+        AddSegment({xf.Apply(s.a), xf.Rotate(s.e), xf.Rotate(s.normal), s.one_sided, s.material},
+                   max_range_m);
       }
       for (const Circle& c : shapes->circles)
-        AddCircle({xf.Apply(c.center), c.radius}, max_range_m);
+        AddCircle({xf.Apply(c.center), c.radius, c.material}, max_range_m);
     }
   }
 
@@ -304,6 +334,11 @@ void RayCaster::Cast(std::span<const Ray> rays, double max_range_m, std::span<do
   }
   for (double& range : ranges_m) {
     if (range > max_range_m) range = kInfinity;
+  }
+  if (has_materials_) {
+    for (std::size_t k = 0; k < rays.size(); ++k) {
+      if (absorbed_[k] != 0) ranges_m[k] = kInfinity;
+    }
   }
 }
 

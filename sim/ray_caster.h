@@ -4,7 +4,10 @@
 
 #include <Eigen/Core>
 #include <span>
+#include <unordered_map>
 #include <vector>
+
+#include "sim/shape_spec.h"
 
 namespace slamrig::sim {
 
@@ -28,12 +31,18 @@ struct Ray {
 /// the origins skips the intersection with it (a depth test, as in a z-buffer renderer drawing
 /// front to back): a range is the minimum over the shapes it hits, so neither the order nor the
 /// skipped tests change a single bit of the result.
+///
+/// Fixtures listed in `materials` as glass or black return a ray only within kSpecularReturnDeg of
+/// their normal; otherwise glass lets it through and black stops it without a return (+infinity,
+/// as for no hit). Every other fixture is matte: every ray that reaches it returns.
 class RayCaster {
  public:
   /// Caches the shapes of every fixture of `world` except sensors and the fixtures of `ignore`
   /// (the robot itself). Fixtures must not be added or removed afterwards; bodies may move.
-  /// Static bodies must stay where they are.
-  explicit RayCaster(b2World* world, const b2Body* ignore = nullptr);
+  /// Static bodies must stay where they are. `materials` (may be null) is read here only.
+  explicit RayCaster(
+      b2World* world, const b2Body* ignore = nullptr,
+      const std::unordered_map<const b2Fixture*, SurfaceMaterial>* materials = nullptr);
 
   /// Writes the distance along each ray to the first surface, or +infinity when there is none
   /// within `max_range_m`, into `ranges_m` (same size as `rays`). The rays' `angle_rad` must be
@@ -49,10 +58,12 @@ class RayCaster {
     Eigen::Vector2d e = Eigen::Vector2d::Zero();       // end - start
     Eigen::Vector2d normal = Eigen::Vector2d::Zero();  // outward unit normal of a polygon side
     bool one_sided = false;  // hit only when entering through the normal's side
+    SurfaceMaterial material = SurfaceMaterial::kMatte;
   };
   struct Circle {
     Eigen::Vector2d center = Eigen::Vector2d::Zero();
     double radius = 0.0;
+    SurfaceMaterial material = SurfaceMaterial::kMatte;
   };
   struct FixtureShapes {
     const b2Body* body = nullptr;
@@ -77,6 +88,10 @@ class RayCaster {
                    std::span<double> ranges_m);
   void CastCircle(const Circle& c, const Candidate& candidate, std::span<const Ray> rays,
                   std::span<double> ranges_m);
+  // Records a hit at `t` of ray `k` on a surface of `material` seen at `cos_incidence` (|cosine|
+  // of the angle between the ray and the normal). Only for rays where t < ranges_m[k].
+  void Hit(std::size_t k, double t, SurfaceMaterial material, double cos_incidence,
+           std::span<double> ranges_m);
   // Calls visit(first, last) for the runs of rays whose angle lies in [lo, hi] modulo 2 pi.
   void ForEachRayInInterval(double lo, double hi, std::size_t num_rays, auto&& visit) const;
 
@@ -93,6 +108,8 @@ class RayCaster {
   Eigen::Vector2d center_ = Eigen::Vector2d::Zero();
   double spread_m_ = 0.0;
   long long num_tests_ = 0;
+  bool has_materials_ = false;  // some fixture is not matte
+  std::vector<char> absorbed_;  // per ray: the nearest hit so far returns nothing
 };
 
 }  // namespace slamrig::sim

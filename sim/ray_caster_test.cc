@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <unordered_map>
 #include <vector>
 
 #include "slam/types/random_stream.h"
@@ -410,6 +411,54 @@ TEST(RayCasterTest, IgnoresTheRobotAndRaysFromInsideSolids) {
   std::vector<double> ranges(1);
   caster.Cast(rays, 30.0, ranges);
   EXPECT_NEAR(ranges[0], 4.5, 1e-6);
+}
+
+// A glass pane (box) at x = 4 in front of a matte wall at x = 8, a black pane at y = 4 in front of
+// a matte wall at y = 8, and a glass disc: returns only within kSpecularReturnDeg of the normal.
+TEST(RayCasterTest, GlassAndBlackReturnOnlyNearNormalIncidence) {
+  b2World world(b2Vec2(0.0f, 0.0f));
+  b2BodyDef def;
+  b2Body* ground = world.CreateBody(&def);
+  std::unordered_map<const b2Fixture*, SurfaceMaterial> materials;
+  auto add_box = [&](float hx, float hy, b2Vec2 c, SurfaceMaterial m) {
+    b2PolygonShape box;
+    box.SetAsBox(hx, hy, c, 0.0f);
+    const b2Fixture* f = ground->CreateFixture(&box, 0.0f);
+    if (m != SurfaceMaterial::kMatte) materials[f] = m;
+  };
+  add_box(0.05f, 50.0f, b2Vec2(4.0f, 0.0f), SurfaceMaterial::kGlass);
+  add_box(0.05f, 50.0f, b2Vec2(8.0f, 0.0f), SurfaceMaterial::kMatte);
+  add_box(3.0f, 0.05f, b2Vec2(0.0f, 4.0f), SurfaceMaterial::kBlack);
+  add_box(3.0f, 0.05f, b2Vec2(0.0f, 8.0f), SurfaceMaterial::kMatte);
+  b2CircleShape disc;
+  disc.m_p = b2Vec2(0.0f, -5.0f);
+  disc.m_radius = 1.0f;
+  materials[ground->CreateFixture(&disc, 0.0f)] = SurfaceMaterial::kGlass;
+  RayCaster caster(&world, nullptr, &materials);
+  auto ray = [](double deg) {
+    const double a = deg * std::numbers::pi / 180.0;
+    return Ray{{0.0, 0.0}, {std::cos(a), std::sin(a)}, a};
+  };
+  // Angles in increasing order, as a scanner sweeps.
+  const std::vector<Ray> rays = {ray(-95.0), ray(-90.0), ray(-5.0), ray(0.0),
+                                 ray(30.0),  ray(85.0),  ray(90.0), ray(120.0)};
+  std::vector<double> ranges(rays.size());
+  caster.Cast(rays, 30.0, ranges);
+  EXPECT_EQ(ranges[0], kInf);  // 5 deg off the disc's centre line: far off its normal, through
+  EXPECT_NEAR(ranges[1], 4.0, 1e-6);                                               // disc, head on
+  EXPECT_NEAR(ranges[2], 3.95 / std::cos(5.0 * std::numbers::pi / 180.0), 1e-6);   // glass, 5 deg
+  EXPECT_NEAR(ranges[3], 3.95, 1e-6);                                              // glass, head on
+  EXPECT_NEAR(ranges[4], 7.95 / std::cos(30.0 * std::numbers::pi / 180.0), 1e-6);  // through
+  EXPECT_NEAR(ranges[5], 3.95 / std::cos(5.0 * std::numbers::pi / 180.0), 1e-6);   // black, 5 deg
+  EXPECT_NEAR(ranges[6], 3.95, 1e-6);                                              // black, head on
+  EXPECT_EQ(ranges[7], kInf);  // black at 30 deg off the normal: swallowed, the wall behind hidden
+
+  // Without materials every surface is matte, bit for bit the caster it always was.
+  RayCaster matte(&world);
+  std::vector<double> plain(rays.size());
+  matte.Cast(rays, 30.0, plain);
+  EXPECT_NEAR(plain[4], 3.95 / std::cos(30.0 * std::numbers::pi / 180.0), 1e-6);
+  EXPECT_NEAR(plain[7], 3.95 / std::cos(30.0 * std::numbers::pi / 180.0), 1e-6);
 }
 
 }  // namespace

@@ -29,6 +29,18 @@ bool OnSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::
 
 }  // namespace
 
+const char* SurfaceMaterialName(SurfaceMaterial material) {
+  switch (material) {
+    case SurfaceMaterial::kMatte:
+      return "matte";
+    case SurfaceMaterial::kGlass:
+      return "glass";
+    case SurfaceMaterial::kBlack:
+      return "black";
+  }
+  return "?";
+}
+
 const char* ShapeTypeName(ShapeType type) {
   switch (type) {
     case ShapeType::kBox:

@@ -17,6 +17,22 @@ enum class ShapeType {
 /// Name used in world files ("box", "polygon", "polyline", "circle").
 const char* ShapeTypeName(ShapeType type);
 
+/// How a wall's surface returns a lidar beam. Glass and black surfaces return a beam only near
+/// normal incidence (within kSpecularReturnDeg of the surface normal, where real scanners see a
+/// specular reflection); otherwise a beam passes through glass and is swallowed by black paint
+/// (no return: the lidar reads its maximum range, and nothing behind is seen).
+enum class SurfaceMaterial {
+  kMatte,  ///< every beam that reaches it returns (the default)
+  kGlass,  ///< transparent except near normal incidence
+  kBlack,  ///< opaque, but returns only near normal incidence
+};
+
+/// The incidence angle from the normal up to which glass and black surfaces return a beam.
+inline constexpr double kSpecularReturnDeg = 10.0;
+
+/// Name used in world files ("matte", "glass", "black").
+const char* SurfaceMaterialName(SurfaceMaterial material);
+
 /// One piece of planar geometry in metres, in the frame of whatever owns it (the map frame for
 /// walls and zones, the obstacle frame for moving obstacles). Only the fields of `type` are used.
 struct ShapeSpec {
@@ -27,6 +43,7 @@ struct ShapeSpec {
   double radius_m = 0.5;                               ///< circle radius
   std::vector<Eigen::Vector2d> points_m;               ///< polygon or polyline vertices
   bool closed = false;  ///< polyline: join the last point to the first
+  SurfaceMaterial material = SurfaceMaterial::kMatte;  ///< how the lidar sees it (walls only)
 
   /// One message per broken rule, field names relative to the shape, e.g.
   /// "radius_m = -1; must be > 0" or "points: edges 0 and 2 cross; the polygon must be simple".

@@ -46,7 +46,7 @@ Simulator::Simulator(const SimulatorOptions& options)
   SLAMRIG_CHECK(errors.empty(), errors.empty() ? "" : errors.front().c_str());
   world_ = std::make_unique<World>(options_.world);
   robot_ = std::make_unique<Robot>(options_.robot, world_.get(), options_.world.spawn);
-  caster_ = std::make_unique<RayCaster>(world_->b2world(), robot_->body());
+  caster_ = std::make_unique<RayCaster>(world_->b2world(), robot_->body(), &world_->materials());
   step_ns_ = PeriodNs(options_.physics_rate_hz);
   step_s_ = static_cast<double>(step_ns_) * 1e-9;
 

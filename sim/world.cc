@@ -69,11 +69,14 @@ World::World(const WorldSpec& spec) : spec_(spec) {
 World::~World() = default;
 
 void World::AddWall(const ShapeSpec& shape, b2Body* body) {
-  auto add_edge = [body](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  auto create = [&](const b2FixtureDef& def) {
+    const b2Fixture* fixture = body->CreateFixture(&def);
+    if (shape.material != SurfaceMaterial::kMatte) materials_[fixture] = shape.material;
+  };
+  auto add_edge = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     b2EdgeShape edge;
     edge.SetTwoSided(ToB2(a), ToB2(b));
-    const b2FixtureDef def = WallFixtureDef(&edge);
-    body->CreateFixture(&def);
+    create(WallFixtureDef(&edge));
   };
   switch (shape.type) {
     case ShapeType::kBox: {
@@ -81,16 +84,14 @@ void World::AddWall(const ShapeSpec& shape, b2Body* body) {
       box.SetAsBox(static_cast<float>(0.5 * shape.size_m.x()),
                    static_cast<float>(0.5 * shape.size_m.y()), ToB2(shape.center_m),
                    static_cast<float>(shape.angle_rad));
-      const b2FixtureDef def = WallFixtureDef(&box);
-      body->CreateFixture(&def);
+      create(WallFixtureDef(&box));
       break;
     }
     case ShapeType::kCircle: {
       b2CircleShape circle;
       circle.m_p = ToB2(shape.center_m);
       circle.m_radius = static_cast<float>(shape.radius_m);
-      const b2FixtureDef def = WallFixtureDef(&circle);
-      body->CreateFixture(&def);
+      create(WallFixtureDef(&circle));
       break;
     }
     case ShapeType::kPolygon: {
@@ -100,8 +101,7 @@ void World::AddWall(const ShapeSpec& shape, b2Body* body) {
         for (const auto& p : outline) points.push_back(ToB2(p));
         b2PolygonShape polygon;
         polygon.Set(points.data(), static_cast<int32>(points.size()));
-        const b2FixtureDef def = WallFixtureDef(&polygon);
-        body->CreateFixture(&def);
+        create(WallFixtureDef(&polygon));
       } else {
         for (std::size_t i = 0; i < outline.size(); ++i) {
           add_edge(outline[i], outline[(i + 1) % outline.size()]);

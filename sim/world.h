@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "sim/world_spec.h"
@@ -43,6 +44,10 @@ class World {
   const WorldSpec& spec() const { return spec_; }
   /// Boxes the imported map was merged into (0 without a map).
   int num_map_boxes() const { return num_map_boxes_; }
+  /// The fixtures whose surface is not matte, with their material (for the RayCaster).
+  const std::unordered_map<const b2Fixture*, SurfaceMaterial>& materials() const {
+    return materials_;
+  }
 
  private:
   struct ObstaclePath {
@@ -59,6 +64,7 @@ class World {
   std::vector<b2Body*> obstacle_bodies_;
   std::vector<ObstaclePath> obstacle_paths_;
   int num_map_boxes_ = 0;
+  std::unordered_map<const b2Fixture*, SurfaceMaterial> materials_;
 };
 
 }  // namespace slamrig::sim

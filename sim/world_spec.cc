@@ -19,6 +19,10 @@ std::vector<std::string> ZoneSpec::Validate() const {
   if (shape.type == ShapeType::kPolyline) {
     errors.push_back("shape.type = polyline; a zone needs an area (box, polygon or circle)");
   }
+  if (shape.material != SurfaceMaterial::kMatte) {
+    errors.push_back(std::string("shape.material = ") + SurfaceMaterialName(shape.material) +
+                     "; a zone is a floor no sensor sees, it has no material");
+  }
   AppendErrors(&errors, PrefixErrors("shape", shape.Validate()));
   return errors;
 }

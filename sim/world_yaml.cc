@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <system_error>
+#include <type_traits>
 
 #include "sim/mount_pose.h"
 #include "slam/config/fields.h"
@@ -36,6 +37,13 @@ void VisitFields(V& v, ShapeSpec& s) {
       v("points_m", s.points_m);
       v("closed", s.closed);
       break;
+  }
+  // Written only when not matte, so that a world without materials resolves to the same text.
+  if (!std::is_same_v<V, FieldWriter> || s.material != SurfaceMaterial::kMatte) {
+    v.Enum("material", s.material,
+           {{SurfaceMaterial::kMatte, "matte"},
+            {SurfaceMaterial::kGlass, "glass"},
+            {SurfaceMaterial::kBlack, "black"}});
   }
 }
 
@@ -90,6 +98,10 @@ void VisitFields(V& v, DriveOptions& d) {
   v("max_decel_m_s2", d.max_decel_m_s2);
   v("goal_tolerance_m", d.goal_tolerance_m);
   v("turn_in_place_rad", d.turn_in_place_rad);
+  // Written only when set, so that a world without dead ends resolves to the same text.
+  if (!std::is_same_v<V, FieldWriter> || d.dead_end_reach_m != 0.0) {
+    v("dead_end_reach_m", d.dead_end_reach_m);
+  }
   v.List("schedule", d.schedule);
 }
 

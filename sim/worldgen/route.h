@@ -1,0 +1,24 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "sim/worldgen/layout.h"
+
+namespace slamrig::sim::worldgen {
+
+/// A closed drive over a layout's graph.
+struct Route {
+  std::vector<Eigen::Vector2d> waypoints;  ///< closed: the robot returns to the first one
+  double length_m = 0.0;                   ///< one lap
+  int loops = 0;      ///< independent cycles of the graph it drives (edges - nodes + 1)
+  int reversals = 0;  ///< dead ends and spurs it drives into and back out of
+};
+
+/// Plans a closed walk from the layout's start node that drives every edge (and every spur,
+/// there and back, on its edge's first pass): a Chinese-postman tour, odd nodes paired greedily
+/// by shortest path and those paths driven twice, the Euler circuit found by Hierholzer's
+/// algorithm. Dead ends are driven in and back out. The graph must be connected (checked).
+Route PlanRoute(const Layout& layout);
+
+}  // namespace slamrig::sim::worldgen
