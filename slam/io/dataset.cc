@@ -28,6 +28,7 @@ Dataset CarmenToDataset(const CarmenLog& log) {
   Dataset data;
   data.source = log.path;
   data.notes = log.notes;
+  data.times_synthesised = !log.timestamps_usable;
   const std::vector<Entry> entries = InFileOrder(log);
 
   if (log.is_corrected) {

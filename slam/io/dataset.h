@@ -17,6 +17,9 @@ struct Dataset {
   std::string format;              ///< its format ("carmen", "ece276a"; see log_reader.h)
   std::string reference_kind;      ///< what `reference` is, e.g. "GMapping-corrected poses"
   std::vector<std::string> notes;  ///< quirks found while reading, for the user
+  /// The log's stamps were unusable and its times were made up from line order: the data's
+  /// duration is not a duration, and no real-time factor can be given.
+  bool times_synthesised = false;
 };
 
 /// Turns a CARMEN log into a Dataset.
