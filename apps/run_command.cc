@@ -81,8 +81,14 @@ int RunRunCommand(const std::vector<std::string>& args) {
   scenario::WriteReport(result, out_dir);
 
   if (!quiet) {
-    std::printf("  %.1f s simulated in %.1f s (%.0fx real time), %d scans", result.sim_time_s,
-                wall_s, result.sim_time_s / std::max(wall_s, 1e-9), result.scans);
+    if (result.times_synthesised) {
+      std::printf(
+          "  %s in %.1f s (times synthesised from line order; no real-time factor), %d scans",
+          spec.log->path.c_str(), wall_s, result.scans);
+    } else {
+      std::printf("  %.1f s simulated in %.1f s (%.0fx real time), %d scans", result.sim_time_s,
+                  wall_s, result.sim_time_s / std::max(wall_s, 1e-9), result.scans);
+    }
     if (result.scans_blacked_out) std::printf(" (%d blacked out)", result.scans_blacked_out);
     std::printf("\n");
     for (const auto& c : result.configs) {

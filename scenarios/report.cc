@@ -10,6 +10,7 @@
 #include "scenarios/plot.h"
 #include "scenarios/scenario_result.h"
 #include "slam/eval/json_writer.h"
+#include "slam/eval/nees.h"
 #include "slam/eval/pose_association.h"
 #include "slam/fusion/consistency.h"
 #include "slam/io/atomic_file.h"
@@ -61,9 +62,15 @@ void ErrorsOverTime(const Trajectory& estimate, const Trajectory& truth, std::ve
   }
 }
 
-// Every metric any configuration has, KnownMetrics() first, in a stable order.
+// Every metric some configuration has, in KnownMetrics() order first, then the others.
 std::vector<std::string> AllMetrics(const ScenarioResult& r) {
-  std::vector<std::string> names = KnownMetrics();
+  const auto any_has = [&](const std::string& name) {
+    return std::any_of(r.configs.begin(), r.configs.end(),
+                       [&](const ConfigResult& c) { return c.metrics.count(name) > 0; });
+  };
+  std::vector<std::string> names;
+  for (const std::string& name : KnownMetrics())
+    if (any_has(name)) names.push_back(name);
   for (const ConfigResult& c : r.configs) {
     for (const auto& [name, value] : c.metrics) {
       if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
@@ -72,14 +79,49 @@ std::vector<std::string> AllMetrics(const ScenarioResult& r) {
   return names;
 }
 
+const char* OdometrySourceName(slam::OdometrySource s) {
+  switch (s) {
+    case slam::OdometrySource::kWheelTicks:
+      return "wheel_ticks";
+    case slam::OdometrySource::kOdometryPoses:
+      return "poses";
+    case slam::OdometrySource::kNone:
+      return "none";
+    case slam::OdometrySource::kAuto:
+      break;
+  }
+  return "auto";
+}
+
+// How a configuration ran (not a metric: no expectation takes these): the odometry it used,
+// the wall time it took, what the synchroniser and the log's stamps did, its map's raster.
+void WriteRunFacts(const ConfigResult& c, slam::JsonWriter* j) {
+  j->BeginObject("run")
+      .String("odometry_source", OdometrySourceName(c.run.odometry_source))
+      .Number("wall_time_s", c.run.wall_s)
+      .Integer("poses", static_cast<long long>(c.estimate.size()))
+      .Integer("gyro_fallbacks", c.run.gyro_fallbacks)
+      .Integer("scans_without_odometry", c.run.scans_without_odometry)
+      .Integer("out_of_order_stamps", c.run.final.out_of_order());
+  j->BeginObject("map")
+      .Number("resolution_m", c.run.map.resolution())
+      .Integer("width", c.run.map.width())
+      .Integer("height", c.run.map.height())
+      .EndObject();
+  j->EndObject();
+}
+
+// The one metrics.json schema of `slamrig run` and `slamrig slam` (see the pipeline notes).
 std::string MetricsJson(const ScenarioResult& r) {
   slam::JsonWriter j;
   j.String("scenario", r.spec->name)
       .Integer("seed", static_cast<long long>(r.spec->seed))
       .String("source", r.spec->simulated ? "simulation" : r.spec->log->path)
-      .String("reference", r.reference_kind)
+      .String("log_format", r.spec->simulated ? "" : r.log_format)
+      .String("reference", r.truth.empty() ? "" : r.reference_kind)
       .Bool("passed", r.passed)
       .Number("sim_time_s", r.sim_time_s)
+      .Bool("times_synthesised", r.times_synthesised)
       .Integer("scans", r.scans)
       .Integer("scans_blacked_out", r.scans_blacked_out)
       .Integer("kidnaps", r.kidnaps_done)
@@ -92,7 +134,9 @@ std::string MetricsJson(const ScenarioResult& r) {
   j.BeginObject("configs");
   for (const ConfigResult& c : r.configs) {
     j.BeginObject(c.name);
+    j.String("algorithm", c.algorithm);
     for (const auto& [name, value] : c.metrics) j.Number(name, value);
+    WriteRunFacts(c, &j);
     j.BeginObject("config");
     for (const slam::EstimatorConfig& config : r.spec->configs) {
       if (config.name == c.name) slam::WriteEstimatorConfigJson(config, &j);
@@ -229,26 +273,41 @@ std::string ExpectationTable(const ScenarioResult& r) {
   return out;
 }
 
-void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
-  fs::create_directories(out_dir);
-  const fs::path dir(out_dir);
-  auto file = [&](const std::string& name) { return (dir / name).string(); };
-  // metrics.json, written last, marks a complete folder: an earlier run's must not vouch for
-  // files this one only half replaced.
-  fs::remove(file("metrics.json"));
-  slam::WriteFileAtomically(file("config.yaml"), r.spec->resolved_yaml);
-  slam::WriteTum(file("truth.tum"), r.truth);
+namespace {
 
-  // Trajectories and maps.
-  std::vector<slam::TrajectoryOverlay> overlays = {{&r.truth, r.reference_kind, 40, 160, 40}};
-  for (std::size_t i = 0; i < r.configs.size(); ++i) {
-    const ConfigResult& c = r.configs[i];
+// A file of the report folder.
+class Folder {
+ public:
+  explicit Folder(const std::string& dir) : dir_(dir) {}
+  std::string operator()(const std::string& name) const { return (dir_ / name).string(); }
+  void WritePng(const std::string& name, const cv::Mat3b& rgb) const {
+    cv::Mat bgr;
+    cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+    std::vector<std::uint8_t> png;
+    cv::imencode(".png", bgr, png);
+    slam::WriteFileAtomically((*this)(name), std::string(png.begin(), png.end()));
+  }
+
+ private:
+  fs::path dir_;
+};
+
+// Configuration i's colour: the palette, skipping its green (the truth's).
+Colour ConfigColour(std::size_t i) { return PaletteColour(i == 2 ? 4 : i); }
+
+std::string Figure(const std::string& png, const std::string& caption = "") {
+  return "<figure><img src=\"" + png + "\">" +
+         (caption.empty() ? "" : "<figcaption>" + caption + "</figcaption>") + "</figure>";
+}
+
+// Each configuration's trajectories (final, online where it revised its past), covariances,
+// landmarks and map (map_server), in the map frame.
+void WriteConfigFiles(const ScenarioResult& r, const Folder& file) {
+  for (const ConfigResult& c : r.configs) {
     slam::WriteTum(file(c.name + ".tum"), c.estimate);
-    // An estimator that revised its past: what it reported online, too.
     if (c.run.final.poses() != c.run.online.poses()) {
       slam::WriteTum(file(c.name + "_online.tum"), c.online);
     }
-    // The online poses' covariances, in the map frame as the trajectories are.
     if (!c.run.covariances.empty()) {
       std::vector<Eigen::Matrix3d> in_map;
       for (const Eigen::Matrix3d& p : c.run.covariances)
@@ -259,113 +318,125 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
     if (!c.run.landmarks.landmarks.empty()) {
       slam::WriteFileAtomically(file(c.name + "_landmarks.csv"), LandmarksCsv(c));
     }
-    const Colour colour = PaletteColour(i == 2 ? 4 : i);  // skip palette green (the truth's)
-    overlays.push_back({&c.estimate, c.name, colour.b, colour.g, colour.r});
-    slam::WriteMapServerMap(c.run.map, file(c.name + "_map"));
+    if (r.scans > 0) slam::WriteMapServerMap(c.run.map, file(c.name + "_map"));
   }
-  // The map picture: the truth map (true poses, same scans) under every trajectory.
-  const slam::OccupancyGrid* background = r.truth_map ? &*r.truth_map : nullptr;
-  if (!background && !r.configs.empty()) background = &r.configs.front().run.map;
-  const std::string truth_source = r.spec->simulated ? "true poses" : r.reference_kind;
-  std::string html_maps;
-  if (background) {
-    slam::MapImageOptions options;
-    options.title = r.spec->name + ": map from " + truth_source + ", trajectories overlaid";
-    slam::WriteMapPng(file("map.png"), *background, overlays, options);
-    html_maps += "<figure><img src=\"map.png\"><figcaption>The map from the " + Html(truth_source) +
-                 " with the reference and estimated trajectories.</figcaption></figure>";
-    for (std::size_t i = 0; i < r.configs.size(); ++i) {
-      const ConfigResult& c = r.configs[i];
-      // The estimator's map is in its own frame: bring both trajectories there.
-      const Pose2 estimator_from_map = c.map_from_estimator.Inverse();
-      Trajectory truth_local, estimate_local;
-      for (const auto& p : r.truth.poses()) truth_local.Append(p.time, estimator_from_map * p.pose);
-      for (const auto& p : c.estimate.poses())
-        estimate_local.Append(p.time, estimator_from_map * p.pose);
-      slam::TrajectoryOverlay truth_overlay = overlays[0], estimate_overlay = overlays[i + 1];
-      truth_overlay.trajectory = &truth_local;
-      estimate_overlay.trajectory = &estimate_local;
-      slam::MapImageOptions own;
-      own.title = c.name + ": its own map and trajectory";
-      // Its loop closures: green when they agree with the reference (or there is none), red not.
-      const auto& final_poses = c.run.final.poses();
-      for (std::size_t k = 0; k < c.run.loop_closures.size(); ++k) {
-        const slam::LoopClosure& loop = c.run.loop_closures[k];
-        if (loop.from_scan < 0 || loop.to_scan < 0 ||
-            static_cast<std::size_t>(std::max(loop.from_scan, loop.to_scan)) >=
-                final_poses.size()) {
-          continue;
-        }
-        const bool ok = k >= c.loop_is_true.size() || c.loop_is_true[k];
-        own.segments.push_back({final_poses[loop.from_scan].pose.translation(),
-                                final_poses[loop.to_scan].pose.translation(), 0,
-                                static_cast<std::uint8_t>(ok ? 170 : 0),
-                                static_cast<std::uint8_t>(ok ? 0 : 220)});
-      }
-      // A landmark estimator's landmarks (crosses) with their 3-sigma ellipses, the true
-      // pillars (green crosses, in its frame) and the last pose's 3-sigma position ellipse.
-      const bool has_landmarks = !c.run.landmarks.landmarks.empty();
-      if (has_landmarks) {
-        const Colour mark = PaletteColour(3);
-        for (const slam::LandmarkEstimate& l : c.run.landmarks.landmarks) {
-          AddCross(l.position_m, 0.4, mark, &own.segments);
-          AddEllipse(l.position_m, l.covariance, mark, &own.segments);
-        }
-        if (r.spec->simulated) {
-          for (const sim::ShapeSpec& shape : r.spec->simulated->options.world.walls) {
-            if (shape.type == sim::ShapeType::kCircle)
-              AddCross(estimator_from_map * shape.center_m, 0.6, {40, 160, 40}, &own.segments);
-          }
-        }
-        if (!c.run.covariances.empty() && !c.run.online.empty()) {
-          AddEllipse(c.run.online.poses().back().pose.translation(),
-                     c.run.covariances.back().topLeftCorner<2, 2>(), mark, &own.segments);
-        }
-      }
-      slam::WriteMapPng(file(c.name + "_map.png"), c.run.map, {truth_overlay, estimate_overlay},
-                        own);
-      html_maps += "<figure><img src=\"" + c.name + "_map.png\"><figcaption>" + Html(c.name) +
-                   "'s map with its trajectory (and the truth, in green)" +
-                   (has_landmarks ? "; its landmarks (crosses) with 3-sigma ellipses, the true "
-                                    "pillars (green crosses) and the last pose's 3-sigma "
-                                    "ellipse"
-                                  : "") +
-                   ".</figcaption></figure>";
+}
+
+// The overlays of a configuration's own map: its loop closures (green when the reference agrees
+// or there is none, red not) and, for a landmark estimator, its landmarks with 3-sigma ellipses,
+// the true pillars (green crosses) and the last pose's 3-sigma position ellipse.
+std::vector<slam::SegmentOverlay> OwnMapSegments(const ScenarioResult& r, const ConfigResult& c) {
+  std::vector<slam::SegmentOverlay> segments;
+  const auto& final_poses = c.run.final.poses();
+  for (std::size_t k = 0; k < c.run.loop_closures.size(); ++k) {
+    const slam::LoopClosure& loop = c.run.loop_closures[k];
+    if (loop.from_scan < 0 || loop.to_scan < 0 ||
+        static_cast<std::size_t>(std::max(loop.from_scan, loop.to_scan)) >= final_poses.size()) {
+      continue;
+    }
+    const bool ok = k >= c.loop_is_true.size() || c.loop_is_true[k];
+    segments.push_back({final_poses[loop.from_scan].pose.translation(),
+                        final_poses[loop.to_scan].pose.translation(), 0,
+                        static_cast<std::uint8_t>(ok ? 170 : 0),
+                        static_cast<std::uint8_t>(ok ? 0 : 220)});
+  }
+  if (c.run.landmarks.landmarks.empty()) return segments;
+  const Colour mark = PaletteColour(3);
+  for (const slam::LandmarkEstimate& l : c.run.landmarks.landmarks) {
+    AddCross(l.position_m, 0.4, mark, &segments);
+    AddEllipse(l.position_m, l.covariance, mark, &segments);
+  }
+  if (r.spec->simulated) {
+    const Pose2 estimator_from_map = c.map_from_estimator.Inverse();
+    for (const sim::ShapeSpec& shape : r.spec->simulated->options.world.walls) {
+      if (shape.type == sim::ShapeType::kCircle)
+        AddCross(estimator_from_map * shape.center_m, 0.6, {40, 160, 40}, &segments);
     }
   }
+  if (!c.run.covariances.empty() && !c.run.online.empty()) {
+    AddEllipse(c.run.online.poses().back().pose.translation(),
+               c.run.covariances.back().topLeftCorner<2, 2>(), mark, &segments);
+  }
+  return segments;
+}
 
-  // The floor texture: the truth, the map from the true poses, each configuration's map.
-  std::string html_texture;
-  const auto write_rgb = [&](const std::string& name, const cv::Mat3b& rgb) {
-    cv::Mat bgr;
-    cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
-    std::vector<std::uint8_t> png;
-    cv::imencode(".png", bgr, png);
-    slam::WriteFileAtomically(file(name), std::string(png.begin(), png.end()));
-  };
+// map.png (the truth map, or the first configuration's, under every trajectory) and each
+// configuration's own map with its trajectory and the truth in its frame; their figures.
+std::string MapsHtml(const ScenarioResult& r, const Folder& file) {
+  const slam::OccupancyGrid* background = r.truth_map ? &*r.truth_map : nullptr;
+  if (!background && !r.configs.empty()) background = &r.configs.front().run.map;
+  if (!background || r.scans == 0) return "";  // no scan, no map
+  const slam::TrajectoryOverlay truth_overlay{&r.truth, r.reference_kind, 40, 160, 40};
+  std::vector<slam::TrajectoryOverlay> overlays = {truth_overlay};
+  for (std::size_t i = 0; i < r.configs.size(); ++i) {
+    const Colour colour = ConfigColour(i);
+    overlays.push_back({&r.configs[i].estimate, r.configs[i].name, colour.b, colour.g, colour.r});
+  }
+  const std::string truth_source = r.spec->simulated ? "true poses" : r.reference_kind;
+  slam::MapImageOptions options;
+  options.title = r.spec->name + ": map from " + truth_source + ", trajectories overlaid";
+  slam::WriteMapPng(file("map.png"), *background, overlays, options);
+  std::string html = Figure("map.png", "The map from the " + Html(truth_source) +
+                                           " with the reference and estimated trajectories.");
+  for (std::size_t i = 0; i < r.configs.size(); ++i) {
+    const ConfigResult& c = r.configs[i];
+    // The estimator's map is in its own frame: bring both trajectories there.
+    const Pose2 estimator_from_map = c.map_from_estimator.Inverse();
+    Trajectory truth_local, estimate_local;
+    for (const auto& p : r.truth.poses()) truth_local.Append(p.time, estimator_from_map * p.pose);
+    for (const auto& p : c.estimate.poses())
+      estimate_local.Append(p.time, estimator_from_map * p.pose);
+    slam::TrajectoryOverlay truth_here = truth_overlay, estimate_here = overlays[i + 1];
+    truth_here.trajectory = &truth_local;
+    estimate_here.trajectory = &estimate_local;
+    slam::MapImageOptions own;
+    own.title = c.name + ": its own map and trajectory";
+    own.segments = OwnMapSegments(r, c);
+    slam::WriteMapPng(file(c.name + "_map.png"), c.run.map, {truth_here, estimate_here}, own);
+    const bool has_landmarks = !c.run.landmarks.landmarks.empty();
+    html += Figure(c.name + "_map.png",
+                   Html(c.name) + "'s map with its trajectory" +
+                       (r.truth.empty() ? "" : " (and the reference, in green)") +
+                       (has_landmarks ? "; its landmarks (crosses) with 3-sigma ellipses, the "
+                                        "true pillars (green crosses) and the last pose's "
+                                        "3-sigma ellipse"
+                                      : "") +
+                       ".");
+  }
+  return html;
+}
+
+// The floor texture: the truth, the map from the true poses, each configuration's map.
+std::string TextureHtml(const ScenarioResult& r, const Folder& file) {
+  std::string html;
   if (r.true_texture && r.truth_texture) {
-    write_rgb("texture_truth.png", *r.true_texture);
-    write_rgb("texture_true_poses.png", r.truth_texture->colors);
-    html_texture +=
-        "<figure><img src=\"texture_truth.png\"><figcaption>The true floor texture."
-        "</figcaption></figure><figure><img src=\"texture_true_poses.png\">"
-        "<figcaption>The texture map from the true poses (PSNR " +
-        Number(r.truth_texture->score.psnr_db.value_or(NAN)) + " dB, coverage " +
-        Number(r.truth_texture->score.coverage) + ").</figcaption></figure>";
+    file.WritePng("texture_truth.png", *r.true_texture);
+    file.WritePng("texture_true_poses.png", r.truth_texture->colors);
+    html += Figure("texture_truth.png", "The true floor texture.") +
+            Figure("texture_true_poses.png",
+                   "The texture map from the true poses (PSNR " +
+                       Number(r.truth_texture->score.psnr_db.value_or(NAN)) + " dB, coverage " +
+                       Number(r.truth_texture->score.coverage) + ").");
   }
   for (const ConfigResult& c : r.configs) {
     if (!c.texture) continue;
-    write_rgb(c.name + "_texture.png", c.texture->colors);
-    html_texture += "<figure><img src=\"" + c.name + "_texture.png\"><figcaption>" + Html(c.name) +
-                    "'s texture map from its final poses, in the frame ATE aligns them to (PSNR " +
-                    Number(c.texture->score.psnr_db.value_or(NAN)) + " dB).</figcaption></figure>";
+    file.WritePng(c.name + "_texture.png", c.texture->colors);
+    html += Figure(c.name + "_texture.png",
+                   Html(c.name) +
+                       "'s texture map from its final poses, in the frame ATE aligns them to "
+                       "(PSNR " +
+                       Number(c.texture->score.psnr_db.value_or(NAN)) + " dB).");
   }
+  return html;
+}
 
-  // Errors over time, per configuration.
+// Position and heading error over time, per configuration (a run with a reference).
+std::string ErrorPlotsHtml(const ScenarioResult& r, const Folder& file) {
+  if (r.truth.empty()) return "";
   std::vector<PlotSeries> position, heading;
   for (std::size_t i = 0; i < r.configs.size(); ++i) {
     const ConfigResult& c = r.configs[i];
-    PlotSeries p{c.name, {}, {}, {}, {}, PaletteColour(i == 2 ? 4 : i)};
+    PlotSeries p{c.name, {}, {}, {}, {}, ConfigColour(i)};
     PlotSeries h = p;
     ErrorsOverTime(c.estimate, r.truth, &p.x, &p.y, &h.y);
     h.x = p.x;
@@ -381,11 +452,11 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
   options.title = "Heading error";
   options.y_label = "error [deg]";
   slam::WriteFileAtomically(file("heading_error.png"), RenderLinePlotPng(heading, options));
-  std::string html_plots =
-      "<figure><img src=\"position_error.png\"></figure><figure><img "
-      "src=\"heading_error.png\"></figure>";
+  return Figure("position_error.png") + Figure("heading_error.png");
+}
 
-  // The pose NEES over time with chi2_3's two-sided 95 % region (Bar-Shalom et al., Sec. 5.4.2).
+// The pose NEES over time with chi2_3's two-sided 95 % region (Bar-Shalom et al., Sec. 5.4.2).
+std::string NeesPlotHtml(const ScenarioResult& r, const Folder& file) {
   std::vector<PlotSeries> nees;
   for (std::size_t i = 0; i < r.configs.size(); ++i) {
     const ConfigResult& c = r.configs[i];
@@ -395,45 +466,53 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
     // On a log scale: an inconsistent filter's NEES runs to thousands.
     std::vector<double> log_nees;
     for (double v : c.nees) log_nees.push_back(std::log10(std::max(v, 1e-6)));
-    nees.push_back({c.name, t, log_nees, {}, {}, PaletteColour(i == 2 ? 4 : i)});
+    nees.push_back({c.name, t, log_nees, {}, {}, ConfigColour(i)});
   }
-  if (!nees.empty()) {
-    const slam::NeesBounds bounds = slam::AneesBounds(3, 1);
-    const std::vector<double> span = {nees.front().x.front(), nees.front().x.back()};
-    const double lower = std::log10(bounds.lower), upper = std::log10(bounds.upper);
-    nees.push_back({"95 % lower", span, {lower, lower}, {}, {}, PaletteColour(3), false, true});
-    nees.push_back({"95 % upper", span, {upper, upper}, {}, {}, PaletteColour(3), false, true});
-    options.title = "Pose NEES e^T P^-1 e (3 dof, log10) with the chi-square 95 % region";
-    options.y_label = "log10 NEES";
-    options.y_from_zero = false;
-    slam::WriteFileAtomically(file("nees.png"), RenderLinePlotPng(nees, options));
-    html_plots += "<figure><img src=\"nees.png\"></figure>";
-    options.y_from_zero = true;
-  }
+  if (nees.empty()) return "";
+  const slam::NeesBounds bounds = slam::AneesBounds(3, 1);
+  const std::vector<double> span = {nees.front().x.front(), nees.front().x.back()};
+  const double lower = std::log10(bounds.lower), upper = std::log10(bounds.upper);
+  nees.push_back({"95 % lower", span, {lower, lower}, {}, {}, PaletteColour(3), false, true});
+  nees.push_back({"95 % upper", span, {upper, upper}, {}, {}, PaletteColour(3), false, true});
+  PlotOptions options;
+  options.title = "Pose NEES e^T P^-1 e (3 dof, log10) with the chi-square 95 % region";
+  options.x_label = "time [s]";
+  options.y_label = "log10 NEES";
+  options.y_from_zero = false;
+  slam::WriteFileAtomically(file("nees.png"), RenderLinePlotPng(nees, options));
+  return Figure("nees.png");
+}
 
-  // Every per-scan trace the estimators report (a PF's Neff, ...), one plot per name.
+// Every per-scan trace the estimators report (a PF's Neff, ...), one plot per name.
+std::string TracePlotsHtml(const ScenarioResult& r, const Folder& file) {
   std::map<std::string, std::vector<PlotSeries>> traces;
   const double t0 = r.truth.empty() ? 0.0 : r.truth[0].time.seconds();
   for (std::size_t i = 0; i < r.configs.size(); ++i) {
     const ConfigResult& c = r.configs[i];
     std::vector<double> t = c.run.trace_time_s;
     for (double& v : t) v -= t0;
-    for (const auto& [name, values] : c.run.traces) {
-      traces[name].push_back({c.name, t, values, {}, {}, PaletteColour(i == 2 ? 4 : i)});
-    }
+    for (const auto& [name, values] : c.run.traces)
+      traces[name].push_back({c.name, t, values, {}, {}, ConfigColour(i)});
   }
+  std::string html;
+  PlotOptions options;
+  options.x_label = "time [s]";
   for (const auto& [name, series] : traces) {
     options.title = name == "neff" ? "Effective sample size Neff = 1 / sum(w^2) after each scan"
                                    : name + " after each scan";
     options.y_label = name == "neff" ? "Neff" : name;
     slam::WriteFileAtomically(file(name + ".png"), RenderLinePlotPng(series, options));
-    html_plots += "<figure><img src=\"" + name + ".png\"></figure>";
+    html += Figure(name + ".png");
   }
+  return html;
+}
 
-  // Metrics side by side.
+// The trajectory errors side by side (configurations scored against a reference).
+std::string ErrorsByConfigHtml(const ScenarioResult& r, const Folder& file) {
   std::vector<std::string> names;
   std::vector<std::vector<double>> values;
   for (const ConfigResult& c : r.configs) {
+    if (!c.metrics.count("ate_rmse_m")) continue;
     names.push_back(c.name);
     auto get = [&](const char* m) {
       const auto it = c.metrics.find(m);
@@ -442,45 +521,55 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
     values.push_back(
         {get("ate_rmse_m"), get("ate_max_m"), get("rpe_m_per_10m"), get("final_error_m")});
   }
+  if (names.empty()) return "";
+  PlotOptions options;
   options.title = "Trajectory errors per SLAM configuration";
   options.y_label = "metres";
-  options.x_label = "";
   slam::WriteFileAtomically(
       file("errors_by_config.png"),
       RenderBarChartPng(names, {"ATE RMSE", "ATE max", "RPE per 10 m", "final error"}, values,
                         options));
-  html_plots += "<figure><img src=\"errors_by_config.png\"></figure>";
+  return Figure("errors_by_config.png");
+}
 
-  // report.html, written last: its presence means the folder is complete.
+// The run in one sentence, and the files to download.
+std::string SummaryHtml(const ScenarioResult& r) {
   std::ostringstream h;
-  h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>" << Html(r.spec->name)
-    << "</title><style>body{font-family:sans-serif;margin:2em;max-width:1100px}"
-       "img{max-width:100%;border:1px solid #ddd}figure{margin:1em 0}"
-       "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:4px "
-       "10px;text-align:right}"
-       "th:first-child,td:first-child{text-align:left}.pass{color:#080;font-weight:bold}"
-       ".fail{color:#c00;font-weight:bold}</style></head><body>";
-  h << "<h1>" << Html(r.spec->name) << " <span class=\""
-    << (r.passed ? "pass\">PASS" : "fail\">FAIL") << "</span></h1><p>" << Html(r.spec->description)
-    << "</p><p>Seed " << r.spec->seed << ", " << Number(r.sim_time_s, "%.1f")
-    << (r.spec->simulated ? " s simulated, " : " s of " + Html(r.spec->log->path) + ", ") << r.scans
-    << " scans";
+  h << "<p>Seed " << r.spec->seed << ", ";
+  if (r.times_synthesised) {
+    h << Html(r.spec->log->path) << " (times synthesised from line order; no real-time factor)";
+  } else {
+    h << Number(r.sim_time_s, "%.1f")
+      << (r.spec->simulated ? " s simulated" : " s of " + Html(r.spec->log->path));
+  }
+  h << ", " << r.scans << " scans";
   if (r.scans_blacked_out) h << " (" << r.scans_blacked_out << " blacked out)";
   if (r.kidnaps_done) h << ", " << r.kidnaps_done << " kidnapping(s)";
   h << ". Files: <a href=\"config.yaml\">config.yaml</a>, <a "
-       "href=\"metrics.json\">metrics.json</a>, "
-       "<a href=\"truth.tum\">truth.tum</a>";
+       "href=\"metrics.json\">metrics.json</a>";
+  if (!r.truth.empty()) h << ", <a href=\"truth.tum\">truth.tum</a>";
   for (const auto& c : r.configs)
     h << ", <a href=\"" << c.name << ".tum\">" << c.name << ".tum</a>";
-  h << ".</p><h2>Expectations</h2><table><tr><th>expectation</th><th>value</th><th>bound</"
-       "th><th>result</th></tr>";
-  for (const auto& o : r.outcomes) {
-    h << "<tr><td>" << Html(o.expectation.config + "." + o.expectation.metric) << "</td><td>"
-      << Number(o.value) << "</td><td>" << (o.expectation.is_max ? "&le; " : "&ge; ")
-      << Number(o.expectation.threshold) << "</td><td class=\""
-      << (o.passed ? "pass\">pass" : "fail\">FAIL") << "</td></tr>";
+  h << ".</p>";
+  return h.str();
+}
+
+// The expectations (when there are any) and the metrics: a row per metric some configuration
+// has, a blank cell where one does not have it.
+std::string TablesHtml(const ScenarioResult& r) {
+  std::ostringstream h;
+  if (!r.outcomes.empty()) {
+    h << "<h2>Expectations</h2><table><tr><th>expectation</th><th>value</th><th>bound</th>"
+         "<th>result</th></tr>";
+    for (const auto& o : r.outcomes) {
+      h << "<tr><td>" << Html(o.expectation.config + "." + o.expectation.metric) << "</td><td>"
+        << Number(o.value) << "</td><td>" << (o.expectation.is_max ? "&le; " : "&ge; ")
+        << Number(o.expectation.threshold) << "</td><td class=\""
+        << (o.passed ? "pass\">pass" : "fail\">FAIL") << "</td></tr>";
+    }
+    h << "</table>";
   }
-  h << "</table><h2>Metrics</h2><table><tr><th>metric</th>";
+  h << "<h2>Metrics</h2><table><tr><th>metric</th>";
   for (const auto& c : r.configs) h << "<th>" << Html(c.name) << "</th>";
   h << "</tr>";
   for (const std::string& m : AllMetrics(r)) {
@@ -492,21 +581,54 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
     h << "</tr>";
   }
   h << "</table>";
-  if (!r.notes.empty()) {
-    h << "<h2>Notes</h2><ul>";
-    for (const std::string& note : r.notes) h << "<li>" << Html(note) << "</li>";
-    h << "</ul>";
-  }
   if (!r.truth_metrics.empty()) {
     h << "<h2>Texture (true poses)</h2><table><tr><th>metric</th><th>truth</th></tr>";
     for (const auto& [name, value] : r.truth_metrics)
       h << "<tr><td>" << name << "</td><td>" << Number(value) << "</td></tr>";
     h << "</table>";
   }
-  h << "<h2>Maps</h2>" << html_maps;
-  if (!html_texture.empty()) h << "<h2>Floor texture</h2>" << html_texture;
-  h << "<h2>Errors</h2>" << html_plots << "</body></html>\n";
+  return h.str();
+}
+
+}  // namespace
+
+void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
+  fs::create_directories(out_dir);
+  const Folder file(out_dir);
+  // metrics.json, written last, marks a complete folder: an earlier run's must not vouch for
+  // files this one only half replaced.
+  fs::remove(file("metrics.json"));
+  slam::WriteFileAtomically(file("config.yaml"), r.spec->resolved_yaml);
+  if (!r.truth.empty()) slam::WriteTum(file("truth.tum"), r.truth);
+  WriteConfigFiles(r, file);
+  const std::string maps = MapsHtml(r, file);
+  const std::string texture = TextureHtml(r, file);
+  const std::string plots = ErrorPlotsHtml(r, file) + NeesPlotHtml(r, file) +
+                            TracePlotsHtml(r, file) + ErrorsByConfigHtml(r, file);
+
+  std::ostringstream h;
+  h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>" << Html(r.spec->name)
+    << "</title><style>body{font-family:sans-serif;margin:2em;max-width:1100px}"
+       "img{max-width:100%;border:1px solid #ddd}figure{margin:1em 0}"
+       "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:4px "
+       "10px;text-align:right}"
+       "th:first-child,td:first-child{text-align:left}.pass{color:#080;font-weight:bold}"
+       ".fail{color:#c00;font-weight:bold}</style></head><body>";
+  h << "<h1>" << Html(r.spec->name) << " <span class=\""
+    << (r.passed ? "pass\">PASS" : "fail\">FAIL") << "</span></h1>";
+  if (!r.spec->description.empty()) h << "<p>" << Html(r.spec->description) << "</p>";
+  h << SummaryHtml(r) << TablesHtml(r);
+  if (!r.notes.empty()) {
+    h << "<h2>Notes</h2><ul>";
+    for (const std::string& note : r.notes) h << "<li>" << Html(note) << "</li>";
+    h << "</ul>";
+  }
+  if (!maps.empty()) h << "<h2>Maps</h2>" << maps;
+  if (!texture.empty()) h << "<h2>Floor texture</h2>" << texture;
+  if (!plots.empty()) h << "<h2>Errors</h2>" << plots;
+  h << "</body></html>\n";
   slam::WriteFileAtomically(file("report.html"), h.str());
+  // Last: its presence means the folder is complete.
   slam::WriteFileAtomically(file("metrics.json"), MetricsJson(r));
 }
 

@@ -23,7 +23,10 @@ struct ConfigResult {
   Trajectory mean_estimate;  ///< the estimator's second estimate (a PF's mean), else empty
   slam::EstimatorRun run;    ///< everything it produced, in its own frame (map, traces, stats)
   Pose2 map_from_estimator;  ///< the reference pose at the estimator's first scan
-  std::map<std::string, double> metrics;  ///< MetricsOf() names; NaN when not applicable
+  /// The MetricsOf() names that apply to this configuration in this run (a reference, a camera,
+  /// kidnappings, covariances, loop closures); NaN where one applies but could not be computed
+  /// (a run too short for a spacing).
+  std::map<std::string, double> metrics;
   /// The pose NEES against the reference at each scan with a covariance (empty without), and
   /// the scans' times in seconds.
   std::vector<double> nees_time_s;
@@ -65,6 +68,13 @@ struct ScenarioResult {
   std::optional<TextureResult> truth_texture;
   std::map<std::string, double> truth_metrics;
   std::vector<std::string> notes;  ///< what the source said (a log's quirks), for the user
+  /// The log was cut short and read up to the cut: where, and what was recovered (also among
+  /// `notes`); empty for a whole log or a simulation.
+  std::string truncated;
+  std::string log_format;  ///< a log's format (slam::Dataset::format), else empty
+  /// A log whose stamps were unusable: its times were made up from line order, so sim_time_s is
+  /// no duration and no configuration has a realtime_factor.
+  bool times_synthesised = false;
   std::vector<ExpectationOutcome> outcomes;
   bool passed = true;
 };

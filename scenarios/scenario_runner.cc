@@ -8,13 +8,16 @@
 #include "scenarios/live_view.h"
 #include "sim/camera/camera_rig.h"
 #include "sim/simulator.h"
+#include "slam/eval/landmark_score.h"
 #include "slam/eval/loop_closure_score.h"
 #include "slam/eval/map_score.h"
+#include "slam/eval/nees.h"
 #include "slam/eval/pose_association.h"
 #include "slam/eval/recovery_time.h"
 #include "slam/eval/trajectory_error.h"
 #include "slam/eval/trajectory_metrics.h"
-#include "slam/fusion/consistency.h"
+#include "slam/io/map_server.h"
+#include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator_runner.h"
 #include "slam/types/error.h"
 #include "slam/types/interrupt.h"
@@ -88,24 +91,13 @@ void ShowLive(LiveView& view, double now_s, const Runners& runners, const Pose2&
   view.Update(now_s, shown->estimator().map(), map_from_start, truth, live);
 }
 
-// The NEES of the online poses that have a covariance, against the reference at the same time:
-// the covariance turned from the estimator's frame into the map frame; scans with a singular
-// covariance (the first, pinned at the origin) are left out.
+// The NEES of the online poses that have a covariance, against the reference at the same time.
 void ScoreNees(const ScenarioResult& run, ConfigResult* c) {
-  if (c->run.covariances.size() != c->online.size()) return;
-  const std::vector<slam::PosePair> pairs = slam::AssociatePoses(c->online, run.truth);
-  std::size_t i = 0;
-  for (const slam::PosePair& p : pairs) {
-    while (i < c->online.size() && c->online[i].time < p.time) ++i;
-    if (i == c->online.size() || c->online[i].time != p.time) continue;
-    const Eigen::Matrix3d covariance =
-        slam::RotateCovariance(c->run.covariances[i], c->map_from_estimator.theta());
-    const double nees = slam::PoseNees(p.reference, p.estimate, covariance);
-    if (!std::isfinite(nees)) continue;
-    c->nees_time_s.push_back(p.time.seconds());
-    c->nees.push_back(nees);
-  }
-  if (c->nees.empty()) return;
+  slam::NeesSeries series =
+      slam::PoseNeesSeries(c->online, c->run.covariances, c->map_from_estimator.theta(), run.truth);
+  if (series.nees.empty()) return;
+  c->nees_time_s = std::move(series.time_s);
+  c->nees = std::move(series.nees);
   double sum = 0.0;
   for (double v : c->nees) sum += v;
   auto& m = c->metrics;
@@ -117,111 +109,64 @@ void ScoreNees(const ScenarioResult& run, ConfigResult* c) {
   m["nees_upper_95"] = bounds.upper;
 }
 
-// A landmark estimator's map against the world's round pillars (its circles): each pillar
-// paired with its nearest estimated landmark when each is the other's nearest and they lie within
-// kPillarMatchRadius; the errors, the landmark NEES (2 dof) of the pairs, and the wrong
-// associations. The pillar of a sighting is the one nearest the observed centre placed at the
-// true pose (none beyond kPillarMatchRadius: clutter), a landmark's the one most of its sightings
-// are of; a sighting is wrong when its pillar is not its landmark's, or, for a clutter landmark,
-// when it lies further than kPillarMatchRadius from where that landmark ended up.
+// A landmark within this distance of a true pillar can be that pillar (slam::ScoreLandmarks).
 constexpr double kPillarMatchRadius = 0.5;
 
+// A landmark estimator's map against the world's round pillars (its circles), in the map frame.
 void ScoreLandmarks(const ScenarioResult& run, ConfigResult* c) {
   const slam::LandmarkMap& map = c->run.landmarks;
-  if (!run.spec->simulated || (map.landmarks.empty() && map.sightings.empty())) return;
   std::vector<Eigen::Vector2d> pillars;
   for (const sim::ShapeSpec& shape : run.spec->simulated->options.world.walls)
     if (shape.type == sim::ShapeType::kCircle) pillars.push_back(shape.center_m);
   const double yaw = c->map_from_estimator.theta();
   Eigen::Matrix2d rotation;
   rotation << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);
-  std::vector<Eigen::Vector2d> estimated;
-  for (const slam::LandmarkEstimate& l : map.landmarks)
-    estimated.push_back(c->map_from_estimator * l.position_m);
-  const auto nearest = [](const std::vector<Eigen::Vector2d>& set, const Eigen::Vector2d& p) {
-    int best = -1;
-    for (int i = 0; i < static_cast<int>(set.size()); ++i)
-      if (best < 0 || (set[i] - p).norm() < (set[best] - p).norm()) best = i;
-    return best;
-  };
+  std::vector<slam::ScoredLandmark> landmarks;
+  for (const slam::LandmarkEstimate& l : map.landmarks) {
+    landmarks.push_back(
+        {c->map_from_estimator * l.position_m, rotation * l.covariance * rotation.transpose()});
+  }
+  std::vector<slam::ScoredSighting> sightings;
+  for (const slam::LandmarkSighting& s : map.sightings)
+    sightings.push_back({s.time, s.landmark, s.center_base_m});
+  const slam::LandmarkScore score =
+      slam::ScoreLandmarks(pillars, landmarks, sightings, run.truth, kPillarMatchRadius);
   auto& m = c->metrics;
-  int mapped = 0;
-  double error_sum = 0.0, error_max = 0.0, nees_sum = 0.0;
-  std::vector<bool> landmark_matched(estimated.size(), false);
-  for (int i = 0; i < static_cast<int>(pillars.size()); ++i) {
-    const int j = nearest(estimated, pillars[i]);
-    if (j < 0 || nearest(pillars, estimated[j]) != i) continue;
-    const Eigen::Vector2d e = pillars[i] - estimated[j];
-    if (e.norm() > kPillarMatchRadius) continue;
-    ++mapped;
-    landmark_matched[j] = true;
-    error_sum += e.norm();
-    error_max = std::max(error_max, e.norm());
-    const Eigen::Matrix2d covariance =
-        rotation * map.landmarks[j].covariance * rotation.transpose();
-    nees_sum += e.dot(covariance.ldlt().solve(e));
+  m["pillars"] = score.pillars;
+  m["pillars_mapped"] = score.mapped;
+  m["spurious_landmarks"] = score.spurious;
+  m["landmark_error_max_m"] = score.error_max_m;
+  m["landmark_error_mean_m"] = score.error_mean_m;
+  m["landmark_anees"] = score.anees;
+  if (score.anees_bounds) {
+    m["landmark_anees_lower_95"] = score.anees_bounds->lower;
+    m["landmark_anees_upper_95"] = score.anees_bounds->upper;
   }
-  m["pillars"] = static_cast<double>(pillars.size());
-  m["pillars_mapped"] = mapped;
-  m["spurious_landmarks"] =
-      static_cast<double>(std::count(landmark_matched.begin(), landmark_matched.end(), false));
-  m["landmark_error_max_m"] = mapped > 0 ? error_max : NAN;
-  m["landmark_error_mean_m"] = mapped > 0 ? error_sum / mapped : NAN;
-  m["landmark_anees"] = mapped > 0 ? nees_sum / mapped : NAN;
-  if (mapped > 0) {
-    const slam::NeesBounds bounds = slam::AneesBounds(2, mapped);
-    m["landmark_anees_lower_95"] = bounds.lower;
-    m["landmark_anees_upper_95"] = bounds.upper;
-  }
-  // The true pillar of every sighting, then each landmark's by majority.
-  std::vector<int> pillar_of_sighting;
-  std::vector<std::optional<Eigen::Vector2d>> true_point;
-  std::vector<std::map<int, int>> votes(map.landmarks.size());
-  for (const slam::LandmarkSighting& s : map.sightings) {
-    const std::optional<Pose2> truth = run.truth.Interpolate(s.time);
-    int pillar = -1;
-    true_point.emplace_back();
-    if (truth) {
-      const Eigen::Vector2d p = *truth * s.center_base_m;
-      true_point.back() = p;
-      pillar = nearest(pillars, p);
-      if (pillar >= 0 && (pillars[pillar] - p).norm() > kPillarMatchRadius) pillar = -1;
-    }
-    pillar_of_sighting.push_back(pillar);
-    if (s.landmark >= 0 && s.landmark < static_cast<int>(votes.size())) ++votes[s.landmark][pillar];
-  }
-  std::vector<int> pillar_of_landmark(votes.size(), -1);
-  for (std::size_t j = 0; j < votes.size(); ++j) {
-    int most = 0;
-    for (const auto& [pillar, count] : votes[j]) {
-      if (count > most) {
-        most = count;
-        pillar_of_landmark[j] = pillar;
-      }
-    }
-  }
-  int wrong = 0;
-  for (std::size_t k = 0; k < map.sightings.size(); ++k) {
-    const int j = map.sightings[k].landmark;
-    if (j < 0 || j >= static_cast<int>(votes.size())) continue;
-    if (pillar_of_landmark[j] >= 0 || pillar_of_sighting[k] >= 0) {
-      wrong += pillar_of_sighting[k] != pillar_of_landmark[j];
-    } else {
-      wrong += !true_point[k] || (*true_point[k] - estimated[j]).norm() > kPillarMatchRadius;
-    }
-  }
-  m["landmark_sightings"] = static_cast<double>(map.sightings.size());
-  m["wrong_associations"] = wrong;
+  m["landmark_sightings"] = score.sightings;
+  m["wrong_associations"] = score.wrong_associations;
 }
 
-// Scores of one configuration against the reference (NaN where there is none).
+// Loop closures against the reference: one reference pose per scan, in scan order.
+void ScoreLoops(const ScenarioResult& run, ConfigResult* c) {
+  if (run.truth.size() != c->estimate.size()) return;
+  std::vector<Pose2> reference;
+  for (const StampedPose& p : run.truth.poses()) reference.push_back(p.pose);
+  const slam::LoopClosureScore loops = slam::ScoreLoopClosures(c->run.loop_closures, reference);
+  c->metrics["loop_precision"] = loops.precision;
+  c->metrics["loop_recall"] = loops.recall;
+  c->metrics["false_loop_closures"] = loops.false_closures;
+  c->loop_is_true = loops.is_true;
+}
+
+// Scores of one configuration: the metrics that apply to it (MetricsOf names), each from what
+// this run has (a reference, kidnappings, the truth map, covariances, loop closures, pillars).
 void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
   auto& m = c->metrics;
-  for (const std::string& name : MetricsOf(slam::DefaultEstimatorConfig(c->name, c->algorithm))) {
-    m[name] = NAN;
-  }
+  const slam::Algorithm* algorithm = slam::FindAlgorithm(c->algorithm);
   m["scans"] = static_cast<double>(c->estimate.size());
-  m["realtime_factor"] = c->run.wall_s > 0.0 ? data_time_s / c->run.wall_s : NAN;
+  // Made-up stamps give a made-up duration: no real-time factor then.
+  if (!run.times_synthesised)
+    m["realtime_factor"] = c->run.wall_s > 0.0 ? data_time_s / c->run.wall_s : NAN;
   for (const auto& [name, value] : c->run.statistics) m[name] = value;
   if (c->estimate.size() < 2 || run.truth.size() < 2) return;
   const slam::TrajectoryMetrics t = slam::EvaluateTrajectory(c->estimate, run.truth);
@@ -231,8 +176,10 @@ void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
   m["ate_max_m"] = t.ate.translation_m.max;
   m["ate_rot_rmse_rad"] = t.ate.rotation_rad.rmse;
   m["online_ate_rmse_m"] = slam::ComputeAte(c->online, run.truth).translation_m.rmse;
+  if (c->mean_estimate.size() >= 2)
+    m["mean_ate_rmse_m"] = slam::ComputeAte(c->mean_estimate, run.truth).translation_m.rmse;
   ScoreNees(run, c);
-  ScoreLandmarks(run, c);
+  if (algorithm && algorithm->maps_landmarks && run.spec->simulated) ScoreLandmarks(run, c);
   // Means of the pairs' translation errors; NaN when the run is too short for a spacing.
   const auto mean = [](const slam::ErrorStats& s) { return s.count ? s.mean : NAN; };
   m["rpe_m_per_scan"] = mean(t.rpe_per_scan.translation_m);
@@ -250,20 +197,11 @@ void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
       m["recovery_time_s"] = slam::WorstRecoveryTime(pairs, run.kidnap_times, kRecoveredM);
     }
   }
-  // Loop closures against the reference: one reference pose per scan, in scan order.
-  if (run.truth.size() == c->estimate.size()) {
-    std::vector<Pose2> reference;
-    for (const StampedPose& p : run.truth.poses()) reference.push_back(p.pose);
-    const slam::LoopClosureScore loops = slam::ScoreLoopClosures(c->run.loop_closures, reference);
-    m["loop_precision"] = loops.precision;
-    m["loop_recall"] = loops.recall;
-    m["false_loop_closures"] = loops.false_closures;
-    c->loop_is_true = loops.is_true;
-  }
+  if (algorithm && algorithm->closes_loops) ScoreLoops(run, c);
   if (run.truth_map) {
     // A simulation's map is scored where the estimate starts (on the truth); a log's reference
     // is itself an estimate, whose first pose is no better an anchor than any other, so there the
-    // map is scored in the ATE alignment's frame, as `slamrig slam` does.
+    // map is scored in the ATE alignment's frame.
     const Pose2 reference_from_map = run.spec->simulated
                                          ? c->map_from_estimator
                                          : t.ate.reference_from_estimate * c->map_from_estimator;
@@ -308,15 +246,29 @@ void ScoreTruthTexture(const ScenarioSpec& spec, const TextureRun& texture,
   ScoreTextureMetrics(*result->truth_texture, NAN, &result->truth_metrics);
 }
 
+// A log without laser scans (wheel encoders and an IMU alone): an estimator's trajectory is the
+// one it reports at its records' rate (dead reckoning and the EKF); others cannot run on it.
+void UseRecordRate(const std::string& log_path, slam::EstimatorRun* run) {
+  if (run->record_rate.empty()) {
+    throw ParseError(log_path + ": no laser scans; " + run->algorithm +
+                     " needs them (dead-reckoning and ekf run on wheel encoder records alone)");
+  }
+  run->final = run->online = run->record_rate;
+  run->covariances = run->record_rate_covariances;
+  run->odometry_source = slam::OdometrySource::kWheelTicks;
+}
+
 void Finish(Runners& runners, const Pose2& map_from_start, double data_time_s,
             const TextureRun* texture, ScenarioResult* result) {
   if (texture) ScoreTruthTexture(*result->spec, *texture, result);
+  const bool records_only = result->spec->log && result->scans == 0;
   for (auto& r : runners) {
     r->Finish();
     ConfigResult c;
     c.name = r->config().name;
     c.algorithm = r->config().algorithm;
     c.run = r->TakeResult();
+    if (records_only) UseRecordRate(result->spec->log->path, &c.run);
     c.map_from_estimator = map_from_start;
     c.estimate = InMapFrame(c.run.final, map_from_start);
     c.online = InMapFrame(c.run.online, map_from_start);
@@ -443,14 +395,45 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
   return result;
 }
 
+// The map a log's configurations are scored against: the true world's map when the source
+// names one, else the log's scans at its reference poses (filled while the log runs).
+std::optional<slam::OccupancyGrid> TrueMapOf(const LogSource& log, const slam::Dataset& data) {
+  if (log.truth_map.empty()) return std::nullopt;
+  if (data.reference.empty()) {
+    throw ConfigError(log.truth_map + ": a true map is placed by the log's reference, and " +
+                      log.path + " has none");
+  }
+  return slam::GridFromMapImage(slam::ReadMapServerMap(log.truth_map));
+}
+
+// The scans the run will take: the log's, up to the source's limit.
+std::size_t ScansToRun(const LogSource& log, const std::vector<Record>& records) {
+  std::size_t n = 0;
+  for (const Record& r : records) n += std::holds_alternative<LaserScan>(r);
+  return log.max_scans > 0 ? std::min(n, log.max_scans) : n;
+}
+
 ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
-  slam::Dataset data = slam::ReadLog(spec.log->path, spec.log->read);
-  slam::ApplyLogPerturbation(&data, spec.log->perturb, spec.seed, spec.log->robot);
+  const LogSource& log = *spec.log;
+  slam::Dataset data = slam::ReadLog(log.path, log.read);
+  slam::ApplyLogPerturbation(&data, log.perturb, spec.seed, log.robot);
+  std::optional<slam::OccupancyGrid> true_map = TrueMapOf(log, data);
   ScenarioResult result;
   result.spec = &spec;
   result.notes = data.notes;
+  result.truncated = data.truncated;
+  result.log_format = data.format;
+  result.times_synthesised = data.times_synthesised;
   if (!data.reference_kind.empty()) result.reference_kind = data.reference_kind;
   Runners runners = MakeRunners(spec, &data.records);
+  if (options.on_scan) {
+    const std::size_t total = ScansToRun(log, data.records);
+    const slam::EstimatorRunner& first = *runners.front();
+    runners.front()->SetScanCallback(
+        [&](std::size_t i, const slam::SyncedScan& scan, const slam::ScanEstimate&) {
+          options.on_scan(i + 1, total, scan, first);
+        });
+  }
   std::unique_ptr<LiveView> view;
   if (options.view) view = std::make_unique<LiveView>("slamrig: " + spec.name);
 
@@ -462,14 +445,16 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
   const bool limited = spec.has_duration;
   for (const Record& record : data.records) {
     const Time t = RecordTime(record);
+    const bool is_scan = std::holds_alternative<LaserScan>(record);
     if (!first_time) first_time = t;
     if (limited && SecondsBetween(t, *first_time) > spec.duration_s) break;
+    if (is_scan && log.max_scans > 0 && scans >= log.max_scans) break;
     ThrowIfInterrupted();
     if (const auto* scan = std::get_if<LaserScan>(&record)) {
       if (scans < data.reference.size()) {
         const Pose2& reference = data.reference[scans].map_from_base;
         result.truth.Append(data.reference[scans].time, reference);
-        truth_map.InsertScan(*scan, reference);
+        if (!true_map) truth_map.InsertScan(*scan, reference);
         if (!map_from_start) map_from_start = reference;
       }
       ++scans;
@@ -479,22 +464,29 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
     }
     last_time = last_time ? std::max(*last_time, t) : t;
     for (auto& r : runners) r->Add(record);
-    if (view && std::holds_alternative<LaserScan>(record)) {
+    if (view && is_scan) {
       ShowLive(*view, SecondsBetween(t, *first_time), runners, map_from_start.value_or(Pose2()),
                true, map_from_start.value_or(Pose2()));
     }
-    if (options.progress && std::holds_alternative<LaserScan>(record) && scans % 100 == 0) {
+    if (options.progress && is_scan && scans % 100 == 0) {
       options.progress(SecondsBetween(t, *first_time), spec.duration_s);
     }
   }
-  if (result.scans == 0) throw ParseError(spec.log->path + ": no laser scans to run SLAM on");
+  if (result.scans == 0) {
+    // Scored over the whole reference: no scan to pair reference poses with.
+    for (const GroundTruthPose& g : data.reference) result.truth.Append(g.time, g.map_from_base);
+  }
   if (result.truth.out_of_order() > 0) {
     result.notes.push_back(std::to_string(result.truth.out_of_order()) +
                            " reference poses are stamped earlier than the one before them; each "
                            "keeps its own scan's stamp, in scan order");
   }
   result.sim_time_s = first_time ? SecondsBetween(*last_time, *first_time) : 0.0;
-  if (!data.reference.empty()) result.truth_map.emplace(std::move(truth_map));
+  if (true_map) {
+    result.truth_map = std::move(true_map);
+  } else if (!data.reference.empty() && result.scans > 0) {
+    result.truth_map.emplace(std::move(truth_map));
+  }
   // A log without a reference is scored on nothing but its own statistics.
   Finish(runners, map_from_start.value_or(Pose2()), result.sim_time_s, nullptr, &result);
   return result;

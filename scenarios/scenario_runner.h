@@ -13,6 +13,11 @@ struct RunnerOptions {
   bool view = false;  ///< open a live window (needs a display)
   /// Called about once per simulated second with (sim time, duration); for progress output.
   std::function<void(double, double)> progress;
+  /// A log source: called after each scan the first configuration takes, with the scans taken,
+  /// the scans the run will take and that configuration's runner (its estimator's view).
+  std::function<void(std::size_t done, std::size_t total, const slam::SyncedScan& scan,
+                     const slam::EstimatorRunner& runner)>
+      on_scan;
 };
 
 /// Runs a scenario: the simulator, every SLAM configuration and the evaluation advance together

@@ -140,6 +140,7 @@ const std::vector<std::string>& KnownMetrics() {
                                                    "ate_max_m",
                                                    "ate_rot_rmse_rad",
                                                    "online_ate_rmse_m",
+                                                   "mean_ate_rmse_m",
                                                    "rpe_m_per_scan",
                                                    "rpe_m_per_1m",
                                                    "rpe_m_per_10m",
@@ -156,9 +157,6 @@ const std::vector<std::string>& KnownMetrics() {
                                                    "final_nees",
                                                    "nees_lower_95",
                                                    "nees_upper_95",
-                                                   "loop_precision",
-                                                   "loop_recall",
-                                                   "false_loop_closures",
                                                    "texture_psnr_db",
                                                    "texture_mean_abs_error",
                                                    "texture_coverage",
@@ -167,6 +165,12 @@ const std::vector<std::string>& KnownMetrics() {
                                                    "texture_psnr_anchored_db",
                                                    "texture_psnr_loss_slow_db",
                                                    "texture_psnr_loss_jitter_db"};
+  return metrics;
+}
+
+const std::vector<std::string>& LoopMetrics() {
+  static const std::vector<std::string> metrics = {"loop_precision", "loop_recall",
+                                                   "false_loop_closures"};
   return metrics;
 }
 
@@ -194,6 +198,7 @@ std::vector<std::string> MetricsOf(const slam::EstimatorConfig& config) {
   std::vector<std::string> metrics = KnownMetrics();
   if (const slam::Algorithm* a = slam::FindAlgorithm(config.algorithm)) {
     metrics.insert(metrics.end(), a->statistics.begin(), a->statistics.end());
+    if (a->closes_loops) metrics.insert(metrics.end(), LoopMetrics().begin(), LoopMetrics().end());
     if (a->maps_landmarks)
       metrics.insert(metrics.end(), LandmarkMetrics().begin(), LandmarkMetrics().end());
   }
@@ -335,6 +340,12 @@ std::string ResolvedYaml(const ScenarioSpec& spec, const std::vector<std::string
         << YAML::Value << fs::absolute(spec.log->path).lexically_normal().string() << YAML::Key
         << "lenient" << YAML::Value << spec.log->read.lenient << YAML::Key << "strict"
         << YAML::Value << spec.log->read.strict;
+    if (spec.log->max_scans > 0)
+      out << YAML::Key << "max_scans" << YAML::Value << spec.log->max_scans;
+    if (!spec.log->truth_map.empty()) {
+      out << YAML::Key << "truth_map" << YAML::Value
+          << fs::absolute(spec.log->truth_map).lexically_normal().string();
+    }
     // Bag topic names, every one (the defaults too), so that the resolved file is complete.
     slam::BagTopicNames topics = spec.log->read.topics;
     out << YAML::Key << "topics" << YAML::Value << YAML::BeginMap;
@@ -424,6 +435,15 @@ LogSource ReadLogSource(const YamlNode& root, const YamlNode& source, const std:
   log.path = ResolveLog(source.Required("log"), path);
   source.Read("lenient", &log.read.lenient);
   source.Read("strict", &log.read.strict);
+  int max_scans = 0;
+  source.Read("max_scans", &max_scans);
+  if (max_scans < 0) source.Required("max_scans").Fail("must be >= 0 (0: every scan)");
+  log.max_scans = static_cast<std::size_t>(max_scans);
+  if (const auto map = source.Optional("truth_map")) {
+    fs::path p = map->As<std::string>();
+    if (p.is_relative()) p = fs::path(path).parent_path() / p;
+    log.truth_map = p.lexically_normal().string();
+  }
   if (const auto topics = source.Optional("topics")) {
     if (!topics->IsMap()) topics->Fail("topics is a map (scan: /front/scan, ...)");
     for (const std::string& key : topics->Keys()) {
@@ -505,6 +525,18 @@ void ReadConfigs(const YamlNode& root, ScenarioSpec* spec_out) {
 }
 
 }  // namespace
+
+ScenarioSpec LogScenario(const LogSource& log, std::vector<slam::EstimatorConfig> configs,
+                         std::uint64_t seed, const std::string& origin) {
+  ScenarioSpec spec;
+  spec.path = origin;
+  spec.name = fs::path(log.path).filename().string();
+  spec.seed = seed;
+  spec.log = log;
+  spec.configs = std::move(configs);
+  spec.resolved_yaml = ResolvedYaml(spec, {});
+  return spec;
+}
 
 ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string>& overrides,
                           std::optional<std::uint64_t> seed) {

@@ -47,6 +47,11 @@ struct LogSource {
   slam::LogReadOptions read;
   slam::LogPerturbation perturb;  ///< applied to the records as read (none by default)
   slam::DiffDriveParams robot;    ///< wheel geometry for logs with encoder ticks (ECE276A default)
+  std::size_t max_scans = 0;      ///< `max_scans:` use the records up to this many scans (0: all)
+  /// `truth_map:` a map_server map (YAML) of the true world, in the reference's frame: the map
+  /// every configuration's map is scored against, in place of the log's scans at its reference
+  /// poses. Needs a log with a reference.
+  std::string truth_map;
 };
 
 /// The texture map options a scenario uses unless its `texture:` block says otherwise: every
@@ -105,8 +110,12 @@ struct ScenarioSpec {
   std::string resolved_yaml;
 };
 
-/// Metric names every configuration has (metrics.json per configuration).
+/// Metric names any configuration may have (metrics.json per configuration); a run gives each
+/// configuration the ones that apply to it (a reference, a camera, kidnappings, a covariance).
 const std::vector<std::string>& KnownMetrics();
+
+/// The scores of accepted loop closures against the reference (algorithms that close loops).
+const std::vector<std::string>& LoopMetrics();
 
 /// Metrics of the `truth` pseudo-configuration of a run with a camera: the texture map from the
 /// true poses (`expect: {truth: {texture_psnr_db_min: 20}}`).
@@ -116,9 +125,16 @@ const std::vector<std::string>& TruthMetrics();
 /// map landmarks).
 const std::vector<std::string>& LandmarkMetrics();
 
-/// The metrics of `config`: KnownMetrics(), its algorithm's statistics and, for an algorithm that
-/// maps landmarks, LandmarkMetrics().
+/// The metrics of `config`, which `expect:` accepts: KnownMetrics(), its algorithm's statistics
+/// (as its estimator declares them) and, for an algorithm that closes loops or maps landmarks,
+/// LoopMetrics() or LandmarkMetrics().
 std::vector<std::string> MetricsOf(const slam::EstimatorConfig& config);
+
+/// A scenario of one log and `configs`, as a command builds it from its flags (`slamrig slam`):
+/// named after the log, `origin` saying where it came from (in messages and config.yaml, which
+/// `slamrig run` repeats bit for bit).
+ScenarioSpec LogScenario(const LogSource& log, std::vector<slam::EstimatorConfig> configs,
+                         std::uint64_t seed, const std::string& origin);
 
 /// Reads a scenario file strictly. `overrides` are `key=value` texts: keys starting with
 /// `world.` or `robot.` change the world or robot file, others the scenario file itself (e.g.

@@ -35,6 +35,7 @@ Dataset CarmenToDataset(const CarmenLog& log) {
   data.source = log.path;
   data.notes = log.notes;
   data.truncated = log.truncated;
+  data.times_synthesised = !log.timestamps_usable;
   const std::vector<Entry> entries = InFileOrder(log);
 
   if (log.is_corrected) {

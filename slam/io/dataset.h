@@ -23,6 +23,9 @@ struct Dataset {
   /// recovered 2,411 scans of an unknown total; the rest is lost"); also among `notes`. Empty
   /// for a whole log.
   std::string truncated;
+  /// The log's stamps were unusable and its times were made up from line order: the data's
+  /// duration is not a duration, and no real-time factor can be given.
+  bool times_synthesised = false;
 };
 
 /// `n` with a comma between groups of three digits ("2,411"), as notes print counts.

@@ -74,15 +74,22 @@ class AlgorithmOptionsFor final : public AlgorithmOptions {
 
 /// One entry of the algorithm table: the only place that knows which algorithms exist.
 struct Algorithm {
-  std::string name;                     ///< `algorithm:` in a scenario, `--algorithm` on the CLI
-  std::string summary;                  ///< one line for --help
-  std::vector<std::string> presets;     ///< named starting points; the first is the default
-  std::vector<std::string> statistics;  ///< the names Estimator::Statistics() reports
+  std::string name;                  ///< `algorithm:` in a scenario, `--algorithm` on the CLI
+  std::string summary;               ///< one line for --help
+  std::vector<std::string> presets;  ///< named starting points; the first is the default
+  /// The names Estimator::Statistics() reports: the estimator's own StatisticNames(), the one
+  /// declaration that expectations and metrics.json both follow (EstimatorRunner checks each run).
+  std::vector<std::string> statistics;
   /// The options of `preset` (one of `presets`).
   std::function<std::unique_ptr<AlgorithmOptions>(const std::string& preset)> make_options;
   /// It reports a landmark map (Estimator::Landmarks()), which simulated runs score against the
   /// world's pillars (the landmark metrics of metrics.json).
   bool maps_landmarks = false;
+  /// It reports loop closures (Estimator::LoopClosures()), scored against the reference.
+  bool closes_loops = false;
+  /// `statistics` is all it reports; false for an algorithm whose statistics are only known
+  /// once it runs (a Python class's).
+  bool statistics_declared = true;
 };
 
 /// Every algorithm, in the order --help lists them.

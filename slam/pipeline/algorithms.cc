@@ -27,8 +27,7 @@ const std::vector<Algorithm>& Algorithms() {
        "particle-filter SLAM on one log-odds map (presets: default, the improved filter; "
        "reports, the ECE276A reports' method)",
        {"default", "reports"},
-       {"mean_neff", "resamples", "updates", "lost", "relocalisations", "resumed", "lost_at_s",
-        "relocalised_at_s", "field_sigma_m", "wall_distance_m"},
+       ParticleFilterEstimator::StatisticNames(),
        [](const std::string& preset) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<
              AlgorithmOptionsFor<ParticleFilterOptions, ParticleFilterEstimator>>(
@@ -39,8 +38,7 @@ const std::vector<Algorithm>& Algorithms() {
        "EKF pose fusion: encoders and gyro predict, scan-to-local-map ICP matches correct, "
        "the gyro bias estimated; a covariance with every pose",
        {"default"},
-       {"gyro_bias_rad_s", "gyro_scale_error", "scan_updates", "zero_rate_updates", "mean_nis",
-        "slip_inflations", "matched", "keyframes", "anchors", "match_covariance_factor"},
+       EkfEstimator::StatisticNames(),
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<AlgorithmOptionsFor<EkfOptions, EkfEstimator>>(EkfOptions{});
        }},
@@ -48,9 +46,7 @@ const std::vector<Algorithm>& Algorithms() {
        "landmark EKF-SLAM: encoders and gyro predict, round landmarks (pillars) from each scan "
        "update pose and map, association by nearest neighbour or JCBB",
        {"default"},
-       {"landmarks", "tentative_landmarks", "landmark_observations", "landmark_pairings",
-        "ambiguous_observations", "landmark_updates", "zero_rate_updates", "gyro_bias_rad_s",
-        "mean_nis_per_dof"},
+       EkfSlamEstimator::StatisticNames(),
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<AlgorithmOptionsFor<EkfSlamEstimatorOptions, EkfSlamEstimator>>(
              EkfSlamEstimatorOptions{});
@@ -59,7 +55,7 @@ const std::vector<Algorithm>& Algorithms() {
       {"icp-odometry",
        "scan-to-local-map point-to-line ICP with the wheel odometry as prior, the map along it",
        {"default"},
-       {"matched", "degenerate", "failed"},
+       IcpOdometryEstimator::StatisticNames(),
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<
              AlgorithmOptionsFor<IcpOdometryEstimatorOptions, IcpOdometryEstimator>>(
@@ -69,19 +65,19 @@ const std::vector<Algorithm>& Algorithms() {
        "graph SLAM: ICP odometry keyframes, loop closures by correlative matching verified by "
        "ICP and a chi2 gate, Ceres with a robust loss",
        {"default"},
-       {"keyframes", "loop_closures", "loop_candidates", "rejected", "optimizations", "final_chi2",
-        "switched_off"},
+       GraphSlamEstimator::StatisticNames(),
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<
              AlgorithmOptionsFor<GraphSlamEstimatorOptions, GraphSlamEstimator>>(
              GraphSlamEstimatorOptions{});
-       }},
+       },
+       /*maps_landmarks=*/false,
+       /*closes_loops=*/true},
       {"rbpf",
        "Rao-Blackwellised particle filter with per-particle copy-on-write maps (GMapping's "
        "scan-matched proposal, selective resampling); revises its past",
        {"default"},
-       {"mean_neff", "resamples", "updates", "failed_matches", "map_tiles",
-        "map_tiles_per_particle"},
+       RbpfEstimator::StatisticNames(),
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<AlgorithmOptionsFor<RbpfOptions, RbpfEstimator>>(RbpfOptions{});
        }},
@@ -92,7 +88,10 @@ const std::vector<Algorithm>& Algorithms() {
        {},
        [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
          return std::make_unique<PythonAlgorithmOptions>();
-       }},
+       },
+       /*maps_landmarks=*/false,
+       /*closes_loops=*/true,
+       /*statistics_declared=*/false},
   };
   return algorithms;
 }

@@ -212,6 +212,15 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
   return estimate;
 }
 
+const std::vector<std::string>& EkfEstimator::StatisticNames() {
+  static const std::vector<std::string> names = {
+      "gyro_bias_rad_s",   "gyro_scale_error",        "gyro_sigma_rad_s", "scan_updates",
+      "zero_rate_updates", "slip_inflations",         "matched",          "keyframes",
+      "anchors",           "match_covariance_factor", "wheel_slip_m",     "skid_ratio",
+      "mean_nis"};
+  return names;
+}
+
 std::map<std::string, double> EkfEstimator::Statistics() const {
   return {{"gyro_bias_rad_s", ekf_.gyro_bias()},
           {"gyro_scale_error", ekf_.gyro_scale_error()},

@@ -115,6 +115,9 @@ class EkfEstimator final : public Estimator {
   ScanEstimate AddScan(const SyncedScan& scan) override;
   const OccupancyGrid& map() const override { return map_; }
   std::map<std::string, double> Statistics() const override;
+  /// The names Statistics() reports, without an instance: the algorithm table's list (and so
+  /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
+  static const std::vector<std::string>& StatisticNames();
 
  private:
   /// Matches `scan` at the filter's current pose, updates, clones; the estimate at the scan.

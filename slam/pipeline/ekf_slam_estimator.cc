@@ -95,6 +95,20 @@ EstimatorView EkfSlamEstimator::View() const {
   return view;
 }
 
+const std::vector<std::string>& EkfSlamEstimator::StatisticNames() {
+  static const std::vector<std::string> names = {"landmarks",
+                                                 "tentative_landmarks",
+                                                 "inconsistent_tentatives",
+                                                 "landmark_observations",
+                                                 "landmark_pairings",
+                                                 "ambiguous_observations",
+                                                 "landmark_updates",
+                                                 "zero_rate_updates",
+                                                 "gyro_bias_rad_s",
+                                                 "mean_nis_per_dof"};
+  return names;
+}
+
 std::map<std::string, double> EkfSlamEstimator::Statistics() const {
   return {{"landmarks", slam_.landmarks()},
           {"tentative_landmarks", slam_.tentative_landmarks()},

@@ -47,6 +47,9 @@ class EkfSlamEstimator final : public Estimator {
   ScanEstimate AddScan(const SyncedScan& scan) override;
   const OccupancyGrid& map() const override { return map_; }
   std::map<std::string, double> Statistics() const override;
+  /// The names Statistics() reports, without an instance: the algorithm table's list (and so
+  /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
+  static const std::vector<std::string>& StatisticNames();
   LandmarkMap Landmarks() const override;
   EstimatorView View() const override;
 

@@ -1,7 +1,9 @@
 #include "slam/pipeline/estimator_runner.h"
 
+#include <algorithm>
 #include <chrono>
 
+#include "slam/pipeline/algorithm.h"
 #include "slam/types/check.h"
 #include "slam/types/interrupt.h"
 
@@ -12,6 +14,23 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// An estimator reports exactly the statistics its algorithm declares (Algorithm::statistics),
+// which expectations accept by name: a name added on one side only is a bug found at once.
+void CheckDeclaredStatistics(const std::string& algorithm,
+                             const std::map<std::string, double>& statistics) {
+  const Algorithm* a = FindAlgorithm(algorithm);
+  if (a == nullptr || !a->statistics_declared) return;
+  std::string differences;
+  for (const auto& [name, value] : statistics) {
+    if (std::find(a->statistics.begin(), a->statistics.end(), name) == a->statistics.end())
+      differences += " reported but not declared: " + name + ";";
+  }
+  for (const std::string& name : a->statistics) {
+    if (!statistics.count(name)) differences += " declared but not reported: " + name + ";";
+  }
+  SLAMRIG_CHECK(differences.empty(), (algorithm + " statistics:" + differences).c_str());
 }
 
 }  // namespace
@@ -77,6 +96,7 @@ EstimatorRun EstimatorRunner::TakeResult() {
   if (run_.record_rate_covariances.size() != run_.record_rate.size())
     run_.record_rate_covariances.clear();
   run_.statistics = estimator_->Statistics();
+  CheckDeclaredStatistics(config_.algorithm, run_.statistics);
   run_.loop_closures = estimator_->LoopClosures();
   run_.landmarks = estimator_->Landmarks();
   run_.map = estimator_->map();

@@ -47,6 +47,13 @@ EstimatorView GraphSlamEstimator::View() const {
   return view;
 }
 
+const std::vector<std::string>& GraphSlamEstimator::StatisticNames() {
+  static const std::vector<std::string> names = {
+      "keyframes",  "loop_closures", "loop_candidates",    "rejected",    "optimizations",
+      "final_chi2", "switched_off",  "odometry_rematched", "inconsistent"};
+  return names;
+}
+
 std::map<std::string, double> GraphSlamEstimator::Statistics() const {
   const GraphSlamCounts& c = slam_.counts();
   return {{"keyframes", c.keyframes},

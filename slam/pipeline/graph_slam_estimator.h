@@ -43,6 +43,9 @@ class GraphSlamEstimator final : public Estimator {
   /// keyframes, loop_closures, loop_candidates, rejected, optimizations, final_chi2,
   /// switched_off, odometry_rematched, inconsistent.
   std::map<std::string, double> Statistics() const override;
+  /// The names Statistics() reports, without an instance: the algorithm table's list (and so
+  /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
+  static const std::vector<std::string>& StatisticNames();
   std::vector<LoopClosure> LoopClosures() const override { return slam_.loop_closures(); }
   /// The graph's odometry and loop-closure edges at the current estimate.
   EstimatorView View() const override;

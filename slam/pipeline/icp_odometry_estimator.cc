@@ -27,6 +27,11 @@ ScanEstimate IcpOdometryEstimator::AddScan(const SyncedScan& scan) {
   return {step.pose, std::nullopt, {}, std::nullopt};
 }
 
+const std::vector<std::string>& IcpOdometryEstimator::StatisticNames() {
+  static const std::vector<std::string> names = {"matched", "degenerate", "failed"};
+  return names;
+}
+
 std::map<std::string, double> IcpOdometryEstimator::Statistics() const {
   const IcpOdometryCounts& c = odometry_.counts();
   return {{"matched", c.matched}, {"degenerate", c.degenerate}, {"failed", c.failed + c.no_points}};

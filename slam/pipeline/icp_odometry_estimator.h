@@ -40,6 +40,9 @@ class IcpOdometryEstimator final : public Estimator {
   const OccupancyGrid& map() const override { return map_; }
   /// matched, degenerate, failed (match failures and scans without points) scan counts.
   std::map<std::string, double> Statistics() const override;
+  /// The names Statistics() reports, without an instance: the algorithm table's list (and so
+  /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
+  static const std::vector<std::string>& StatisticNames();
 
  private:
   IcpOdometry odometry_;

@@ -38,6 +38,13 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
   return estimate;
 }
 
+const std::vector<std::string>& ParticleFilterEstimator::StatisticNames() {
+  static const std::vector<std::string> names = {
+      "mean_neff", "resamples", "updates",          "lost",          "relocalisations",
+      "resumed",   "lost_at_s", "relocalised_at_s", "field_sigma_m", "wall_distance_m"};
+  return names;
+}
+
 std::map<std::string, double> ParticleFilterEstimator::Statistics() const {
   return {{"mean_neff", scans_ > 0 ? neff_sum_ / scans_ : 0.0},
           {"resamples", filter_.resample_count()},

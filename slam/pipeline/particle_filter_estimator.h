@@ -22,6 +22,9 @@ class ParticleFilterEstimator final : public Estimator {
   /// lost and relocalisations (counts), lost_at_s and relocalised_at_s (the first loss and the
   /// first relocalisation after it, seconds since the first scan; NaN when none).
   std::map<std::string, double> Statistics() const override;
+  /// The names Statistics() reports, without an instance: the algorithm table's list (and so
+  /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
+  static const std::vector<std::string>& StatisticNames();
   EstimatorView View() const override;
 
  private:

@@ -49,6 +49,18 @@ const OccupancyGrid& RbpfEstimator::map() const {
   return map_;
 }
 
+const std::vector<std::string>& RbpfEstimator::StatisticNames() {
+  static const std::vector<std::string> names = {"mean_neff",
+                                                 "resamples",
+                                                 "updates",
+                                                 "failed_matches",
+                                                 "odometry_rejections",
+                                                 "mean_weight_exponent",
+                                                 "map_tiles",
+                                                 "map_tiles_per_particle"};
+  return names;
+}
+
 std::map<std::string, double> RbpfEstimator::Statistics() const {
   const int scans = static_cast<int>(scan_offsets_.size());
   const int tiles = filter_.particles().empty() ? 0 : filter_.DistinctTiles();

@@ -27,6 +27,9 @@ class RbpfEstimator final : public Estimator {
   /// mean_weight_exponent (the weights' exponent, RbpfStep::weight_exponent, over updates),
   /// map_tiles (distinct tiles over all particles at the end) and map_tiles_per_particle.
   std::map<std::string, double> Statistics() const override;
+  /// The names Statistics() reports, without an instance: the algorithm table's list (and so
+  /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
+  static const std::vector<std::string>& StatisticNames();
   EstimatorView View() const override;
 
  private:
