@@ -12,9 +12,12 @@
 #include "slam/eval/loop_closure_score.h"
 #include "slam/eval/map_score.h"
 #include "slam/fusion/consistency.h"
+#include "slam/grid/occupancy_grid.h"
 #include "slam/types/error.h"
 
 namespace slamrig::python {
+
+using slam::OccupancyGrid;
 
 void DefineEvaluation(py::module_& m) {
   m.def(

@@ -12,6 +12,7 @@
 
 #include "python/arrays.h"
 #include "python/core_internal.h"
+#include "python/python_estimator.h"
 #include "slam/io/log_reader.h"
 
 namespace slamrig::python {

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "python/core_internal.h"
+#include "python/python_estimator.h"
 #include "slam/types/error.h"
 
 namespace slamrig::python {

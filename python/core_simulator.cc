@@ -13,6 +13,7 @@
 
 #include "python/arrays.h"
 #include "python/core_internal.h"
+#include "python/python_estimator.h"
 #include "sim/presets.h"
 #include "sim/robot_yaml.h"
 #include "sim/simulator.h"

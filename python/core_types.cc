@@ -11,6 +11,7 @@
 
 #include "python/arrays.h"
 #include "python/core_internal.h"
+#include "python/python_estimator.h"
 #include "slam/types/error.h"
 
 namespace slamrig::python {
