@@ -98,7 +98,11 @@ TEST(SweepTest, RunsEveryRunOnceAndResumesAfterAKill) {
   for (const auto& l : got) b.insert(WithoutWallTime(l));
   EXPECT_EQ(a, b);
   EXPECT_TRUE(std::filesystem::exists(resumed.dir.File("out/summary.html")));
-  EXPECT_TRUE(std::filesystem::exists(resumed.dir.File("out/summary_pf.ate_rmse_m__a.noise.png")));
+  // Two swept parameters: a heat map per metric, no line plots.
+  std::ifstream summary(resumed.dir.File("out/summary.html"));
+  const std::string html{std::istreambuf_iterator<char>(summary), std::istreambuf_iterator<char>()};
+  EXPECT_THAT(html, ::testing::HasSubstr("<table class=\"heat\">"));
+  EXPECT_FALSE(std::filesystem::exists(resumed.dir.File("out/summary_pf.ate_rmse_m__a.noise.png")));
 }
 
 TEST(SweepTest, RefusesResultsOfAnotherSweep) {
