@@ -148,8 +148,10 @@ std::string HeatMap(const SweepSpec& spec, const SweepAggregate& a, const std::s
     lo = std::min(lo, stats->second.mean);
     hi = std::max(hi, stats->second.mean);
   }
-  std::string h = "<h3>" + Html(metric) + ": mean over seeds</h3><table class=\"heat\"><tr><th>" +
-                  Html(rows.key) + " \\ " + Html(cols.key) + "</th>";
+  std::string h =
+      "<h3>" + Html(metric) + "</h3><p>Mean over seeds (small: min &ndash; max); rows " +
+      Html(rows.key) + ", columns " + Html(cols.key) + "; darker is higher.</p>" +
+      "<table class=\"heat\"><tr><th>" + Html(rows.key) + " \\ " + Html(cols.key) + "</th>";
   for (const std::string& v : cols.values) h += "<th>" + Html(v) + "</th>";
   h += "</tr>";
   for (std::size_t r = 0; r < rows.values.size(); ++r) {
@@ -200,8 +202,8 @@ std::string RunsTable(const SweepSpec& spec, const SweepAggregate& a) {
         const bool is_max = e.name.size() > 4 && e.name.compare(e.name.size() - 4, 4, "_max") == 0;
         const std::string metric = e.name.substr(0, e.name.size() - 4);
         failures += "<li>seed " + std::to_string(s.seed) + ": " + Html(metric) + " = " +
-                    Format(e.value) + (is_max ? " &gt; " : " &lt; ") + Format(e.threshold) +
-                    "</li>";
+                    Format(e.value) + ", bound " + (is_max ? "&le; " : "&ge; ") +
+                    Format(e.threshold) + "</li>";
       }
       if (s.status == "fail" && s.failed.empty()) {
         failures += "<li>seed " + std::to_string(s.seed) + ": failed (<a href=\"" + dir +

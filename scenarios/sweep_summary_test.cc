@@ -166,7 +166,7 @@ TEST(SweepSummaryTest, SummaryTableLinksEachRunAndNamesWhatFailed) {
   EXPECT_THAT(html, HasSubstr("<tr><td>a=1, b=10</td><td class=\"pass\"><a "
                               "href=\"runs/0000/report.html\">pass</a></td><td class=\"fail\"><a "
                               "href=\"runs/0001/report.html\">FAIL</a></td>"));
-  EXPECT_THAT(html, HasSubstr("<li>seed 9: s.m = 3 &gt; 2</li>"));
+  EXPECT_THAT(html, HasSubstr("<li>seed 9: s.m = 3, bound &le; 2</li>"));
   EXPECT_THAT(html, HasSubstr("<tr><td>a=2, b=30</td><td class=\"none\">not run</td>"));
   EXPECT_THAT(html, HasSubstr("<table class=\"heat\">"));
   EXPECT_THAT(html, HasSubstr("held: held = x"));

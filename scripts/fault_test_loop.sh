@@ -2,6 +2,7 @@
 # Runs scripts/fault_test.sh N times (default 50) with both cores loaded by two busy loops, and
 # reports "K of N passed". Each failing run's output is kept in BUILD_DIR/fault_test_loop/.
 # Not for CI: it takes N times the fault test's minute or two. Needs what fault_test.sh needs.
+# To go on building meanwhile, give it a folder holding a copy of the binary as apps/slamrig.
 #
 #   scripts/fault_test_loop.sh [N] [BUILD_DIR]
 set -euo pipefail
@@ -27,6 +28,11 @@ done
 
 passed=0 skipped=0
 for i in $(seq "$runs"); do
+  # A rebuild replacing the binary mid-loop would fail every run for nothing.
+  [[ -x $build/apps/slamrig ]] || {
+    echo "fault_test_loop: $build/apps/slamrig is gone (rebuilt?); stopped after $((i - 1))" >&2
+    exit 1
+  }
   code=0
   bash "$repo/scripts/fault_test.sh" "$build" >"$logs/run_$i.log" 2>&1 || code=$?
   if ((code == 0)); then
