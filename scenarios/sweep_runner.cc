@@ -148,8 +148,9 @@ std::vector<std::string> ResultRow(const SweepSpec& spec, const std::vector<std:
 
 // What an earlier, interrupted sweep left in results.csv.
 struct ResumeState {
-  bool has_header = false;     ///< the file exists with a header line
-  std::set<std::string> done;  ///< run ids with a row
+  bool has_header = false;       ///< the file exists with a header line
+  std::set<std::string> done;    ///< run ids with a row
+  std::set<std::string> failed;  ///< of them, those whose status is not pass
 };
 
 // Reads results.csv for a resumed sweep, which must have been started with the same grid and
@@ -173,7 +174,11 @@ ResumeState ReadResumeState(const SweepSpec& spec, const std::vector<std::string
   }
   state.has_header = true;
   while (std::getline(lines, line)) {
-    if (!line.empty()) state.done.insert(SplitCsv(line)[0]);
+    if (line.empty()) continue;
+    const std::vector<std::string> fields = SplitCsv(line);
+    state.done.insert(fields[0]);
+    const std::size_t status = spec.parameters.size() + 2;
+    if (fields.size() <= status || fields[status] != "pass") state.failed.insert(fields[0]);
   }
   return state;
 }
@@ -253,6 +258,7 @@ SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options) 
   for (std::size_t i = 0; i < runs.size(); ++i) {
     if (done.count(runs[i].id)) {
       ++summary.already_done;
+      summary.failed += static_cast<int>(resume.failed.count(runs[i].id));
     } else {
       todo.push_back(i);
     }
