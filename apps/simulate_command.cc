@@ -23,12 +23,13 @@
 namespace slamrig::app {
 
 int RunSimulateCommand(const std::vector<std::string>& args) {
-  std::string world_arg, robot_arg = "ece276a", out_dir, format = "carmen", compression = "zstd";
+  std::string world_arg, robot_arg = sim::kDefaultRobot, out_dir, format = "carmen",
+                         compression = "zstd";
   std::vector<std::string> topic_flags;
   double duration_s = 0.0, physics_rate_hz = 200.0;
   std::uint64_t seed = 1;
   int laps = 0, dataset = 20;
-  bool no_noise = false;
+  bool no_noise = false, quiet = false;
   ArgParser parser(
       "slamrig simulate", "WORLD [--robot R] [--duration S] [--seed N] --out DIR [options]",
       "Simulates a robot driving through a world (Box2D physics with wheel slip, encoders, IMU,\n"
@@ -42,7 +43,9 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
       "data (N from --dataset). truth.tum and the yaml files are written for every format.");
   parser.AddPositional("WORLD", "world file, or a name in worlds/ (office, corridor, ...)",
                        &world_arg);
-  parser.AddOption("robot", "R", "robot file, or a name in robots/ (ece276a, small_diff)",
+  parser.AddOption("robot", "R",
+                   "robot file, or a name in robots/ (ece276a, small_diff) [default: " +
+                       std::string(sim::kDefaultRobot) + "]",
                    &robot_arg);
   parser.AddOption("duration", "S", "simulated seconds (default: until the drive is done)",
                    &duration_s);
@@ -60,6 +63,7 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
                      "a bag topic name, e.g. scan=/front/scan (keys: " +
                          std::string(slam::BagTopicNames::Keys()) + ")",
                      &topic_flags);
+  parser.AddFlag("quiet", "print nothing but errors", &quiet);
   if (!parser.Parse(args)) return 0;
   if (out_dir.empty()) throw ConfigError("slamrig simulate: --out DIR is required");
   if (format != "carmen" && format != "mcap" && format != "sqlite3" && format != "ece276a") {
@@ -118,6 +122,7 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
   const scenario::RunSummary summary = scenario::RecordSimulation(options, run, out_dir, recording);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (quiet) return 0;
   const Pose2 error = summary.final_truth.Between(options.world.spawn * summary.final_odometry);
   std::printf(
       "%s with %s, seed %llu: %.1f s simulated%s, %.1f m driven, %d scans, %d odometry, %d IMU "

@@ -474,7 +474,11 @@ SimulatedSource ReadSimulatedSource(const YamlNode& root, const std::string& pat
                                     std::uint64_t seed, const FileOverrides& sets) {
   SimulatedSource sim_source;
   YamlNode world = WorldOrRobot(root.Required("world"), path, "worlds");
-  YamlNode robot = WorldOrRobot(root.Required("robot"), path, "robots");
+  // No robot: the one `slamrig simulate` drives when given none.
+  const std::optional<YamlNode> robot_node = root.Optional("robot");
+  YamlNode robot = robot_node
+                       ? WorldOrRobot(*robot_node, path, "robots")
+                       : YamlNode::LoadFile(sim::FindPresetFile(sim::kDefaultRobot, "robots"));
   for (const char* section : {"world_overrides", "robot_overrides"}) {
     if (auto o = root.Optional(section)) {
       for (const std::string& key : o->Keys()) {

@@ -69,7 +69,7 @@ inline slam::TextureMapOptions DefaultScenarioTexture() {
 /// name: office_loop
 /// description: three laps of the office corridor loop at 0.5 m/s
 /// world: ../worlds/office.yaml       # a file (relative to this one), a preset name or a map
-/// robot: ../robots/ece276a.yaml      # likewise
+/// robot: ../robots/ece276a.yaml      # likewise; optional: sim::kDefaultRobot
 /// seed: 1
 /// duration_s: 400                    # stop here even if the drive is not finished
 /// world_overrides: {drive.laps: 3}   # key path in the world file -> value

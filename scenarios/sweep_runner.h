@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "scenarios/sweep_spec.h"
+#include "scenarios/sweep_summary.h"
 
 namespace slamrig::scenario {
 
@@ -36,9 +37,7 @@ struct SweepSummary {
 /// a child process `slamrig run SCENARIO --out runs/<n> --seed S --set key=value ... --quiet`,
 /// appending one CSV row per finished run at once (a single write), so a sweep killed at any
 /// moment resumes with no run lost or run twice. A results.csv written for another grid is an
-/// error, never mixed. At the end writes one summary plot per metric and parameter
-/// (summary_<metric>__<parameter>.png: the mean over seeds with the min-max spread) and
-/// summary.html.
+/// error, never mixed. At the end writes summary.html (WriteSweepSummary).
 SweepSummary RunSweep(const SweepSpec& spec, const SweepRunnerOptions& options);
 
 /// Resolves the sweep's scenario at every value of the grid, as its runs will, before anything
@@ -59,10 +58,6 @@ bool RunSweepRow(const SweepSpec& spec, const SweepRunnerOptions& options, std::
 
 /// Where RunSweepRow writes row `row`: `out_dir`/rows/<row, 4 digits>.csv.
 std::string SweepRowPath(const std::string& out_dir, std::size_t row);
-
-/// Reads `out_dir`/results.csv and writes the summary plots and summary.html. Returns the
-/// number of plots written.
-int WriteSweepSummary(const SweepSpec& spec, const std::string& out_dir);
 
 /// The CSV header of `spec`'s results file.
 std::vector<std::string> ResultsHeader(const SweepSpec& spec,

@@ -98,7 +98,30 @@ TEST(SweepTest, RunsEveryRunOnceAndResumesAfterAKill) {
   for (const auto& l : got) b.insert(WithoutWallTime(l));
   EXPECT_EQ(a, b);
   EXPECT_TRUE(std::filesystem::exists(resumed.dir.File("out/summary.html")));
-  EXPECT_TRUE(std::filesystem::exists(resumed.dir.File("out/summary_pf.ate_rmse_m__a.noise.png")));
+  // Two swept parameters: a heat map per metric, no line plots.
+  std::ifstream summary(resumed.dir.File("out/summary.html"));
+  const std::string html{std::istreambuf_iterator<char>(summary), std::istreambuf_iterator<char>()};
+  EXPECT_THAT(html, ::testing::HasSubstr("<table class=\"heat\">"));
+  EXPECT_FALSE(std::filesystem::exists(resumed.dir.File("out/summary_pf.ate_rmse_m__a.noise.png")));
+}
+
+// A sweep run again over a complete results.csv runs nothing and still counts the runs that
+// failed before (its exit code says so).
+TEST(SweepTest, AResumedSweepCountsTheRunsThatFailedBefore) {
+  Fixture f;
+  RunSweep(f.spec, f.options);
+  std::vector<std::string> lines = f.Lines();
+  ASSERT_EQ(lines.size(), 19u);
+  for (const int i : {2, 5}) {
+    lines[i].replace(lines[i].find(",pass,"), 6, i == 2 ? ",fail," : ",error,");
+  }
+  std::string csv;
+  for (const auto& l : lines) csv += l + "\n";
+  f.dir.Write("out/results.csv", csv);
+  const SweepSummary again = RunSweep(f.spec, f.options);
+  EXPECT_EQ(again.already_done, 18);
+  EXPECT_EQ(again.ran, 0);
+  EXPECT_EQ(again.failed, 2);
 }
 
 TEST(SweepTest, RefusesResultsOfAnotherSweep) {

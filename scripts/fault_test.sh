@@ -119,13 +119,19 @@ check_folder() { # name out_dir what
   if [[ $name != sweep && -e $dir/$(marker_of "$name") ]]; then
     fail "$what: $(marker_of "$name") written: the folder looks complete"
   fi
+  # The list is read whole before the loop: find as a process substitution (`< <(find ...)`)
+  # is not waited for, and could still be exiting, with `dir` on its command line, when
+  # check_no_children looks for processes naming `dir`.
+  local files
+  files=$(find "$dir" -type f)
   while IFS= read -r f; do
+    [[ -n $f ]] || continue
     local rel=${f#"$dir"/}
     timed_file "$f" && continue
     [[ $name == sweep && $rel == runs/*/log.txt ]] && continue # the run's own error line
     [[ -f $ref/$rel ]] || fail "$what: $rel is not in the uninterrupted output"
     cmp -s "$f" "$ref/$rel" || fail "$what: $rel differs from the uninterrupted one"
-  done < <(find "$dir" -type f)
+  done <<<"$files"
 }
 # Exactly one line on stderr, matching `pattern`.
 check_stderr() { # file pattern what
@@ -134,17 +140,32 @@ check_stderr() { # file pattern what
   ((lines == 1)) || fail "$3: $lines lines on stderr, expected one: $(head -c 600 "$1")"
   grep -Eq -- "$2" "$1" || fail "$3: stderr '$(cat "$1")' does not match '$2'"
 }
-# No process of ours still has `dir` on its command line (a sweep's children) after a grace of
-# 2 s: one still exiting as the check runs is not left running (a one-off failure once listed
-# nothing: the process was gone by the second look). The list is what the last look saw.
+# A process as /proc shows it: state, parent, executable and command line.
+process_info() { # pid
+  local state ppid exe cmd
+  state=$(sed -n 's/^State:\s*//p' "/proc/$1/status" 2>/dev/null) || true
+  ppid=$(sed -n 's/^PPid:\s*//p' "/proc/$1/status" 2>/dev/null) || true
+  exe=$(readlink "/proc/$1/exe" 2>/dev/null) || true
+  cmd=$(tr '\0' ' ' <"/proc/$1/cmdline" 2>/dev/null) || true
+  if [[ -z $state ]]; then
+    echo "pid $1: gone by the time it was read"
+  else
+    echo "pid $1: state ${state:-?}, parent ${ppid:-?}, exe ${exe:-(none)}, command ${cmd:-(none)}"
+  fi
+}
+# No slamrig process still has `dir` on its command line (a sweep's child, or one between fork
+# and exec) once the sweep has exited: the sweep waits for every child it started. One look, no
+# grace period. Only this build's slamrig counts: a tool naming `dir` (this script's own find or
+# cmp, which are waited for anyway) is no child of the sweep. Everything pgrep saw is listed as
+# /proc showed it.
 check_no_children() { # dir what
-  local seen
-  for _ in $(seq 20); do
-    seen=$(pgrep -af -- "$1" | head -n 3) || true
-    [[ -z $seen ]] && return 0
-    sleep 0.1
+  local pids pid seen="" left=0
+  pids=$(pgrep -f -- "$1") || true
+  for pid in $pids; do
+    [[ $(readlink "/proc/$pid/exe" 2>/dev/null) == "$binary" ]] && left=$((left + 1))
+    seen+="$(process_info "$pid"); "
   done
-  fail "$2: processes left running after 2 s: $seen"
+  ((left == 0)) || fail "$2: $left slamrig processes left running; pgrep -f saw: $seen"
 }
 # The sweep in `dir` run again to the end gives the reference rows, each once.
 check_resume() { # dir what

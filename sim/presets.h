@@ -6,6 +6,10 @@
 
 namespace slamrig::sim {
 
+/// The robot preset of a simulation that names none: `slamrig simulate` without --robot and a
+/// scenario without `robot:`.
+inline constexpr const char* kDefaultRobot = "ece276a";
+
 /// Where shipped presets of `folder` ("worlds", "robots", "scenarios") are looked for, in order:
 /// under the current directory, in share/slamrig beside the running binary (an installed
 /// slamrig), in the configured install prefix, and in the source tree this binary was built from.

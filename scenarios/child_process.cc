@@ -1,0 +1,190 @@
+#include "scenarios/child_process.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "slam/types/interrupt.h"
+
+namespace slamrig::scenario {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Reads what is there on the child's stderr pipe; closes it at end of file.
+void DrainStderr(Child* child) {
+  char buffer[4096];
+  while (child->stderr_fd >= 0) {
+    const ssize_t n = ::read(child->stderr_fd, buffer, sizeof(buffer));
+    if (n > 0) {
+      child->stderr_text.append(buffer, static_cast<std::size_t>(n));
+      constexpr std::size_t kKeep = 64 * 1024;
+      if (child->stderr_text.size() > kKeep)
+        child->stderr_text.erase(0, child->stderr_text.size() - kKeep);
+      continue;
+    }
+    if (n < 0 && (errno == EAGAIN || errno == EINTR)) return;
+    ::close(child->stderr_fd);  // end of file, or an error: nothing more will come
+    child->stderr_fd = -1;
+  }
+}
+
+// A child that ended: the rest of its stderr, appended to its log.txt (best effort: the disk
+// may be full; the text stays in `child` for the sweep's error line).
+void FinishChild(Child* child) {
+  // Only the child held the pipe's write end (O_CLOEXEC elsewhere), so end of file is near; a
+  // deadline all the same, should a process it started keep the pipe open.
+  const Clock::time_point deadline = Clock::now() + std::chrono::seconds(2);
+  while (child->stderr_fd >= 0 && Clock::now() < deadline) {
+    DrainStderr(child);
+    if (child->stderr_fd >= 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  if (child->stderr_fd >= 0) {
+    ::close(child->stderr_fd);
+    child->stderr_fd = -1;
+  }
+  if (child->stderr_text.empty()) return;
+  std::ofstream log(child->log_path, std::ios::app | std::ios::binary);
+  log << child->stderr_text;
+}
+
+}  // namespace
+
+ChildEnd ClassifyEnd(int status) {
+  if (WIFSIGNALED(status)) {
+    const int s = WTERMSIG(status);
+    // A crash is the run's own failure; these come from outside (a user, scancel, the OOM killer).
+    return s == SIGTERM || s == SIGINT || s == SIGKILL || s == SIGHUP ? ChildEnd::kStopped
+                                                                      : ChildEnd::kResult;
+  }
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 0;
+  if (code == 128 + SIGINT || code == 128 + SIGTERM) return ChildEnd::kStopped;
+  if (code == kExitOutputError) return ChildEnd::kOutputError;
+  return ChildEnd::kResult;
+}
+
+// The last non-empty line a child wrote to stderr (its error line, without slamrig's prefix),
+// or `fallback`.
+std::string LastErrorLine(const Child& child, const std::string& fallback) {
+  std::istringstream in(child.stderr_text);
+  std::string line, last;
+  while (std::getline(in, line)) {
+    if (!line.empty()) last = line;
+  }
+  const std::string prefix = "slamrig: error: ";
+  if (last.rfind(prefix, 0) == 0) last = last.substr(prefix.size());
+  return last.empty() ? fallback : last;
+}
+
+Child SpawnChild(const std::vector<std::string>& args, const std::string& log_path,
+                 std::size_t run) {
+  Child child;
+  child.run = run;
+  child.start = Clock::now();
+  child.log_path = log_path;
+  // Everything the child needs is made before fork: between fork and exec it only calls
+  // async-signal-safe functions.
+  std::vector<std::string> argv_text = args;
+  std::vector<char*> argv;
+  for (auto& a : argv_text) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  int pipe_fds[2];
+  if (::pipe2(pipe_fds, O_CLOEXEC) != 0)
+    throw std::runtime_error(std::string("pipe failed: ") + std::strerror(errno));
+  // SIGINT and SIGTERM blocked across fork: the child starts with this process's handlers, which
+  // only record a signal in the child's copy of memory, lost at exec. Blocked, a signal sent to
+  // the child before it restores the default action stays pending and then ends it.
+  sigset_t interrupts, old_mask;
+  sigemptyset(&interrupts);
+  sigaddset(&interrupts, SIGINT);
+  sigaddset(&interrupts, SIGTERM);
+  ::sigprocmask(SIG_BLOCK, &interrupts, &old_mask);
+  const pid_t parent = ::getpid();
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::signal(SIGINT, SIG_DFL);
+    ::signal(SIGTERM, SIG_DFL);
+    ::sigprocmask(SIG_SETMASK, &old_mask, nullptr);
+    // A child never outlives a killed sweep: it would finish a run nobody records. SIGTERM
+    // (not SIGKILL), so that it still removes its temporary files.
+    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (::getppid() != parent) ::_exit(128 + SIGTERM);  // the sweep died before prctl
+    const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (log >= 0) ::dup2(log, STDOUT_FILENO);
+    ::dup2(pipe_fds[1], STDERR_FILENO);  // dup2 clears O_CLOEXEC on the copy
+    ::execv(argv[0], argv.data());
+    static constexpr char kMessage[] = "execv failed\n";
+    [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, kMessage, sizeof(kMessage) - 1);
+    ::_exit(127);
+  }
+  const int fork_errno = errno;
+  ::sigprocmask(SIG_SETMASK, &old_mask, nullptr);
+  if (pid < 0) {
+    ::close(pipe_fds[0]);
+    ::close(pipe_fds[1]);
+    throw std::runtime_error(std::string("fork failed: ") + std::strerror(fork_errno));
+  }
+  ::close(pipe_fds[1]);
+  ::fcntl(pipe_fds[0], F_SETFL, O_NONBLOCK);
+  child.pid = pid;
+  child.stderr_fd = pipe_fds[0];
+  return child;
+}
+
+std::optional<std::pair<Child, int>> Children::WaitAny() {
+  while (!running_.empty() && InterruptSignal() == 0) {
+    for (auto& [pid, child] : running_) DrainStderr(&child);
+    int status = 0;
+    const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+    if (pid < 0 && errno != EINTR) return std::nullopt;
+    if (pid <= 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      continue;
+    }
+    const auto it = running_.find(pid);
+    if (it == running_.end()) continue;
+    Child child = std::move(it->second);
+    running_.erase(it);
+    FinishChild(&child);
+    return std::make_pair(std::move(child), status);
+  }
+  return std::nullopt;
+}
+
+void Children::StopAll() {
+  for (const auto& [pid, child] : running_) ::kill(pid, SIGTERM);
+  const Clock::time_point deadline = Clock::now() + std::chrono::seconds(10);
+  while (!running_.empty()) {
+    for (auto& [pid, child] : running_) DrainStderr(&child);
+    int status = 0;
+    const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+    if (pid > 0) {
+      if (const auto it = running_.find(pid); it != running_.end()) {
+        FinishChild(&it->second);
+        running_.erase(it);
+      }
+    } else if (pid < 0 && errno == ECHILD) {
+      break;
+    } else if (Clock::now() > deadline) {
+      for (const auto& [p, child] : running_) ::kill(p, SIGKILL);
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
+  for (auto& [pid, child] : running_) {
+    if (child.stderr_fd >= 0) ::close(child.stderr_fd);
+  }
+  running_.clear();
+}
+
+}  // namespace slamrig::scenario

@@ -1,0 +1,78 @@
+#pragma once
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace slamrig::scenario {
+
+/// A running child process of a sweep (`slamrig run`). Its stdout goes to `log_path`; its stderr
+/// comes through a pipe, so that its error line reaches the sweep even when the log cannot be
+/// written (a full disk), and is appended to the log when it ends.
+struct Child {
+  std::size_t run = 0;  ///< the caller's tag: the grid row
+  std::chrono::steady_clock::time_point start;
+  pid_t pid = -1;
+  int stderr_fd = -1;  ///< read end of the child's stderr, non-blocking
+  std::string log_path;
+  std::string stderr_text;  ///< what it wrote there (the last 64 KiB)
+};
+
+/// Exit code of a slamrig command that could not write its output (apps/main.cc).
+inline constexpr int kExitOutputError = 74;
+
+/// How a child ended, as far as a sweep's results are concerned.
+enum class ChildEnd {
+  kResult,       ///< it ran to a verdict or failed by itself: its row is recorded
+  kStopped,      ///< a signal stopped it: no row, the next sweep runs it again
+  kOutputError,  ///< it could not write its folder: no row, and the sweep stops
+};
+
+/// Classifies a wait status: SIGTERM, SIGINT, SIGKILL, SIGHUP (as a signal or as exit code
+/// 128 + signal) come from outside; exit code kExitOutputError is an unwritable output; anything
+/// else, a crash included, is the run's own result.
+ChildEnd ClassifyEnd(int status);
+
+/// The last non-empty line the child wrote to stderr, without slamrig's "slamrig: error: "
+/// prefix, or `fallback`.
+std::string LastErrorLine(const Child& child, const std::string& fallback);
+
+/// Starts `args` (args[0] is the program's path) with stdout to `log_path` (truncated) and
+/// stderr to a pipe. The child gets SIGTERM when the calling process dies (PR_SET_PDEATHSIG).
+Child SpawnChild(const std::vector<std::string>& args, const std::string& log_path,
+                 std::size_t run);
+
+/// The child processes of a sweep. However the sweep ends (done, interrupted, an error thrown),
+/// the ones still running are sent SIGTERM, so that they remove their temporary files, and are
+/// waited for: nothing of a stopped sweep goes on writing behind its back, and once the sweep
+/// has exited no child of it is left.
+class Children {
+ public:
+  Children() = default;
+  Children(const Children&) = delete;
+  Children& operator=(const Children&) = delete;
+  ~Children() { StopAll(); }
+
+  void Add(const Child& child) { running_[child.pid] = child; }
+  std::size_t size() const { return running_.size(); }
+  bool empty() const { return running_.empty(); }
+
+  /// Waits until a child ends and returns it with its wait status; nullopt when none is left
+  /// or SIGINT/SIGTERM arrived (polled every 20 ms: a signal between a check and a blocking
+  /// waitpid would otherwise wait for the next child to end).
+  std::optional<std::pair<Child, int>> WaitAny();
+
+  /// SIGTERM to every running child, then waits for them (SIGKILL after 10 s).
+  void StopAll();
+
+ private:
+  std::map<pid_t, Child> running_;
+};
+
+}  // namespace slamrig::scenario
