@@ -4,6 +4,8 @@
 // ask for, with dead reckoning beside it), which runs and reports as `slamrig run` does; the
 // files `slamrig slam` has always written (trajectory.tum, map.pgm, ...) join the report.
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -38,29 +40,42 @@ std::string Fixed(double v, int digits) {
   return buffer;
 }
 
-// Progress on stderr, at most every two seconds, for logs that take a while.
+// Progress on stderr for logs that take a while: on a terminal one line rewritten every two
+// seconds; otherwise (a file, a pipe, CI) a whole line every ten seconds, so that no progress
+// ever runs into the lines that follow it.
 class Progress {
  public:
   explicit Progress(bool enabled)
-      : enabled_(enabled), start_(Clock::now()), next_(start_ + std::chrono::seconds(2)) {}
+      : enabled_(enabled),
+        terminal_(::isatty(STDERR_FILENO) != 0),
+        period_(terminal_ ? 2 : 10),
+        start_(Clock::now()),
+        next_(start_ + period_) {}
+  ~Progress() {
+    if (open_line_) std::fputc('\n', stderr);
+  }
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+
   void operator()(std::size_t done, std::size_t total) {
     if (!enabled_) return;
     const auto now = Clock::now();
-    if (now < next_ && done < total) return;
-    next_ = now + std::chrono::seconds(2);
+    if (now < next_ && (done < total || !terminal_)) return;
+    next_ = now + period_;
     const double s = std::chrono::duration<double>(now - start_).count();
     std::fprintf(
-        stderr, "\rslam: %zu/%zu scans (%.0f%%), %.1f s", done, total,
-        100.0 * static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(total, 1)),
-        s);
-    if (done == total) std::fputc('\n', stderr);
+        stderr, "%sslam: %zu/%zu scans (%.0f%%), %.1f s%s", terminal_ ? "\r" : "", done, total,
+        100.0 * static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(total, 1)), s,
+        terminal_ && done < total ? "" : "\n");
+    open_line_ = terminal_ && done < total;
     std::fflush(stderr);
-    printed_ = true;
   }
 
  private:
   bool enabled_;
-  bool printed_ = false;
+  bool terminal_;
+  std::chrono::seconds period_;
+  bool open_line_ = false;
   Clock::time_point start_, next_;
 };
 

@@ -19,7 +19,8 @@ import subprocess
 import sys
 
 DEFAULT_DIRS = ["apps", "bench", "fuzz", "python", "scenarios", "sim", "slam", "tests"]
-MARKER = re.compile(r"//\s*function-length:\s*exception\s*\((.+)\)")
+# The reason may run on over the following comment lines; its first line is enough here.
+MARKER = re.compile(r"//\s*function-length:\s*exception\s*\((.+?)\)?\s*$")
 
 
 def Functions(root, dirs):
