@@ -188,9 +188,7 @@ void AddCross(const Eigen::Vector2d& c, double size_m, Colour colour,
 // A landmark estimator's map in the map frame: one line per landmark, its covariance and its
 // sightings.
 std::string LandmarksCsv(const ConfigResult& c) {
-  const double yaw = c.map_from_estimator.theta();
-  Eigen::Matrix2d rotation;
-  rotation << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);
+  const Eigen::Matrix2d rotation = c.map_from_estimator.Rotation();
   std::vector<int> sightings(c.run.landmarks.landmarks.size(), 0);
   for (const slam::LandmarkSighting& s : c.run.landmarks.sightings)
     if (s.landmark >= 0 && s.landmark < static_cast<int>(sightings.size())) ++sightings[s.landmark];

@@ -71,9 +71,7 @@ void ShowLive(LiveView& view, double now_s, const Runners& runners, const Pose2&
     for (const slam::ViewEdge& edge : extras.edges) {
       e.edges.push_back({map_from_start * edge.from, map_from_start * edge.to, edge.loop_closure});
     }
-    const double c = std::cos(map_from_start.theta()), s = std::sin(map_from_start.theta());
-    Eigen::Matrix2d rotation;
-    rotation << c, -s, s, c;
+    const Eigen::Matrix2d rotation = map_from_start.Rotation();
     for (const slam::LandmarkEstimate& l : extras.landmarks) {
       e.landmarks.push_back(
           {map_from_start * l.position_m, rotation * l.covariance * rotation.transpose()});
@@ -118,9 +116,7 @@ void ScoreLandmarks(const ScenarioResult& run, ConfigResult* c) {
   std::vector<Eigen::Vector2d> pillars;
   for (const sim::ShapeSpec& shape : run.spec->simulated->options.world.walls)
     if (shape.type == sim::ShapeType::kCircle) pillars.push_back(shape.center_m);
-  const double yaw = c->map_from_estimator.theta();
-  Eigen::Matrix2d rotation;
-  rotation << std::cos(yaw), -std::sin(yaw), std::sin(yaw), std::cos(yaw);
+  const Eigen::Matrix2d rotation = c->map_from_estimator.Rotation();
   std::vector<slam::ScoredLandmark> landmarks;
   for (const slam::LandmarkEstimate& l : map.landmarks) {
     landmarks.push_back(

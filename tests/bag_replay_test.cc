@@ -1,5 +1,5 @@
-// DESIGN.md's missing test: simulate, write a log, read it back, and get bit-identical SLAM
-// output. A scenario runs in process on the simulator; the same simulation recorded as a ROS 2
+// docs/architecture.md's missing test: simulate, write a log, read it back, and get bit-identical
+// SLAM output. A scenario runs in process on the simulator; the same simulation recorded as a ROS 2
 // bag (MCAP with renamed topics, and sqlite3) replays through the same estimators; every pose,
 // trace and statistic must be equal bit for bit.
 

@@ -1,5 +1,5 @@
-// The dependency rules of DESIGN.md, checked on the code's own includes: one folder is one
-// module, modules only include modules listed before them in the top-level CMakeLists.txt's
+// The dependency rules of docs/architecture.md, checked on the code's own includes: one folder is
+// one module, modules only include modules listed before them in the top-level CMakeLists.txt's
 // SLAMRIG_MODULES (arrows only point down), nothing under slam/ includes the simulator, Box2D or
 // MuJoCo, and sim/ includes nothing of scenarios/ or apps/.
 #include <gmock/gmock.h>
