@@ -24,12 +24,6 @@ std::vector<Entry> InFileOrder(const CarmenLog& log) {
 
 }  // namespace
 
-std::string GroupedCount(std::uint64_t n) {
-  std::string digits = std::to_string(n);
-  for (std::size_t i = digits.size(); i > 3; i -= 3) digits.insert(i - 3, 1, ',');
-  return digits;
-}
-
 Dataset CarmenToDataset(const CarmenLog& log) {
   Dataset data;
   data.source = log.path;

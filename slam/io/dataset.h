@@ -28,8 +28,13 @@ struct Dataset {
   bool times_synthesised = false;
 };
 
-/// `n` with a comma between groups of three digits ("2,411"), as notes print counts.
-std::string GroupedCount(std::uint64_t n);
+/// `n` with a comma between groups of three digits ("2,411"), as notes print counts. Inline: the
+/// bag readers (slamrig_bag) use it without linking slamrig_io.
+inline std::string GroupedCount(std::uint64_t n) {
+  std::string digits = std::to_string(n);
+  for (std::size_t i = digits.size(); i > 3; i -= 3) digits.insert(i - 3, 1, ',');
+  return digits;
+}
 
 /// Turns a CARMEN log into a Dataset.
 /// - GMapping-corrected logs: the scans' poses become the reference; the raw odometry is
