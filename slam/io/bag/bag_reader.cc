@@ -102,8 +102,11 @@ TopicHints HintsFor(const BagTopicNames& n, const std::map<std::string, SeenTopi
     // Any odometry could stand in for ground truth: that one is never guessed.
     if (candidates.empty() || std::string_view(key) == "ground_truth") continue;
     // Names with the key's word first ("/wheel/odom" before "/truth" for odom), else by name.
-    std::stable_partition(candidates.begin(), candidates.end(),
-                          [&](const std::string& c) { return c.find(word) != std::string::npos; });
+    // (A copy: clang 14 cannot capture a structured binding.)
+    const std::string_view key_word = word;
+    std::stable_partition(candidates.begin(), candidates.end(), [&](const std::string& c) {
+      return c.find(key_word) != std::string::npos;
+    });
     hints.missing.push_back("no " + std::string(RosTypeName(type)) + " on " + *name);
     hints.flags.push_back("--topic " + std::string(key) + "=" + candidates.front());
     hints.scan_elsewhere = hints.scan_elsewhere || type == RosType::kLaserScan;
