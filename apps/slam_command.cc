@@ -28,17 +28,12 @@
 #include "slam/io/tum_io.h"
 #include "slam/pipeline/estimator_runner.h"
 #include "slam/types/error.h"
+#include "slam/types/format.h"
 
 namespace slamrig::app {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::string Fixed(double v, int digits) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.*f", digits, v);
-  return buffer;
-}
 
 // Progress on stderr for logs that take a while: on a terminal one line rewritten every two
 // seconds; otherwise (a file, a pipe, CI) a whole line every ten seconds, so that no progress
