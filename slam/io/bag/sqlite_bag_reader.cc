@@ -166,7 +166,11 @@ class Database {
  public:
   explicit Database(const std::string& path) : path_(path) {
     if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READONLY, NoShortReadVfs()) != SQLITE_OK) {
-      Fail("open");
+      // A failed open still allocates the handle, and a throwing constructor runs no destructor.
+      const std::string message = db_ != nullptr ? sqlite3_errmsg(db_) : "cannot open";
+      sqlite3_close(db_);
+      db_ = nullptr;
+      throw ParseError(path_ + ": sqlite3 open: " + message);
     }
   }
   ~Database() { sqlite3_close(db_); }
