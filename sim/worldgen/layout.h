@@ -22,6 +22,14 @@ class Rng {
   double Uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
   /// Uniform in [lo, hi).
   double Uniform(double lo, double hi) { return lo + (hi - lo) * Uniform(); }
+  /// A point uniform in the box [lo, hi). y is drawn before x, as is every pair of draws here: one
+  /// statement with two draws as arguments leaves their order to the compiler (gcc: last first),
+  /// so each pair is sequenced explicitly, in the order that made the worlds already generated.
+  Eigen::Vector2d UniformPoint(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) {
+    const double y = Uniform(lo.y(), hi.y());
+    const double x = Uniform(lo.x(), hi.x());
+    return {x, y};
+  }
   /// Uniform integer in [0, n), n > 0 (the modulo bias is below 2^-40 for any n here).
   int Below(int n) { return static_cast<int>(engine_() % static_cast<std::uint64_t>(n)); }
   /// True with probability p.

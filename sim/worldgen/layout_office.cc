@@ -38,11 +38,10 @@ void Furnish(const Rect& room, const std::vector<Rect>& keep, const OfficeOption
   std::vector<Rect> placed = keep;
   for (int n = 0; n < count; ++n) {
     for (int attempt = 0; attempt < 8; ++attempt) {
-      Eigen::Vector2d item(rng.Uniform(0.6, 1.6), rng.Uniform(0.4, 0.8));
+      Eigen::Vector2d item = rng.UniformPoint({0.6, 0.4}, {1.6, 0.8});
       if (rng.Chance(0.5)) item = Eigen::Vector2d(item.y(), item.x());
       if (item.x() > size.x() || item.y() > size.y()) continue;
-      const Eigen::Vector2d lo(rng.Uniform(room.lo.x(), room.hi.x() - item.x()),
-                               rng.Uniform(room.lo.y(), room.hi.y() - item.y()));
+      const Eigen::Vector2d lo = rng.UniformPoint(room.lo, room.hi - item);
       const Rect r{lo, lo + item};
       if (std::any_of(placed.begin(), placed.end(),
                       [&](const Rect& p) { return p.Overlaps(r, 0.25); })) {
@@ -57,8 +56,8 @@ void Furnish(const Rect& room, const std::vector<Rect>& keep, const OfficeOption
   for (int attempt = 0; attempt < 8; ++attempt) {
     const double radius = rng.Uniform(0.15, 0.3);
     if (2.0 * radius > size.minCoeff()) return;
-    const Eigen::Vector2d c(rng.Uniform(room.lo.x() + radius, room.hi.x() - radius),
-                            rng.Uniform(room.lo.y() + radius, room.hi.y() - radius));
+    const Eigen::Vector2d c =
+        rng.UniformPoint((room.lo.array() + radius).matrix(), (room.hi.array() - radius).matrix());
     const Rect r{(c.array() - radius).matrix(), (c.array() + radius).matrix()};
     if (std::any_of(placed.begin(), placed.end(),
                     [&](const Rect& p) { return p.Overlaps(r, 0.25); })) {

@@ -95,8 +95,8 @@ Layout MakeCampus(const CampusOptions& o, const RouteOptions& route, Rng& rng) {
       }
       const double u = rng.Uniform();
       if (u < o.building_fraction) {
-        const Eigen::Vector2d blo(lo.x() + rng.Uniform(2.0, 8.0), lo.y() + rng.Uniform(2.0, 8.0));
-        const Eigen::Vector2d bhi(hi.x() - rng.Uniform(2.0, 8.0), hi.y() - rng.Uniform(2.0, 8.0));
+        const Eigen::Vector2d blo = lo + rng.UniformPoint({2.0, 2.0}, {8.0, 8.0});
+        const Eigen::Vector2d bhi = hi - rng.UniformPoint({2.0, 2.0}, {8.0, 8.0});
         if ((bhi - blo).minCoeff() < 2.0) continue;
         const SurfaceMaterial m = facade();
         layout.walls.push_back(Box(blo, bhi, m));

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -20,6 +21,16 @@ inline double StandardNormal(RandomEngine& rng) {
   const double u1 = 1.0 - Uniform01(rng);  // (0, 1]: log is finite
   const double u2 = Uniform01(rng);
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
+}
+
+/// Three independent standard normal samples. The last component is drawn first: three draws as
+/// the arguments of one call come in an order the compiler chooses (gcc: last first), so callers
+/// take them from here, in the order that made the results recorded so far.
+inline Eigen::Vector3d StandardNormal3(RandomEngine& rng) {
+  const double z = StandardNormal(rng);
+  const double y = StandardNormal(rng);
+  const double x = StandardNormal(rng);
+  return {x, y, z};
 }
 
 }  // namespace slamrig::slam

@@ -368,9 +368,9 @@ void ParticleFilter::RestartAt(const Pose2& place, ParticleFilterStep* step) {
   const RelocalisationOptions& o = options_.relocalisation;
   const double uniform = 1.0 / options_.num_particles;
   for (Particle& p : particles_) {
-    p.pose = Pose2(place.x() + o.reset_sigma_xy_m * StandardNormal(rng_),
-                   place.y() + o.reset_sigma_xy_m * StandardNormal(rng_),
-                   place.theta() + o.reset_sigma_yaw_rad * StandardNormal(rng_));
+    const Eigen::Vector3d n = StandardNormal3(rng_);
+    p.pose = Pose2(place.x() + o.reset_sigma_xy_m * n.x(), place.y() + o.reset_sigma_xy_m * n.y(),
+                   place.theta() + o.reset_sigma_yaw_rad * n.z());
     p.weight = uniform;
   }
   std::fill(log_weights_.begin(), log_weights_.end(), 0.0);

@@ -47,9 +47,9 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
   // gmapping code does): the matcher sees only a few cells around each point, so the spread of
   // starting points is what lets some particles reach the right match after a large odometry
   // error. The motion prior below stays centred on the prediction.
-  const Pose2 start =
-      predicted * Pose2(sigma_xy * StandardNormal(rng), sigma_xy * StandardNormal(rng),
-                        sigma_yaw * StandardNormal(rng));
+  const Eigen::Vector3d start_noise = StandardNormal3(rng);
+  const Pose2 start = predicted * Pose2(sigma_xy * start_noise.x(), sigma_xy * start_noise.y(),
+                                        sigma_yaw * start_noise.z());
   const ClimbResult match =
       matcher_.Climb(particle.map, points, start, PosePrior{predicted, sigma_xy, sigma_yaw});
   // log_eta is the untempered normaliser (the path's likelihood); log_eta_weight the one the
@@ -117,7 +117,7 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
     }
     covariance.diagonal().array() += 1e-12;
     const Eigen::Matrix3d l = covariance.llt().matrixL();
-    const Eigen::Vector3d z(StandardNormal(rng), StandardNormal(rng), StandardNormal(rng));
+    const Eigen::Vector3d z = StandardNormal3(rng);
     const Eigen::Vector3d d = mean + options_.proposal_spread * Eigen::Vector3d(l * z);
     drawn = Pose2(match.pose.x() + d.x(), match.pose.y() + d.y(), match.pose.theta() + d.z());
   }
