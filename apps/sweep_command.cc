@@ -26,7 +26,7 @@ std::string SelfPath() {
 
 int RunSweepCommand(const std::vector<std::string>& args) {
   std::string sweep_path;
-  scenario::SweepRunnerOptions options;
+  scenario::RunQueueOptions options;
   bool quiet = false;
   ArgParser parser("slamrig sweep", "SWEEP.yaml --out DIR [options]",
                    "Runs the sweep's scenario for every combination of its parameter values and\n"
@@ -50,8 +50,8 @@ int RunSweepCommand(const std::vector<std::string>& args) {
     throw ConfigError("slamrig sweep: --backend = " + backend + "; must be local or slurm");
   }
   options.backend =
-      backend == "slurm" ? scenario::SweepBackend::kSlurm : scenario::SweepBackend::kLocal;
-  options.sweep_path = sweep_path;
+      backend == "slurm" ? scenario::RunBackend::kSlurm : scenario::RunBackend::kLocal;
+  options.spec_path = sweep_path;
   if (options.out_dir.empty()) throw ConfigError("slamrig sweep: --out DIR is required");
   if (options.jobs < 0)
     throw ConfigError("slamrig sweep: --jobs = " + std::to_string(options.jobs) + "; must be >= 0");
@@ -65,7 +65,7 @@ int RunSweepCommand(const std::vector<std::string>& args) {
   // Every value of the grid resolves before a run starts or a file is written (a Slurm array is
   // checked before it is submitted; its tasks, --row, were checked then).
   scenario::CheckSweepGrid(spec);
-  const scenario::SweepSummary s = scenario::RunSweep(spec, options);
+  const scenario::RunQueueSummary s = scenario::RunSweep(spec, options);
   std::printf("%s: %d runs (%d from an earlier sweep, %d now), %d failed -> %s/results.csv\n",
               sweep_path.c_str(), s.total, s.already_done, s.ran, s.failed,
               options.out_dir.c_str());

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -143,9 +144,17 @@ Child SpawnChild(const std::vector<std::string>& args, const std::string& log_pa
 
 std::optional<std::pair<Child, int>> Children::WaitAny() {
   while (!running_.empty() && InterruptSignal() == 0) {
-    for (auto& [pid, child] : running_) DrainStderr(&child);
+    const Clock::time_point now = Clock::now();
+    for (auto& [pid, child] : running_) {
+      DrainStderr(&child);
+      if (!child.timed_out && now > child.deadline) {
+        child.timed_out = true;
+        ::kill(pid, SIGKILL);
+      }
+    }
     int status = 0;
-    const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+    struct rusage usage {};
+    const pid_t pid = ::wait4(-1, &status, WNOHANG, &usage);
     if (pid < 0 && errno != EINTR) return std::nullopt;
     if (pid <= 0) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -155,6 +164,7 @@ std::optional<std::pair<Child, int>> Children::WaitAny() {
     if (it == running_.end()) continue;
     Child child = std::move(it->second);
     running_.erase(it);
+    child.peak_rss_kb = usage.ru_maxrss;
     FinishChild(&child);
     return std::make_pair(std::move(child), status);
   }

@@ -22,6 +22,10 @@ struct Child {
   int stderr_fd = -1;  ///< read end of the child's stderr, non-blocking
   std::string log_path;
   std::string stderr_text;  ///< what it wrote there (the last 64 KiB)
+  /// Past this, WaitAny kills it (SIGKILL) and sets timed_out. Never, by default.
+  std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+  bool timed_out = false;
+  long peak_rss_kb = 0;  ///< its peak resident memory, once it has ended (ru_maxrss)
 };
 
 /// Exit code of a slamrig command that could not write its output (apps/main.cc).
@@ -64,8 +68,9 @@ class Children {
   bool empty() const { return running_.empty(); }
 
   /// Waits until a child ends and returns it with its wait status; nullopt when none is left
-  /// or SIGINT/SIGTERM arrived (polled every 20 ms: a signal between a check and a blocking
-  /// waitpid would otherwise wait for the next child to end).
+  /// or SIGINT/SIGTERM arrived. A child past its deadline is killed on the way (polled every 20 ms:
+  /// a signal between a check and a blocking waitpid would otherwise wait for the next child to
+  /// end).
   std::optional<std::pair<Child, int>> WaitAny();
 
   /// SIGTERM to every running child, then waits for them (SIGKILL after 10 s).

@@ -69,26 +69,26 @@ std::string SlurmArrayIndices(const std::vector<std::size_t>& rows) {
   return out;
 }
 
-std::vector<std::string> RunRowsOnSlurm(const SweepRunnerOptions& options,
+std::vector<std::string> RunRowsOnSlurm(const RunQueueOptions& options,
                                         const std::vector<std::size_t>& rows) {
   if (rows.empty()) return {};
   const fs::path out = fs::absolute(options.out_dir);
   const fs::path slurm_dir = out / "slurm";
   fs::create_directories(slurm_dir);
   // A row file left by an earlier attempt would pass for this one's result.
-  for (const std::size_t row : rows) fs::remove(SweepRowPath(out.string(), row));
+  for (const std::size_t row : rows) fs::remove(QueueRowPath(out.string(), row));
 
-  const std::string script = (slurm_dir / "sweep.sbatch").string();
-  slam::WriteFileAtomically(
-      script,
-      "#!/bin/sh\n# One grid row per array task (written by slamrig sweep --backend slurm).\n"
-      "exec " +
-          ShellQuote(options.slamrig_binary) + " sweep " +
-          ShellQuote(fs::absolute(options.sweep_path).string()) + " --out " +
-          ShellQuote(out.string()) + " --row \"$SLURM_ARRAY_TASK_ID\" --quiet\n");
-  const std::string submit =
-      "sbatch --parsable --job-name=slamrig-sweep --array=" + SlurmArrayIndices(rows) +
-      " --output=" + ShellQuote((slurm_dir / "task_%a.log").string()) + " " + ShellQuote(script);
+  const std::string script = (slurm_dir / (options.command + ".sbatch")).string();
+  slam::WriteFileAtomically(script, "#!/bin/sh\n# One row per array task (written by slamrig " +
+                                        options.command + " --backend slurm).\nexec " +
+                                        ShellQuote(options.slamrig_binary) + " " + options.command +
+                                        " " + ShellQuote(fs::absolute(options.spec_path).string()) +
+                                        " --out " + ShellQuote(out.string()) +
+                                        " --row \"$SLURM_ARRAY_TASK_ID\" --quiet\n");
+  const std::string submit = "sbatch --parsable --job-name=slamrig-" + options.command +
+                             " --array=" + SlurmArrayIndices(rows) +
+                             " --output=" + ShellQuote((slurm_dir / "task_%a.log").string()) + " " +
+                             ShellQuote(script);
   const CommandResult submitted = Run(submit);
   const std::string job = submitted.output.substr(0, submitted.output.find_first_of(";\n"));
   if (submitted.exit_code != 0 || job.empty()) {
@@ -124,7 +124,7 @@ std::vector<std::string> RunRowsOnSlurm(const SweepRunnerOptions& options,
     if (options.progress) {
       std::size_t done = 0;
       for (const std::size_t row : rows)
-        done += fs::exists(SweepRowPath(out.string(), row)) ? 1 : 0;
+        done += fs::exists(QueueRowPath(out.string(), row)) ? 1 : 0;
       if (done != last_done) std::fprintf(stderr, "slurm: %zu/%zu rows\n", done, rows.size());
       last_done = done;
     }
@@ -132,7 +132,7 @@ std::vector<std::string> RunRowsOnSlurm(const SweepRunnerOptions& options,
   }
 
   std::vector<std::string> lines;
-  for (const std::size_t row : rows) lines.push_back(RowLine(SweepRowPath(out.string(), row)));
+  for (const std::size_t row : rows) lines.push_back(RowLine(QueueRowPath(out.string(), row)));
   return lines;
 }
 

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "scenarios/sweep_runner.h"
+#include "scenarios/run_queue.h"
 
 namespace slamrig::scenario {
 
@@ -17,7 +17,7 @@ namespace slamrig::scenario {
 /// std::runtime_error when sbatch fails. On SIGINT/SIGTERM (Ctrl-C) cancels the array
 /// (`scancel`), waits for its tasks to leave the queue and throws Interrupted; the rows that
 /// were not finished stay missing, so the next sweep submits them again.
-std::vector<std::string> RunRowsOnSlurm(const SweepRunnerOptions& options,
+std::vector<std::string> RunRowsOnSlurm(const RunQueueOptions& options,
                                         const std::vector<std::size_t>& rows);
 
 /// Where the task of grid row `row` logs: `out_dir`/slurm/task_<row>.log.

@@ -34,7 +34,7 @@ printf '{"passed": true, "configs": {"pf": {"ate_rmse_m": %s, "name": "pf"}}}\n'
 struct Fixture {
   testing::TempDir dir;
   SweepSpec spec;
-  SweepRunnerOptions options;
+  RunQueueOptions options;
   Fixture() {
     const std::string runner = dir.Write("fake_runner.sh", kFakeRunner);
     ::chmod(runner.c_str(), 0755);
@@ -73,7 +73,7 @@ TEST(SweepTest, ExpandsTheGridTimesSeedsInAFixedOrder) {
 
 TEST(SweepTest, RunsEveryRunOnceAndResumesAfterAKill) {
   Fixture complete;
-  const SweepSummary all = RunSweep(complete.spec, complete.options);
+  const RunQueueSummary all = RunSweep(complete.spec, complete.options);
   EXPECT_EQ(all.ran, 18);
   EXPECT_EQ(all.failed, 0);
   std::vector<std::string> expected = complete.Lines();
@@ -88,7 +88,7 @@ TEST(SweepTest, RunsEveryRunOnceAndResumesAfterAKill) {
     for (int i = 0; i < 8; ++i) out << expected[i] << "\n";
     out << expected[8].substr(0, 10);
   }
-  const SweepSummary second = RunSweep(resumed.spec, resumed.options);
+  const RunQueueSummary second = RunSweep(resumed.spec, resumed.options);
   EXPECT_EQ(second.already_done, 7);
   EXPECT_EQ(second.ran, 11);
   std::vector<std::string> got = resumed.Lines();
@@ -118,7 +118,7 @@ TEST(SweepTest, AResumedSweepCountsTheRunsThatFailedBefore) {
   std::string csv;
   for (const auto& l : lines) csv += l + "\n";
   f.dir.Write("out/results.csv", csv);
-  const SweepSummary again = RunSweep(f.spec, f.options);
+  const RunQueueSummary again = RunSweep(f.spec, f.options);
   EXPECT_EQ(again.already_done, 18);
   EXPECT_EQ(again.ran, 0);
   EXPECT_EQ(again.failed, 2);
