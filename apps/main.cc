@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <climits>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -18,6 +19,13 @@
 
 namespace slamrig::app {
 
+std::string SelfPath() {
+  char buffer[PATH_MAX];
+  const ssize_t n = ::readlink("/proc/self/exe", buffer, sizeof(buffer) - 1);
+  if (n <= 0) throw std::runtime_error("cannot find the slamrig binary (/proc/self/exe)");
+  return std::string(buffer, static_cast<std::size_t>(n));
+}
+
 const std::vector<Command>& Commands() {
   static const std::vector<Command> commands = {
       {"map", "build the occupancy map of a log from its logged poses", RunMapCommand},
@@ -28,6 +36,8 @@ const std::vector<Command>& Commands() {
        RunEvalCommand},
       {"run", "run a scenario: simulation, SLAM, evaluation, report and verdict", RunRunCommand},
       {"sweep", "run a scenario over a grid of parameters and seeds, all cores", RunSweepCommand},
+      {"benchmark", "every estimator of a suite on every dataset: leaderboard and failures",
+       RunBenchmarkCommand},
       {"world", "generate a procedural world (office, warehouse, corridor, campus, maze)",
        RunWorldCommand},
       {"optimize", "optimise a 2D pose graph (g2o file) with Ceres: chi2, iterations, time",

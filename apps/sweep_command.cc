@@ -1,8 +1,5 @@
 // `slamrig sweep SWEEP.yaml --out DIR`: a scenario over a parameter grid and seeds.
 
-#include <unistd.h>
-
-#include <climits>
 #include <cstdio>
 #include <filesystem>
 
@@ -12,18 +9,6 @@
 #include "slam/types/error.h"
 
 namespace slamrig::app {
-namespace {
-
-// This program's own path, so that every run uses the same build.
-std::string SelfPath() {
-  char buffer[PATH_MAX];
-  const ssize_t n = ::readlink("/proc/self/exe", buffer, sizeof(buffer) - 1);
-  if (n <= 0) throw std::runtime_error("cannot find the slamrig binary (/proc/self/exe)");
-  return std::string(buffer, static_cast<std::size_t>(n));
-}
-
-}  // namespace
-
 int RunSweepCommand(const std::vector<std::string>& args) {
   std::string sweep_path;
   scenario::RunQueueOptions options;

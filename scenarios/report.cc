@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "scenarios/html.h"
 #include "scenarios/plot.h"
 #include "scenarios/scenario_result.h"
 #include "slam/eval/json_writer.h"
@@ -33,21 +34,6 @@ std::string Number(double v, const char* format = "%.4g") {
   }
   std::snprintf(buffer, sizeof(buffer), format, v);
   return buffer;
-}
-
-std::string Html(const std::string& s) {
-  std::string out;
-  for (const char c : s) {
-    if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '&')
-      out += "&amp;";
-    else
-      out += c;
-  }
-  return out;
 }
 
 // Position and heading error of `estimate` against `truth`, pose for pose as evaluation pairs
@@ -374,7 +360,7 @@ std::string MapsHtml(const ScenarioResult& r, const Folder& file) {
   slam::MapImageOptions options;
   options.title = r.spec->name + ": map from " + truth_source + ", trajectories overlaid";
   slam::WriteMapPng(file("map.png"), *background, overlays, options);
-  std::string html = Figure("map.png", "The map from the " + Html(truth_source) +
+  std::string html = Figure("map.png", "The map from the " + EscapeHtml(truth_source) +
                                            " with the reference and estimated trajectories.");
   for (std::size_t i = 0; i < r.configs.size(); ++i) {
     const ConfigResult& c = r.configs[i];
@@ -393,7 +379,7 @@ std::string MapsHtml(const ScenarioResult& r, const Folder& file) {
     slam::WriteMapPng(file(c.name + "_map.png"), c.run.map, {truth_here, estimate_here}, own);
     const bool has_landmarks = !c.run.landmarks.landmarks.empty();
     html += Figure(c.name + "_map.png",
-                   Html(c.name) + "'s map with its trajectory" +
+                   EscapeHtml(c.name) + "'s map with its trajectory" +
                        (r.truth.empty() ? "" : " (and the reference, in green)") +
                        (has_landmarks ? "; its landmarks (crosses) with 3-sigma ellipses, the "
                                         "true pillars (green crosses) and the last pose's "
@@ -420,7 +406,7 @@ std::string TextureHtml(const ScenarioResult& r, const Folder& file) {
     if (!c.texture) continue;
     file.WritePng(c.name + "_texture.png", c.texture->colors);
     html += Figure(c.name + "_texture.png",
-                   Html(c.name) +
+                   EscapeHtml(c.name) +
                        "'s texture map from its final poses, in the frame ATE aligns them to "
                        "(PSNR " +
                        Number(c.texture->score.psnr_db.value_or(NAN)) + " dB).");
@@ -535,10 +521,11 @@ std::string SummaryHtml(const ScenarioResult& r) {
   std::ostringstream h;
   h << "<p>Seed " << r.spec->seed << ", ";
   if (r.times_synthesised) {
-    h << Html(r.spec->log->path) << " (times synthesised from line order; no real-time factor)";
+    h << EscapeHtml(r.spec->log->path)
+      << " (times synthesised from line order; no real-time factor)";
   } else {
     h << Number(r.sim_time_s, "%.1f")
-      << (r.spec->simulated ? " s simulated" : " s of " + Html(r.spec->log->path));
+      << (r.spec->simulated ? " s simulated" : " s of " + EscapeHtml(r.spec->log->path));
   }
   h << ", " << r.scans << " scans";
   if (r.scans_blacked_out) h << " (" << r.scans_blacked_out << " blacked out)";
@@ -560,15 +547,15 @@ std::string TablesHtml(const ScenarioResult& r) {
     h << "<h2>Expectations</h2><table><tr><th>expectation</th><th>value</th><th>bound</th>"
          "<th>result</th></tr>";
     for (const auto& o : r.outcomes) {
-      h << "<tr><td>" << Html(o.expectation.config + "." + o.expectation.metric) << "</td><td>"
-        << Number(o.value) << "</td><td>" << (o.expectation.is_max ? "&le; " : "&ge; ")
-        << Number(o.expectation.threshold) << "</td><td class=\""
-        << (o.passed ? "pass\">pass" : "fail\">FAIL") << "</td></tr>";
+      h << "<tr><td>" << EscapeHtml(o.expectation.config + "." + o.expectation.metric)
+        << "</td><td>" << Number(o.value) << "</td><td>"
+        << (o.expectation.is_max ? "&le; " : "&ge; ") << Number(o.expectation.threshold)
+        << "</td><td class=\"" << (o.passed ? "pass\">pass" : "fail\">FAIL") << "</td></tr>";
     }
     h << "</table>";
   }
   h << "<h2>Metrics</h2><table><tr><th>metric</th>";
-  for (const auto& c : r.configs) h << "<th>" << Html(c.name) << "</th>";
+  for (const auto& c : r.configs) h << "<th>" << EscapeHtml(c.name) << "</th>";
   h << "</tr>";
   for (const std::string& m : AllMetrics(r)) {
     h << "<tr><td>" << m << "</td>";
@@ -605,20 +592,20 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
                             TracePlotsHtml(r, file) + ErrorsByConfigHtml(r, file);
 
   std::ostringstream h;
-  h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>" << Html(r.spec->name)
+  h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>" << EscapeHtml(r.spec->name)
     << "</title><style>body{font-family:sans-serif;margin:2em;max-width:1100px}"
        "img{max-width:100%;border:1px solid #ddd}figure{margin:1em 0}"
        "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:4px "
        "10px;text-align:right}"
        "th:first-child,td:first-child{text-align:left}.pass{color:#080;font-weight:bold}"
        ".fail{color:#c00;font-weight:bold}</style></head><body>";
-  h << "<h1>" << Html(r.spec->name) << " <span class=\""
+  h << "<h1>" << EscapeHtml(r.spec->name) << " <span class=\""
     << (r.passed ? "pass\">PASS" : "fail\">FAIL") << "</span></h1>";
-  if (!r.spec->description.empty()) h << "<p>" << Html(r.spec->description) << "</p>";
+  if (!r.spec->description.empty()) h << "<p>" << EscapeHtml(r.spec->description) << "</p>";
   h << SummaryHtml(r) << TablesHtml(r);
   if (!r.notes.empty()) {
     h << "<h2>Notes</h2><ul>";
-    for (const std::string& note : r.notes) h << "<li>" << Html(note) << "</li>";
+    for (const std::string& note : r.notes) h << "<li>" << EscapeHtml(note) << "</li>";
     h << "</ul>";
   }
   if (!maps.empty()) h << "<h2>Maps</h2>" << maps;

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -160,6 +161,25 @@ void RunOnSlurm(const RunQueueSpec& spec, const RunQueueOptions& options,
   }
 }
 
+// results.csv with its rows in the study's order (they were appended as runs ended, an order
+// that depends on the machine), so that the same study gives the same file. Atomic: a study
+// killed here keeps the appended file.
+void SortResults(const RunQueueSpec& spec, const std::string& csv_path) {
+  std::ifstream in(csv_path, std::ios::binary);
+  std::string header;
+  std::getline(in, header);
+  std::map<std::string, std::string> by_id;
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty()) by_id.emplace(SplitCsv(line).front(), line);
+  }
+  std::string text = header + "\n";
+  for (const QueuedRun& run : spec.runs) {
+    const auto found = by_id.find(run.id);
+    if (found != by_id.end()) text += found->second + "\n";
+  }
+  slam::WriteFileAtomically(csv_path, text);
+}
+
 }  // namespace
 
 std::string FormatCsvNumber(double v) {
@@ -197,6 +217,7 @@ RunQueueSummary RunQueue(const RunQueueSpec& spec, const RunQueueOptions& option
 
   if (options.backend == RunBackend::kSlurm) {
     RunOnSlurm(spec, options, todo, fd, csv_path, &summary);
+    SortResults(spec, csv_path);
     if (spec.summarise) spec.summarise();
     return summary;
   }
@@ -239,6 +260,7 @@ RunQueueSummary RunQueue(const RunQueueSpec& spec, const RunQueueOptions& option
     progress.Report(finished_now, running.size(), summary.failed);
   }
   progress.End();
+  SortResults(spec, csv_path);
   if (spec.summarise) spec.summarise();
   return summary;
 }

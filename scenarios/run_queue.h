@@ -67,7 +67,8 @@ struct RunQueueSummary {
 /// study killed at any moment resumes with no run lost or run twice. A results.csv with another
 /// header is a ConfigError, never mixed. A run stopped from outside (SIGTERM, SIGKILL, Ctrl-C)
 /// leaves no row, so the next study runs it again; one that cannot write its folder stops the
-/// study. Calls `spec.summarise` at the end.
+/// study. At the end, results.csv's rows are put in the study's order (same study, same file)
+/// and `spec.summarise` is called.
 RunQueueSummary RunQueue(const RunQueueSpec& spec, const RunQueueOptions& options);
 
 /// Runs row `row` alone and writes its results.csv line, under the header, to

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <limits>
 
+#include "scenarios/html.h"
 #include "scenarios/plot.h"
 #include "slam/fusion/consistency.h"
 #include "slam/io/atomic_file.h"
@@ -34,24 +35,6 @@ double Number(const std::string& s) {
   } catch (const std::exception&) {
     return std::nan("");
   }
-}
-
-std::string Html(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    if (c == '<') {
-      out += "&lt;";
-    } else if (c == '>') {
-      out += "&gt;";
-    } else if (c == '&') {
-      out += "&amp;";
-    } else if (c == '"') {
-      out += "&quot;";
-    } else {
-      out += c;
-    }
-  }
-  return out;
 }
 
 std::string Format(double v) {
@@ -126,8 +109,8 @@ int LinePlots(const SweepSpec& spec, const SweepAggregate& a, const std::string&
       const std::string file = "summary_" + metric + "__" + param.key + ".png";
       slam::WriteFileAtomically((fs::path(out_dir) / file).string(),
                                 RenderLinePlotPng(plot, options));
-      *html += "<h3>" + Html(options.title) + "</h3><img alt=\"" + Html(options.title) +
-               "\" src=\"" + Html(file) + "\">";
+      *html += "<h3>" + EscapeHtml(options.title) + "</h3><img alt=\"" + EscapeHtml(options.title) +
+               "\" src=\"" + EscapeHtml(file) + "\">";
       ++plots;
     }
   }
@@ -148,14 +131,15 @@ std::string HeatMap(const SweepSpec& spec, const SweepAggregate& a, const std::s
     lo = std::min(lo, stats->second.mean);
     hi = std::max(hi, stats->second.mean);
   }
-  std::string h =
-      "<h3>" + Html(metric) + "</h3><p>Mean over seeds (small: min &ndash; max); rows " +
-      Html(rows.key) + ", columns " + Html(cols.key) + "; darker is higher.</p>" +
-      "<table class=\"heat\"><tr><th>" + Html(rows.key) + " \\ " + Html(cols.key) + "</th>";
-  for (const std::string& v : cols.values) h += "<th>" + Html(v) + "</th>";
+  std::string h = "<h3>" + EscapeHtml(metric) +
+                  "</h3><p>Mean over seeds (small: min &ndash; max); rows " + EscapeHtml(rows.key) +
+                  ", columns " + EscapeHtml(cols.key) + "; darker is higher.</p>" +
+                  "<table class=\"heat\"><tr><th>" + EscapeHtml(rows.key) + " \\ " +
+                  EscapeHtml(cols.key) + "</th>";
+  for (const std::string& v : cols.values) h += "<th>" + EscapeHtml(v) + "</th>";
   h += "</tr>";
   for (std::size_t r = 0; r < rows.values.size(); ++r) {
-    h += "<tr><th>" + Html(rows.values[r]) + "</th>";
+    h += "<tr><th>" + EscapeHtml(rows.values[r]) + "</th>";
     for (std::size_t c = 0; c < cols.values.size(); ++c) {
       const auto it = cells.find({r, c});
       if (it == cells.end()) {
@@ -182,7 +166,7 @@ std::string RunsTable(const SweepSpec& spec, const SweepAggregate& a) {
   h += "<th>failed expectations</th></tr>";
   for (const GridPoint& point : a.points) {
     std::string label = Label(spec, point, a.swept);
-    h += "<tr><td>" + Html(label.empty() ? "all runs" : label) + "</td>";
+    h += "<tr><td>" + EscapeHtml(label.empty() ? "all runs" : label) + "</td>";
     std::string failures;
     for (const SeedResult& s : point.seeds) {
       char dir[16];
@@ -201,7 +185,7 @@ std::string RunsTable(const SweepSpec& spec, const SweepAggregate& a) {
       for (const ExpectationResult& e : s.failed) {
         const bool is_max = e.name.size() > 4 && e.name.compare(e.name.size() - 4, 4, "_max") == 0;
         const std::string metric = e.name.substr(0, e.name.size() - 4);
-        failures += "<li>seed " + std::to_string(s.seed) + ": " + Html(metric) + " = " +
+        failures += "<li>seed " + std::to_string(s.seed) + ": " + EscapeHtml(metric) + " = " +
                     Format(e.value) + ", bound " + (is_max ? "&le; " : "&ge; ") +
                     Format(e.threshold) + "</li>";
       }
@@ -502,12 +486,12 @@ int WriteSweepSummary(const SweepSpec& spec, const std::string& out_dir) {
       "td.fail,td.error{background:#fbe0e0;font-weight:bold}td.none{color:#888}"
       "table.heat td{text-align:center}ul{margin:0;padding-left:1.2em}</style></head><body>"
       "<h1>Sweep summary</h1><p>Scenario: " +
-      Html(spec.scenario_path) + ".</p><p class=\"counts\">" +
+      EscapeHtml(spec.scenario_path) + ".</p><p class=\"counts\">" +
       std::to_string(a.passed + a.failed + a.errors + a.missing) +
       " runs: " + std::to_string(a.passed) + " passed, " + std::to_string(a.failed) + " failed, " +
       std::to_string(a.errors) + " ended in an error, " + std::to_string(a.missing) +
-      " not run yet.</p><p>Swept: " + Html(swept.empty() ? "nothing (seeds only)" : swept) +
-      (held.empty() ? "" : "; held: " + Html(held)) + ".</p>";
+      " not run yet.</p><p>Swept: " + EscapeHtml(swept.empty() ? "nothing (seeds only)" : swept) +
+      (held.empty() ? "" : "; held: " + EscapeHtml(held)) + ".</p>";
   html += "<h2>Runs</h2>" + RunsTable(spec, a);
   int plots = 0;
   if (a.swept.size() == 2) {

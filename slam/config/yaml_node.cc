@@ -246,6 +246,14 @@ void YamlNode::Override(const std::string& key_path, const std::string& value,
   }
 }
 
+std::string YamlNode::ToFlowYaml() const {
+  YAML::Emitter out;
+  out.SetMapFormat(YAML::Flow);
+  out.SetSeqFormat(YAML::Flow);
+  out << node_;
+  return out.c_str();
+}
+
 void YamlNode::CheckAllKeysUsed() const { CheckUsedRecursive(node_, path_); }
 
 void YamlNode::CheckUsedRecursive(const YAML::Node& node, const std::string& path) const {

@@ -71,6 +71,10 @@ class YamlNode {
   /// read from, or to the base_dir of the Override that set it (or a node above it).
   std::string ResolvePath(const std::string& text) const;
 
+  /// This node as it was written, as one line of flow YAML (`{algorithm: pf, particles: 100}`):
+  /// a part of one file passed on into another.
+  std::string ToFlowYaml() const;
+
   /// Throws a ConfigError for the first map key, anywhere below this node, that was never read.
   void CheckAllKeysUsed() const;
 
