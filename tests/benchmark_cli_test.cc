@@ -5,9 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include "scenarios/benchmark_spec.h"
 #include "scenarios/sweep_summary.h"
 #include "tests/util/dataset.h"
 #include "tests/util/run_command.h"
@@ -102,6 +104,20 @@ TEST(BenchmarkCliTest, ARunPastTheTimeoutIsKilledAndFailed) {
   EXPECT_EQ(rows[1][4], "timeout");
   EXPECT_EQ(rows[1][5], "still running after 0.5 s");
   EXPECT_NE(Read(dir.File("out/summary.html")).find("timeout"), std::string::npos);
+}
+
+// Every shipped suite loads: its logs are there, its worlds generate, its estimators resolve.
+TEST(BenchmarkCliTest, EveryShippedSuiteLoads) {
+  int suites = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::string(SLAMRIG_SOURCE_DIR) + "/suites")) {
+    if (entry.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(entry.path().string());
+    const scenario::BenchmarkSuite suite = scenario::LoadBenchmarkSuite(entry.path().string());
+    EXPECT_FALSE(scenario::ExpandBenchmark(suite).empty());
+    ++suites;
+  }
+  EXPECT_GE(suites, 4);
 }
 
 }  // namespace
