@@ -91,20 +91,26 @@ wait_ready() { # pid
 }
 
 # Reference outputs, uninterrupted; `slam` reads the simulated log. The time each takes from
-# wait_ready to its end is what the signal delays are drawn from.
-mkdir -p "$work/ref"
+# wait_ready to its end is what the signal delays are drawn from: the fastest of three runs, so
+# that a reference slowed by a burst of load elsewhere does not push the delays past the end.
+mkdir -p "$work/ref" "$work/timing"
 declare -A work_ms
 for name in simulate simulate_mcap slam run sweep; do
-  out=$work/ref/$name
-  $(command_of "$name" "$out") >"$out.stdout" 2>"$out.stderr" &
-  pid=$!
-  wait_ready "$pid"
-  start=$(date +%s%N)
-  code=0
-  wait "$pid" || code=$?
-  work_ms[$name]=$((($(date +%s%N) - start) / 1000000))
-  ((code == 0 || code == 3)) || fail "$name exited $code: $(cat "$out.stderr")"
+  for attempt in 1 2 3; do
+    out=$work/ref/$name
+    if ((attempt > 1)); then out=$work/timing/$name.$attempt; fi
+    $(command_of "$name" "$out") >"$out.stdout" 2>"$out.stderr" &
+    pid=$!
+    wait_ready "$pid"
+    start=$(date +%s%N)
+    code=0
+    wait "$pid" || code=$?
+    ms=$((($(date +%s%N) - start) / 1000000))
+    ((code == 0 || code == 3)) || fail "$name exited $code: $(cat "$out.stderr")"
+    if [[ -z ${work_ms[$name]:-} ]] || ((ms < work_ms[$name])); then work_ms[$name]=$ms; fi
+  done
 done
+rm -rf "$work/timing"
 rows() { tail -n +2 "$1" | sed 's/,[^,]*$//' | sort; } # results.csv rows, wall time aside
 rows "$work/ref/sweep/results.csv" >"$work/ref/sweep.rows"
 [[ $(wc -l <"$work/ref/sweep.rows") == 4 ]] || fail "the reference sweep has not 4 rows"
@@ -179,12 +185,16 @@ check_resume() { # dir what
 }
 
 # 1. Signals at random points: delays in [5 %, 60 %] of the command's uninterrupted work time
-# (the reference's time varies with the machine's load, so not up to its end).
+# (the reference's time varies with the machine's load, so not up to its end). A command done
+# before all four of its signals gets up to four more, each at a quarter of the delays.
 interrupted=0 finished=0
 for name in simulate simulate_mcap slam run sweep; do
-  stopped=0
-  for signal in TERM INT TERM INT; do
+  stopped=0 sent=0
+  for signal in TERM INT TERM INT TERM INT TERM INT; do
+    sent=$((sent + 1))
+    if ((sent > 4 && stopped > 0)); then break; fi
     delay_ms=$((work_ms[$name] * (5 + RANDOM % 56) / 100))
+    if ((sent > 4)); then delay_ms=$((delay_ms / 4)); fi
     out=$work/signal/$name.$signal.$delay_ms
     mkdir -p "$(dirname "$out")"
     what="$name, SIG$signal after $delay_ms ms"
@@ -215,7 +225,7 @@ for name in simulate simulate_mcap slam run sweep; do
     stopped=$((stopped + 1))
   done
   # A command done before its signal proves nothing: each must have been stopped.
-  ((stopped >= 1)) || fail "$name: all 4 signals came after it was done"
+  ((stopped >= 1)) || fail "$name: all $sent signals came after it was done"
 done
 ((interrupted >= 10)) || fail "only $interrupted of 20 signals came before the command was done"
 

@@ -1,14 +1,9 @@
 #!/usr/bin/env bash
-# The whole test suite, as CI runs it: dependencies, the clang-format check, a Release build with
-# warnings as errors and every ctest label (unit, integration, scenario, python), the unit tests
-# under AddressSanitizer and UndefinedBehaviorSanitizer (gcc, building only the unit tests), and
-# every reader of outside data over its fuzz corpus (clang, libFuzzer, building only the fuzz
-# targets and the binary that makes their seeds). Build folders build-ci/, build-asan/ and
-# build-fuzz/ (all ignored by git); ccache is used when it is installed.
-#
-# The unit tests run under gcc, not in the clang build: several of them hold gcc's arithmetic to
-# tight tolerances (ICP and map-correlation offsets at 0.01 m and 0.003 rad), and clang's code
-# lands just outside them (0.0135 m, 0.0032 rad).
+# The whole test suite, as CI runs it, in two builds: dependencies; the clang-format check; a gcc
+# Release build with warnings as errors and every ctest label (unit, integration, scenario,
+# python); then one clang build with AddressSanitizer, UndefinedBehaviorSanitizer and libFuzzer
+# instrumentation, for the unit tests and every reader of outside data over its fuzz corpus.
+# Build folders build-ci/ and build-san/ (ignored by git); ccache is used when it is installed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -39,23 +34,23 @@ cmake --build build-ci -j"$jobs"
 echo "== all tests (Release)"
 if ! ctest --test-dir build-ci --output-on-failure -j"$jobs"; then failed+=(ctest-release); fi
 
-echo "== ASan/UBSan build of the unit tests"
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSLAMRIG_SANITIZE=ON \
-  -DSLAMRIG_BUILD_BENCHMARKS=OFF -DCMAKE_COMPILE_WARNING_AS_ERROR=ON "${launcher[@]}" >/dev/null
-cmake --build build-asan -j"$jobs" --target slamrig_unit_tests
+echo "== ASan/UBSan build (clang, libFuzzer instrumentation): the unit tests and the fuzz targets"
+# One build serves both: every target gets ASan, UBSan and libFuzzer's coverage instrumentation;
+# the unit tests are ordinary gtest binaries in it, the fuzz targets link libFuzzer.
+CC=clang CXX=clang++ cmake -S . -B build-san -DSLAMRIG_FUZZ=ON -DSLAMRIG_SANITIZE=ON \
+  -DSLAMRIG_BUILD_BENCHMARKS=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_COMPILE_WARNING_AS_ERROR=ON "${launcher[@]}" >/dev/null
+cmake --build build-san -j"$jobs" --target slamrig_unit_tests
 
 echo "== unit tests under ASan/UBSan"
 if ! ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build-asan -L unit --output-on-failure -j"$jobs"; then
+  ctest --test-dir build-san -L unit --output-on-failure -j"$jobs"; then
   failed+=(ctest-asan)
 fi
 
 echo "== fuzz corpora"
 # Every reader over its seed corpus and regression inputs once, under libFuzzer with ASan/UBSan.
-CC=clang CXX=clang++ cmake -S . -B build-fuzz -DSLAMRIG_FUZZ=ON -DSLAMRIG_SANITIZE=ON \
-  -DSLAMRIG_BUILD_BENCHMARKS=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_COMPILE_WARNING_AS_ERROR=ON "${launcher[@]}" >/dev/null
-if ! SLAMRIG_FUZZ_BUILD_DIR=build-fuzz SLAMRIG_FUZZ_JOBS="$jobs" \
+if ! SLAMRIG_FUZZ_BUILD_DIR=build-san SLAMRIG_FUZZ_JOBS="$jobs" \
   bash fuzz/run_fuzzers.sh --corpus-only; then
   failed+=(fuzz)
 fi
