@@ -89,6 +89,16 @@ void WriteRunFacts(const ConfigResult& c, slam::JsonWriter* j) {
       .Integer("gyro_fallbacks", c.run.gyro_fallbacks)
       .Integer("scans_without_odometry", c.run.scans_without_odometry)
       .Integer("out_of_order_stamps", c.run.final.out_of_order());
+  if (const auto& m = c.run.scan_matched_odometry) {
+    // Without odometry: how the scan-matched motion prior placed the scans.
+    j->BeginObject("scan_matched_odometry")
+        .Integer("scans", m->scans)
+        .Integer("matched", m->matched)
+        .Integer("degenerate", m->degenerate)
+        .Integer("failed", m->failed)
+        .Integer("no_points", m->no_points)
+        .EndObject();
+  }
   j->BeginObject("map")
       .Number("resolution_m", c.run.map.resolution())
       .Integer("width", c.run.map.width())

@@ -417,6 +417,14 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
   ScenarioResult result;
   result.spec = &spec;
   result.notes = data.notes;
+  const bool said = std::any_of(result.notes.begin(), result.notes.end(), [](const std::string& n) {
+    return n.rfind("no raw odometry", 0) == 0;
+  });
+  if (!said && slam::ResolveOdometrySource(data.records, slam::OdometrySource::kAuto) ==
+                   slam::OdometrySource::kNone) {
+    result.notes.push_back(
+        "no odometry in the log: running without it (a scan-matched motion prior)");
+  }
   result.truncated = data.truncated;
   result.log_format = data.format;
   result.times_synthesised = data.times_synthesised;

@@ -40,12 +40,17 @@ Dataset CarmenToDataset(const CarmenLog& log) {
     Pose2 previous_corrected;  // P_{k-1}
     Pose2 previous_odometry;   // recovered odometry at scan k-1
     int dropped = 0;
+    int odometry_after_start = 0;
+    int intervals = 0, intervals_without_odometry = 0;
+    bool odometry_since_scan = false;
     for (const Entry& e : entries) {
       if (e.odometry != nullptr) {
         if (!started) {
           ++dropped;
           continue;
         }
+        ++odometry_after_start;
+        odometry_since_scan = true;
         const Pose2 recovered =
             previous_odometry * previous_corrected.Between(e.odometry->odometry.odom_from_base);
         data.records.push_back(OdometryPose{e.odometry->odometry.time, recovered});
@@ -57,6 +62,8 @@ Dataset CarmenToDataset(const CarmenLog& log) {
         previous_odometry = s.logged_pose;
         data.records.push_back(OdometryPose{s.scan.time, previous_odometry});
       } else {
+        ++intervals;
+        if (!odometry_since_scan) ++intervals_without_odometry;
         // The odometry at this scan is the last ODOM before it (or no motion if there was none).
         const auto last =
             std::find_if(data.records.rbegin(), data.records.rend(),
@@ -64,11 +71,24 @@ Dataset CarmenToDataset(const CarmenLog& log) {
         previous_odometry = std::get<OdometryPose>(*last).odom_from_base;
       }
       previous_corrected = s.logged_pose;
+      odometry_since_scan = false;
       data.records.push_back(s.scan);
       data.reference.push_back({s.scan.time, s.logged_pose});
     }
     if (dropped > 0) {
       data.notes.push_back(std::to_string(dropped) + " ODOM lines before the first scan dropped");
+    }
+    if (odometry_after_start == 0 && intervals > 0) {
+      // Nothing but echoes: the first scan's pose held still is no odometry at all.
+      std::erase_if(data.records,
+                    [](const Record& r) { return std::holds_alternative<OdometryPose>(r); });
+      data.notes.push_back(
+          "no raw odometry: every ODOM line repeats its scan's pose; running without odometry "
+          "(a scan-matched motion prior)");
+    } else if (intervals_without_odometry > 0) {
+      data.notes.push_back(GroupedCount(static_cast<std::uint64_t>(intervals_without_odometry)) +
+                           " of " + GroupedCount(static_cast<std::uint64_t>(intervals)) +
+                           " scan intervals have no raw ODOM line: the odometry holds still there");
     }
     return data;
   }

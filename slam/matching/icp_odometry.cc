@@ -88,6 +88,24 @@ std::pair<int, std::vector<KeyframeShareOf>> IcpOdometry::AddKeyframe(
 }
 
 IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_increment) {
+  return Add(scan, std::vector<Pose2>{odometry_increment});
+}
+
+std::optional<MatchResult> IcpOdometry::GatedMatch(const std::vector<Eigen::Vector2d>& points,
+                                                   const Pose2& prior) const {
+  std::optional<MatchResult> match = matcher_->Match(points, prior);
+  if (match &&
+      (match->score < options_.min_score ||
+       (match->pose.translation() - prior.translation()).norm() > options_.max_correction_m ||
+       std::abs(NormalizeAngle(match->pose.theta() - prior.theta())) >
+           options_.max_correction_rad)) {
+    match.reset();
+  }
+  return match;
+}
+
+IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>& increments) {
+  SLAMRIG_CHECK(!increments.empty(), "IcpOdometry::Add: no increment");
   const std::vector<Eigen::Vector2d> points = ScanToBasePoints(scan, options_.points);
   ++counts_.scans;
   IcpOdometryStep step;
@@ -102,6 +120,20 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_in
     return step;
   }
 
+  // The match from each increment; the best-scoring one that passes the gates is kept, and its
+  // increment is the prior (the first increment's when none passes).
+  std::size_t chosen = 0;
+  std::optional<MatchResult> match;
+  if (!points.empty() && matcher_) {
+    for (std::size_t i = 0; i < increments.size(); ++i) {
+      std::optional<MatchResult> m = GatedMatch(points, pose_ * increments[i]);
+      if (m && (!match || m->score > match->score)) {
+        match = std::move(m);
+        chosen = i;
+      }
+    }
+  }
+  const Pose2& odometry_increment = increments[chosen];
   const Pose2 prior = pose_ * odometry_increment;
   // The increment's noise, rotated from the previous base frame into the odom frame.
   const Eigen::Matrix2d r = Eigen::Rotation2Dd(pose_.theta()).toRotationMatrix();
@@ -111,22 +143,8 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_in
   step.pose = prior;
   step.covariance = prior_covariance;
 
-  std::optional<MatchResult> match;
-  if (points.empty()) {
-    step.outcome = IcpOdometryOutcome::kNoPoints;
-  } else if (matcher_) {
-    match = matcher_->Match(points, prior);
-    if (match &&
-        (match->score < options_.min_score ||
-         (match->pose.translation() - prior.translation()).norm() > options_.max_correction_m ||
-         std::abs(NormalizeAngle(match->pose.theta() - prior.theta())) >
-             options_.max_correction_rad)) {
-      match.reset();
-    }
-    step.outcome = IcpOdometryOutcome::kMatchFailed;
-  } else {
-    step.outcome = IcpOdometryOutcome::kMatchFailed;  // no local map yet
-  }
+  // Failed unless the match below says otherwise (also with no local map yet).
+  step.outcome = points.empty() ? IcpOdometryOutcome::kNoPoints : IcpOdometryOutcome::kMatchFailed;
 
   if (match) {
     // Keep the prior along poorly constrained directions of the match.

@@ -98,6 +98,10 @@ class IcpOdometry {
   /// Places `scan`, taken after the robot moved by `odometry_increment` (base frame at the previous
   /// scan to base frame at this one, from the wheel odometry; ignored for the first scan).
   IcpOdometryStep Add(const LaserScan& scan, const Pose2& odometry_increment);
+  /// Places `scan` from several candidate increments (a motion prediction and its alternatives):
+  /// the match from each, the best-scoring one that passes the gates kept, its increment then the
+  /// prior (the first's when none passes). One increment: exactly Add(scan, increment).
+  IcpOdometryStep Add(const LaserScan& scan, const std::vector<Pose2>& increments);
 
   const Pose2& pose() const { return pose_; }
   const IcpOdometryCounts& counts() const { return counts_; }
@@ -114,6 +118,9 @@ class IcpOdometry {
   std::pair<int, std::vector<KeyframeShareOf>> AddKeyframe(
       const std::vector<Eigen::Vector2d>& points_base);
   Eigen::Matrix3d IncrementCovariance(const Pose2& increment) const;
+  /// The local map's match from `prior`, or nothing when it fails the score or correction gates.
+  std::optional<MatchResult> GatedMatch(const std::vector<Eigen::Vector2d>& points,
+                                        const Pose2& prior) const;
 
   IcpOdometryOptions options_;
   Pose2 pose_;

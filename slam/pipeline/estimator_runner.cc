@@ -41,6 +41,7 @@ EstimatorRunner::EstimatorRunner(const EstimatorConfig& config, OdometrySource s
   run_.name = config.name;
   run_.algorithm = config.algorithm;
   run_.odometry_source = source;
+  if (source == OdometrySource::kNone) scan_odometry_.emplace();
 }
 
 void EstimatorRunner::Add(const Record& record) {
@@ -67,8 +68,9 @@ void EstimatorRunner::Finish() {
   run_.wall_s += SecondsSince(start);
 }
 
-void EstimatorRunner::Process(const SyncedScan& scan) {
+void EstimatorRunner::Process(const SyncedScan& synced) {
   ThrowIfInterrupted();  // a scan is the unit of work; SIGINT/SIGTERM stop between two
+  const SyncedScan scan = scan_odometry_ ? scan_odometry_->Apply(synced) : synced;
   const ScanEstimate estimate = estimator_->AddScan(scan);
   const Time time = scan.scan.time;
   pose_ = estimate.pose;
@@ -102,6 +104,7 @@ EstimatorRun EstimatorRunner::TakeResult() {
   run_.map = estimator_->map();
   run_.gyro_fallbacks = sync_.gyro_fallbacks();
   run_.scans_without_odometry = sync_.scans_without_odometry();
+  if (scan_odometry_) run_.scan_matched_odometry = scan_odometry_->counts();
   return std::move(run_);
 }
 

@@ -4,6 +4,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "slam/odometry/scan_sync.h"
 #include "slam/pipeline/estimator.h"
 #include "slam/pipeline/estimator_config.h"
+#include "slam/pipeline/scan_matched_odometry.h"
 #include "slam/types/trajectory.h"
 
 namespace slamrig::slam {
@@ -38,6 +40,8 @@ struct EstimatorRun {
   OdometrySource odometry_source = OdometrySource::kNone;  ///< the odometry used
   int gyro_fallbacks = 0;          ///< intervals without IMU samples (ScanSynchronizer)
   int scans_without_odometry = 0;  ///< scans before any odometry
+  /// Without odometry (source none): how the scan-matched motion prior placed the scans.
+  std::optional<IcpOdometryCounts> scan_matched_odometry;
   double wall_s = 0.0;  ///< wall time spent in sync and estimator (the only wall-clock figure)
 };
 
@@ -74,6 +78,8 @@ class EstimatorRunner {
 
   EstimatorConfig config_;
   ScanSynchronizer sync_;
+  /// The motion prior of a source without odometry (ScanMatchedOdometry), else empty.
+  std::optional<ScanMatchedOdometry> scan_odometry_;
   std::unique_ptr<Estimator> estimator_;
   std::function<void(std::size_t, const SyncedScan&, const ScanEstimate&)> on_scan_;
   EstimatorRun run_;

@@ -1,0 +1,38 @@
+#pragma once
+
+#include <optional>
+
+#include "slam/matching/icp_odometry.h"
+#include "slam/odometry/scan_sync.h"
+#include "slam/types/pose2.h"
+
+namespace slamrig::slam {
+
+/// The motion between scans of a log without odometry (`odometry: {source: none}`, or a log
+/// whose odometry is missing): each scan is matched against a local map of the last keyframes
+/// (IcpOdometry), from a constant-velocity prediction (the last matched increment, scaled to
+/// this interval's length) and its alternatives (standing still, turned or moved by a few
+/// decimetres), the best match kept, with gates wide enough for a robot that speeds up or turns
+/// between two scans. Where every match fails the prediction stands; where the match is
+/// degenerate, along the degenerate direction only. Every estimator then takes the result as its
+/// odometry, with its own motion noise around it. Deterministic.
+class ScanMatchedOdometry {
+ public:
+  ScanMatchedOdometry();
+
+  /// `scan` with odom_from_base, increment, distance_m and yaw_change_rad from the match (a
+  /// scan from a source without odometry: identity increments).
+  SyncedScan Apply(const SyncedScan& scan);
+
+  const IcpOdometryCounts& counts() const { return odometry_.counts(); }
+
+ private:
+  IcpOdometry odometry_;
+  Pose2 pose_;
+  Pose2 last_increment_;
+  double last_dt_s_ = 0.0;
+  bool last_matched_ = false;
+  bool started_ = false;
+};
+
+}  // namespace slamrig::slam
