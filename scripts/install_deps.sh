@@ -7,6 +7,7 @@ packages=(
   build-essential cmake pkg-config clang-format ccache
   libbox2d-dev libeigen3-dev libopencv-dev libmujoco-dev libyaml-cpp-dev libceres-dev
   libgtest-dev libgmock-dev libbenchmark-dev libsqlite3-dev zlib1g-dev libnanoflann-dev
+  libspectra-dev
   libzstd-dev liblz4-dev
   clang libclang-rt-14-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri
