@@ -324,6 +324,38 @@ OptimalityCertificate CertifyOptimality(const PoseGraph& graph,
   return c;
 }
 
+PoseGraph WithRobustWeights(const PoseGraph& graph, const PoseGraphOptimizerOptions& options,
+                            const std::vector<double>& switches) {
+  PoseGraph out;
+  for (const PoseGraphVertex& v : graph.vertices()) out.AddVertex(v.id, v.pose, v.fixed);
+  const double a2 = options.robust_loss_scale * options.robust_loss_scale;
+  for (std::size_t k = 0; k < graph.edges().size(); ++k) {
+    PoseGraphEdge e = graph.edges()[k];
+    const bool robust = options.robust_loss_on_all_edges || e.kind == EdgeKind::kLoopClosure;
+    double weight = 1.0;
+    if (robust && options.robust_loss != RobustLoss::kNone) {
+      const Eigen::Vector3d error = EdgeError(graph, e);
+      const double s = error.dot(e.information * error);
+      switch (options.robust_loss) {
+        case RobustLoss::kHuber:
+          weight = s <= a2 ? 1.0 : std::sqrt(a2 / s);
+          break;
+        case RobustLoss::kCauchy:
+          weight = 1.0 / (1.0 + s / a2);
+          break;
+        case RobustLoss::kSwitchable:
+          weight = k < switches.size() ? switches[k] * switches[k] : 1.0;
+          break;
+        case RobustLoss::kNone:
+          break;
+      }
+    }
+    e.information *= std::max(weight, 1e-9);
+    out.AddEdge(e);
+  }
+  return out;
+}
+
 std::string CertificateLine(const OptimalityCertificate& c) {
   std::string line = std::string(c.certified ? "certified optimal" : "not certified") +
                      " (lambda_min = " + Number("%.3g", c.lambda_min) + ", tolerance " +

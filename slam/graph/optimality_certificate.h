@@ -26,6 +26,7 @@
 
 #include <Eigen/SparseCore>
 #include <string>
+#include <vector>
 
 #include "slam/graph/pose_graph.h"
 #include "slam/graph/pose_graph_optimizer_options.h"
@@ -115,6 +116,15 @@ struct OptimalityCertificate {
 /// least one edge.
 OptimalityCertificate CertifyOptimality(const PoseGraph& graph,
                                         const OptimalityCertificateOptions& options = {});
+
+/// The graph with each robust edge's information scaled by its robust loss's weight at the
+/// graph's poses: rho'(s) at s = e^T Omega e for Huber and Cauchy (Ceres's losses), the switch
+/// squared for switchable constraints (`switches` as PoseGraphSummary::switches gives them),
+/// at least 1e-9 so that no edge vanishes. A robust solution is a stationary point of this
+/// weighted least-squares problem (iteratively reweighted least squares at its fixed point),
+/// which is the problem CertifyOptimality() can then check; without a robust loss, the graph.
+PoseGraph WithRobustWeights(const PoseGraph& graph, const PoseGraphOptimizerOptions& options,
+                            const std::vector<double>& switches);
 
 /// "certified optimal (lambda_min = ...)" or "not certified (lambda_min = ...)", with the
 /// tolerance.
