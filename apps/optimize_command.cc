@@ -136,9 +136,13 @@ int RunOptimizeCommand(const std::vector<std::string>& args) {
   if (!out_path.empty()) line += " -> " + out_path;
   std::puts(line.c_str());
   if (!no_certificate && !graph.edges().empty()) {
+    // With a robust loss: the weighted least-squares problem the robust solution is stationary
+    // for, the weights carrying the loss.
     slam::OptimalityCertificateOptions certificate_options;
     certificate_options.optimizer = options;
-    const slam::OptimalityCertificate c = slam::CertifyOptimality(graph, certificate_options);
+    certificate_options.optimizer.robust_loss = slam::RobustLoss::kNone;
+    const slam::OptimalityCertificate c = slam::CertifyOptimality(
+        slam::WithRobustWeights(graph, options, s.switches), certificate_options);
     const std::string cert =
         slam::CertificateLine(c) + "; check " + Number("%.3f", c.time_s) + " s";
     std::puts(cert.c_str());
