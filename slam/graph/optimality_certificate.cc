@@ -315,6 +315,7 @@ OptimalityCertificate CertifyOptimality(const PoseGraph& graph,
   // Whether the given solution is the chi2 minimum in the basin of f's certified minimiser.
   c.chi2 = Chi2(graph);
   c.chi2_from_certified = c.chi2;
+  c.chi2_at_refined = Chi2(refined);
   if (c.relaxation_tight) {
     c.chi2_from_certified = PoseGraphOptimizer(options.optimizer).Optimize(&refined).final_chi2;
   }

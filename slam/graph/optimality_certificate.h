@@ -89,6 +89,9 @@ struct OptimalityCertificate {
   /// (equal to chi2 when the relaxation is not tight: nothing to start from).
   double chi2 = 0.0;
   double chi2_from_certified = 0.0;
+  /// g2o's chi2 at the refined poses (f's minimiser, SE-Sync's solution): above the chi2
+  /// minimum, since the two costs weigh the edges differently.
+  double chi2_at_refined = 0.0;
   /// Smallest eigenvalue of S at the refined poses (NaN if it could not be computed).
   double lambda_min = 0.0;
   /// The threshold used: certified iff lambda_min >= -tolerance.
