@@ -39,19 +39,35 @@ double GershgorinBound(const SparseMatrix& s) {
 //   df/dt_j = 2 tau d, df/dt_i = -2 tau d, df/dtheta_j = 4 kappa sin e,
 //   df/dtheta_i = -2 tau d.u - 4 kappa sin e,
 //   d2f/dtheta_i2 = 2 tau (|u|^2 + d.w) + 4 kappa cos e, d2f/dt_i dtheta_i = 2 tau u, ...
-double IsotropicCostAndDerivatives(const PoseGraph& graph, const std::vector<Eigen::Index>& unknown,
+struct IsotropicEdge {
+  std::size_t a = 0, b = 0;  // vertex indices of from and to
+  Eigen::Vector2d z;         // measured translation
+  double theta = 0.0;        // measured rotation
+  IsotropicWeights w;
+};
+
+std::vector<IsotropicEdge> IsotropicEdges(const PoseGraph& graph) {
+  std::vector<IsotropicEdge> edges;
+  edges.reserve(graph.edges().size());
+  for (const PoseGraphEdge& e : graph.edges()) {
+    edges.push_back({graph.IndexOf(e.from), graph.IndexOf(e.to), e.measurement.translation(),
+                     e.measurement.theta(), SeSyncWeights(e.information)});
+  }
+  return edges;
+}
+
+double IsotropicCostAndDerivatives(const std::vector<IsotropicEdge>& edges,
+                                   const std::vector<Eigen::Index>& unknown,
                                    const std::vector<Eigen::Vector3d>& x, Eigen::VectorXd* g,
                                    std::vector<Eigen::Triplet<double>>* h) {
   double f = 0.0;
-  for (const PoseGraphEdge& e : graph.edges()) {
-    const IsotropicWeights wt = SeSyncWeights(e.information);
-    const std::size_t a = graph.IndexOf(e.from), b = graph.IndexOf(e.to);
-    const Eigen::Matrix2d ri = Rotation(x[a].z());
-    const Eigen::Vector2d z = e.measurement.translation();
-    const Eigen::Vector2d w = ri * z;
+  for (const IsotropicEdge& e : edges) {
+    const std::size_t a = e.a, b = e.b;
+    const IsotropicWeights& wt = e.w;
+    const Eigen::Vector2d w = Rotation(x[a].z()) * e.z;
     const Eigen::Vector2d u(-w.y(), w.x());
     const Eigen::Vector2d d = x[b].head<2>() - x[a].head<2>() - w;
-    const double angle = x[b].z() - x[a].z() - e.measurement.theta();
+    const double angle = x[b].z() - x[a].z() - e.theta;
     const double k4 = 4.0 * wt.kappa, t2 = 2.0 * wt.tau;
     f += k4 * (1.0 - std::cos(angle)) + wt.tau * d.squaredNorm();
     if (h == nullptr) continue;
@@ -112,15 +128,18 @@ RefineResult RefineIsotropic(PoseGraph* graph, int max_iterations) {
     const Pose2& p = graph->vertices()[i].pose;
     x[i] = {p.x(), p.y(), p.theta()};
   }
+  const std::vector<IsotropicEdge> edges = IsotropicEdges(*graph);
   Eigen::SimplicialLLT<SparseMatrix> llt;
   SparseMatrix hessian(3 * num_unknowns, 3 * num_unknowns), identity = hessian;
   identity.setIdentity();
+  std::vector<Eigen::Triplet<double>> triplets;
   int iteration = 0;
   bool converged = num_unknowns == 0;
   for (; iteration < max_iterations && !converged; ++iteration) {
     Eigen::VectorXd g = Eigen::VectorXd::Zero(3 * num_unknowns);
-    std::vector<Eigen::Triplet<double>> triplets;
-    const double f = IsotropicCostAndDerivatives(*graph, unknown, x, &g, &triplets);
+    triplets.clear();
+    triplets.reserve(36 * edges.size());
+    const double f = IsotropicCostAndDerivatives(edges, unknown, x, &g, &triplets);
     hessian.setFromTriplets(triplets.begin(), triplets.end());
     if (iteration == 0) llt.analyzePattern(hessian);
     // Beyond the Gershgorin bound the damped Hessian is positive definite and the step a
@@ -136,12 +155,13 @@ RefineResult RefineIsotropic(PoseGraph* graph, int max_iterations) {
       for (std::size_t i = 0; i < n; ++i) {
         if (unknown[i] >= 0) trial[i] += step.segment<3>(3 * unknown[i]);
       }
-      // Accepted when f does not rise beyond its rounding noise; the last step, whose
-      // predicted decrease is below that noise, ends the iteration.
+      // Accepted when f does not rise beyond its rounding noise. An undamped step whose
+      // predicted decrease is below 1e-12 f ends the iteration: Newton's convergence is
+      // quadratic there, so the next step's would be at rounding level.
       const double noise = 1e-13 * std::abs(f);
-      if (IsotropicCostAndDerivatives(*graph, unknown, trial, nullptr, nullptr) <= f + noise) {
+      if (IsotropicCostAndDerivatives(edges, unknown, trial, nullptr, nullptr) <= f + noise) {
         x = std::move(trial);
-        converged = -0.5 * g.dot(step) <= noise;
+        converged = -0.5 * g.dot(step) <= (damping == 0.0 ? 1e-12 * std::abs(f) : noise);
         improved = true;
         break;
       }
