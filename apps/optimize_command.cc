@@ -2,6 +2,7 @@
 // optimisation of a g2o file with Ceres, from the odometry chain, a chordal initialisation or
 // the file's own vertex estimates.
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -60,15 +61,16 @@ slam::PoseGraphSummary InitializeAndOptimize(const std::string& init,
 }
 
 // --init best: optimises from both the odometry chain and the chordal initialisation and keeps
-// the lower final chi2 (chordal on a tie). `used` names the one kept; the summary's time is both
-// solves'.
+// the lower final chi2: chordal unless odometry's is lower by more than 1e-6 of it (below that
+// the two are one minimum, apart by the solver's stopping tolerances). `used` names the one
+// kept; the summary's time is both solves'.
 slam::PoseGraphSummary OptimizeFromBest(const PoseGraphOptimizerOptions& options,
                                         slam::PoseGraph* graph, std::string* used) {
   slam::PoseGraph from_odometry = *graph;
   slam::PoseGraphSummary odometry = InitializeAndOptimize("odometry", options, &from_odometry);
   slam::PoseGraphSummary chordal = InitializeAndOptimize("chordal", options, graph);
   const double total_s = odometry.time_s + chordal.time_s;
-  if (odometry.final_chi2 < chordal.final_chi2) {
+  if (odometry.final_chi2 < chordal.final_chi2 - 1e-6 * chordal.final_chi2) {
     *graph = std::move(from_odometry);
     odometry.time_s = total_s;
     *used = "best (odometry, chordal reached chi2 " + Number("%.6g", chordal.final_chi2) + ")";
@@ -135,7 +137,13 @@ int RunOptimizeCommand(const std::vector<std::string>& args) {
                      (s.converged ? "" : " (not converged: " + s.message + ")");
   if (!out_path.empty()) line += " -> " + out_path;
   std::puts(line.c_str());
-  if (!no_certificate && !graph.edges().empty()) {
+  const auto fixed = std::count_if(graph.vertices().begin(), graph.vertices().end(),
+                                   [](const slam::PoseGraphVertex& v) { return v.fixed; });
+  if (!no_certificate && fixed > 1) {
+    std::puts(("not certified: the graph has " + std::to_string(fixed) +
+               " fixed vertices; the certificate is for a graph anchored at one pose")
+                  .c_str());
+  } else if (!no_certificate && !graph.edges().empty()) {
     // With a robust loss: the weighted least-squares problem the robust solution is stationary
     // for, the weights carrying the loss.
     slam::OptimalityCertificateOptions certificate_options;

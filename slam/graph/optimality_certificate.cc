@@ -329,9 +329,9 @@ OptimalityCertificate CertifyOptimality(const PoseGraph& graph,
   for (Eigen::Index k = 0; k < m.rows(); ++k) scale = std::max(scale, m.coeff(k, k));
   c.tolerance = options.relative_tolerance * scale;
   c.lambda_min = MinimumEigenvalue(CertificateMatrix(refined, &c.dual_value), c.tolerance);
-  c.relaxation_tight = c.refine_converged && std::isfinite(c.lambda_min) &&
-                       c.lambda_min >= -c.tolerance &&
-                       c.cost - c.dual_value <= options.relative_gap_tolerance * c.cost;
+  c.relaxation_tight =
+      c.refine_converged && std::isfinite(c.lambda_min) && c.lambda_min >= -c.tolerance &&
+      c.cost - c.dual_value <= options.relative_gap_tolerance * std::max(c.cost, c.tolerance);
   // Whether the given solution is the chi2 minimum in the basin of f's certified minimiser.
   c.chi2 = Chi2(graph);
   c.chi2_from_certified = c.chi2;
@@ -339,8 +339,9 @@ OptimalityCertificate CertifyOptimality(const PoseGraph& graph,
   if (c.relaxation_tight) {
     c.chi2_from_certified = PoseGraphOptimizer(options.optimizer).Optimize(&refined).final_chi2;
   }
-  c.certified = c.relaxation_tight &&
-                c.chi2_from_certified >= c.chi2 - options.relative_chi2_tolerance * c.chi2;
+  c.certified =
+      c.relaxation_tight &&
+      c.chi2_from_certified >= c.chi2 - options.relative_chi2_tolerance * std::max(c.chi2, 1.0);
   c.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return c;
 }

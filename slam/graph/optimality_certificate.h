@@ -65,10 +65,12 @@ struct OptimalityCertificateOptions {
   /// lambda_min >= -relative_tolerance * scale counts as nonnegative, scale being the largest
   /// diagonal entry of M (the largest weight sum at one pose).
   double relative_tolerance = 1e-8;
-  /// f(X) - d <= relative_gap_tolerance * f(X) (d the dual value, CertificateMatrix()).
+  /// f(X) - d <= relative_gap_tolerance * max(f(X), tolerance) (d the dual value,
+  /// CertificateMatrix(); the floor for a graph whose optimum costs 0).
   double relative_gap_tolerance = 1e-6;
   /// chi2 re-optimised from f's certified minimiser may be below the given solution's chi2 by
-  /// this fraction (Ceres's stopping tolerances) and still count as the same minimum.
+  /// this fraction (Ceres's stopping tolerances; of max(chi2, 1): chi2 is in whitened units, so
+  /// below 1 the margin is absolute) and still count as the same minimum.
   double relative_chi2_tolerance = 1e-6;
   /// The chi2 optimiser of that re-optimisation (the caller's own, so both solve one problem).
   PoseGraphOptimizerOptions optimizer;
@@ -116,7 +118,8 @@ struct OptimalityCertificate {
 /// S at the refined poses and tests it (relaxation_tight: the refined poses are a global
 /// minimum of SE-Sync's problem f for this graph), then re-optimises chi2 from there to tell
 /// whether the given poses are the chi2 minimum of that basin (certified). The graph needs at
-/// least one edge.
+/// least one edge. SE-Sync's problem has one anchored pose: with several fixed vertices the
+/// graph is a different (constrained) problem, which this does not certify (callers check).
 OptimalityCertificate CertifyOptimality(const PoseGraph& graph,
                                         const OptimalityCertificateOptions& options = {});
 
