@@ -32,13 +32,7 @@ double GershgorinBound(const SparseMatrix& s) {
   return row_sums.size() == 0 ? 0.0 : row_sums.maxCoeff();
 }
 
-// f and, when `h` is given, its gradient and Hessian in the poses' (x, y, theta), pose i at
-// 3 * unknown[i] (unknown[i] < 0: held, left out). Per edge, with d = t_j - t_i - R_i t_ij,
-// u = dR_i/dtheta_i t_ij, w = R_i t_ij and e = theta_j - theta_i - theta_ij:
-//   f_e = 4 kappa (1 - cos e) + tau |d|^2,
-//   df/dt_j = 2 tau d, df/dt_i = -2 tau d, df/dtheta_j = 4 kappa sin e,
-//   df/dtheta_i = -2 tau d.u - 4 kappa sin e,
-//   d2f/dtheta_i2 = 2 tau (|u|^2 + d.w) + 4 kappa cos e, d2f/dt_i dtheta_i = 2 tau u, ...
+// One edge of f, with what it needs precomputed.
 struct IsotropicEdge {
   std::size_t a = 0, b = 0;  // vertex indices of from and to
   Eigen::Vector2d z;         // measured translation
@@ -56,6 +50,13 @@ std::vector<IsotropicEdge> IsotropicEdges(const PoseGraph& graph) {
   return edges;
 }
 
+// f and, when `h` is given, its gradient and Hessian in the poses' (x, y, theta), pose i at
+// 3 * unknown[i] (unknown[i] < 0: held, left out). Per edge, with d = t_j - t_i - R_i t_ij,
+// u = dR_i/dtheta_i t_ij, w = R_i t_ij and e = theta_j - theta_i - theta_ij:
+//   f_e = 4 kappa (1 - cos e) + tau |d|^2,
+//   df/dt_j = 2 tau d, df/dt_i = -2 tau d, df/dtheta_j = 4 kappa sin e,
+//   df/dtheta_i = -2 tau d.u - 4 kappa sin e,
+//   d2f/dtheta_i2 = 2 tau (|u|^2 + d.w) + 4 kappa cos e, d2f/dt_i dtheta_i = 2 tau u, ...
 double IsotropicCostAndDerivatives(const std::vector<IsotropicEdge>& edges,
                                    const std::vector<Eigen::Index>& unknown,
                                    const std::vector<Eigen::Vector3d>& x, Eigen::VectorXd* g,
