@@ -11,6 +11,7 @@ packages=(
   build-essential cmake pkg-config ccache
   libbox2d-dev libeigen3-dev libopencv-dev libmujoco-dev libyaml-cpp-dev libceres-dev
   libgtest-dev libgmock-dev libbenchmark-dev libsqlite3-dev zlib1g-dev libnanoflann-dev
+  libspectra-dev
   libzstd-dev liblz4-dev
   libegl-dev libegl-mesa0 libgl1-mesa-dri
   pybind11-dev python3-dev python3-numpy

@@ -1,10 +1,12 @@
-// `slamrig optimize` as a user runs it: one summary line, the written graph is the library's
-// result bit for bit, and bad input gives one error line, a non-zero exit and no output file.
+// `slamrig optimize` as a user runs it: a summary line and the certificate's line, the written
+// graph is the library's result bit for bit, and bad input gives one error line, a non-zero exit
+// and no output file.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
 
 #include "slam/graph/edge_error.h"
 #include "slam/graph/g2o_io.h"
@@ -35,15 +37,18 @@ int CountLines(const std::string& text) {
   return n;
 }
 
-TEST(OptimizeCliTest, WritesTheLibrarysOptimumAndPrintsOneLine) {
+TEST(OptimizeCliTest, WritesTheLibrarysOptimumAndPrintsTheSummaryAndTheCertificate) {
   testing::TempDir dir;
   const slam::testing::RandomPoseGraph r =
       slam::testing::MakeRandomPoseGraph({.num_poses = 80, .seed = 21});
   const std::string in = dir.File("graph.g2o"), out = dir.File("optimised.g2o");
   slam::WriteG2o(in, r.graph);
-  const auto result = RunCommand(kBinary + " optimize " + in + " --init chordal --out " + out);
+  // No --init: chordal is the default.
+  const auto result = RunCommand(kBinary + " optimize " + in + " --out " + out);
   ASSERT_EQ(result.exit_code, 0) << result.output;
-  EXPECT_EQ(CountLines(result.output), 1) << result.output;
+  EXPECT_EQ(CountLines(result.output), 2) << result.output;
+  EXPECT_NE(result.output.find("\ncertified optimal (lambda_min = "), std::string::npos)
+      << result.output;
   EXPECT_NE(result.output.find("80 vertices, " + std::to_string(r.graph.edges().size()) +
                                " edges; init chordal"),
             std::string::npos)
@@ -57,6 +62,47 @@ TEST(OptimizeCliTest, WritesTheLibrarysOptimumAndPrintsOneLine) {
   std::snprintf(chi2, sizeof(chi2), "-> %.6g in", slam::Chi2(slam::ReadG2o(out)));
   EXPECT_NE(result.output.find(chi2), std::string::npos) << result.output << " vs " << chi2;
   EXPECT_LT(s.final_chi2, s.initial_chi2);
+}
+
+// The final chi2 of a summary line ("chi2 A -> B in ...").
+double FinalChi2(const std::string& output) {
+  const std::size_t arrow = output.find(" -> ");
+  return arrow == std::string::npos ? -1.0 : std::stod(output.substr(arrow + 4));
+}
+
+// A noisy graph (0.2 rad heading noise) where the odometry start ends in a poor local minimum:
+// the default start reaches a far lower chi2 and certifies it; the odometry start's result is
+// not certified.
+TEST(OptimizeCliTest, TheDefaultStartAvoidsThePoorMinimumOfTheOdometryStart) {
+  testing::TempDir dir;
+  const std::string in = dir.File("graph.g2o");
+  slam::WriteG2o(in, slam::testing::MakeRandomPoseGraph({.num_poses = 100,
+                                                         .loop_closure_probability = 0.2,
+                                                         .sigma_xy_m = 0.1,
+                                                         .sigma_theta_rad = 0.2,
+                                                         .seed = 3})
+                         .graph);
+  const auto by_default = RunCommand(kBinary + " optimize " + in);
+  const auto from_odometry = RunCommand(kBinary + " optimize " + in + " --init odometry");
+  ASSERT_EQ(by_default.exit_code, 0) << by_default.output;
+  ASSERT_EQ(from_odometry.exit_code, 0) << from_odometry.output;
+  EXPECT_GT(FinalChi2(by_default.output), 0.0) << by_default.output;
+  EXPECT_LT(5.0 * FinalChi2(by_default.output), FinalChi2(from_odometry.output))
+      << by_default.output << from_odometry.output;
+  EXPECT_NE(by_default.output.find("\ncertified optimal"), std::string::npos) << by_default.output;
+  EXPECT_NE(from_odometry.output.find("\nnot certified (lambda_min = "), std::string::npos)
+      << from_odometry.output;
+}
+
+TEST(OptimizeCliTest, BestNamesTheStartItKeepsAndTheCertificateCanBeSkipped) {
+  testing::TempDir dir;
+  const std::string in = dir.File("graph.g2o");
+  slam::WriteG2o(in, slam::testing::MakeRandomPoseGraph({.num_poses = 40, .seed = 4}).graph);
+  const auto result = RunCommand(kBinary + " optimize " + in + " --init best --no-certificate");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(CountLines(result.output), 1) << result.output;
+  EXPECT_NE(result.output.find("init best (chordal, odometry reached chi2 "), std::string::npos)
+      << result.output;
 }
 
 TEST(OptimizeCliTest, BadGraphIsOneErrorLineAndNoOutput) {
@@ -87,12 +133,17 @@ TEST(OptimizeCliTest, BadFlagsAreUsageErrors) {
   }
 }
 
-TEST(OptimizeCliTest, IntelFromChordalReachesTheCertifiedOptimum) {
+TEST(OptimizeCliTest, IntelReachesTheCertifiedOptimum) {
   SLAMRIG_REQUIRE_DATASET(path, "pose_graphs_2d/intel.g2o.gz");
-  const auto result = RunCommand(kBinary + " optimize " + path + " --init chordal");
+  const auto result = RunCommand(kBinary + " optimize " + path);
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_NE(result.output.find("1728 vertices, 2512 edges"), std::string::npos) << result.output;
   EXPECT_NE(result.output.find("-> 45.004"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("\ncertified optimal (lambda_min = "), std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("SE-Sync's certified global optimum, cost 52.348"),
+            std::string::npos)
+      << result.output;
 }
 
 }  // namespace

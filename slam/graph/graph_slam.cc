@@ -12,6 +12,7 @@
 #include <set>
 #include <utility>
 
+#include "slam/graph/optimality_certificate.h"
 #include "slam/matching/correlative_matcher.h"
 #include "slam/matching/grid_view.h"
 #include "slam/matching/icp_matcher.h"
@@ -172,6 +173,18 @@ Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment) {
 
 void GraphSlam::Finish() {
   if (pending_closure_) Optimize();
+  CheckOptimality();
+}
+
+void GraphSlam::CheckOptimality() {
+  if (graph_.edges().empty()) return;
+  OptimalityCertificateOptions certificate;
+  certificate.optimizer = options_.optimizer;
+  certificate.optimizer.robust_loss = RobustLoss::kNone;  // the weights carry it
+  const OptimalityCertificate c =
+      CertifyOptimality(WithRobustWeights(graph_, options_.optimizer, switches_), certificate);
+  counts_.certified = c.certified;
+  counts_.certificate_lambda_min = c.lambda_min;
 }
 
 std::vector<Pose2> GraphSlam::Poses() const {

@@ -11,6 +11,7 @@
 // Kümmerle et al. 2011) and a robust loss on loop closures.
 
 #include <Eigen/Core>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -42,6 +43,12 @@ struct GraphSlamCounts {
   /// With pairwise consistency: closures that passed their own checks but are outside the
   /// largest pairwise-consistent set (so not in the graph).
   int inconsistent = 0;
+  /// After Finish(): whether the final graph's solution is certified globally optimal
+  /// (optimality_certificate.h) for the graph with every robust edge weighted by its final
+  /// robust-loss weight, and the certificate matrix's smallest eigenvalue (NaN before Finish()
+  /// or when it could not be computed).
+  bool certified = false;
+  double certificate_lambda_min = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Online graph SLAM over laser scans with an odometry increment each. Deterministic; not
@@ -93,6 +100,8 @@ class GraphSlam {
   void AcceptClosure(const PoseGraphEdge& edge, const LoopClosure& closure);
   void AddClosureEdge(const PoseGraphEdge& edge, const LoopClosure& closure);
   void Optimize();
+  // The optimality certificate of the current solution, into counts_.
+  void CheckOptimality();
 
   GraphSlamOptions options_;
   IcpOdometry odometry_;

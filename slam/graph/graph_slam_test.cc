@@ -75,6 +75,9 @@ TEST(GraphSlamTest, ClosesTheOfficeLoopAndBeatsOdometry) {
   EXPECT_GT(slam.counts().optimizations, 0);
   EXPECT_LT(graph, 0.1);
   EXPECT_LT(graph, 0.25 * odometry) << "odometry " << odometry;
+  // The final solution passes the optimality check (a low-noise graph: the relaxation is tight).
+  EXPECT_TRUE(slam.counts().certified);
+  EXPECT_TRUE(std::isfinite(slam.counts().certificate_lambda_min));
 
   // Every accepted closure agrees with the truth.
   std::vector<Pose2> reference;

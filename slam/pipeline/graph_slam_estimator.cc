@@ -49,8 +49,9 @@ EstimatorView GraphSlamEstimator::View() const {
 
 const std::vector<std::string>& GraphSlamEstimator::StatisticNames() {
   static const std::vector<std::string> names = {
-      "keyframes",  "loop_closures", "loop_candidates",    "rejected",    "optimizations",
-      "final_chi2", "switched_off",  "odometry_rematched", "inconsistent"};
+      "keyframes",     "loop_closures", "loop_candidates",       "rejected",
+      "optimizations", "final_chi2",    "switched_off",          "odometry_rematched",
+      "inconsistent",  "certified",     "certificate_lambda_min"};
   return names;
 }
 
@@ -64,7 +65,9 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"final_chi2", c.final_chi2},
           {"switched_off", c.switched_off},
           {"odometry_rematched", c.odometry_rematched},
-          {"inconsistent", c.inconsistent}};
+          {"inconsistent", c.inconsistent},
+          {"certified", c.certified ? 1.0 : 0.0},
+          {"certificate_lambda_min", c.certificate_lambda_min}};
 }
 
 }  // namespace slamrig::slam
