@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "scenarios/plot.h"
+#include "scenarios/run_recorder.h"
 #include "scenarios/scenario_result.h"
 #include "slam/eval/json_writer.h"
 #include "slam/eval/nees.h"
@@ -596,6 +597,7 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
   // metrics.json, written last, marks a complete folder: an earlier run's must not vouch for
   // files this one only half replaced.
   fs::remove(file("metrics.json"));
+  if (!r.recording.empty()) RunRecorder::Commit(r.recording);
   slam::WriteFileAtomically(file("config.yaml"), r.spec->resolved_yaml);
   if (!r.truth.empty()) slam::WriteTum(file("truth.tum"), r.truth);
   WriteConfigFiles(r, file);
