@@ -190,6 +190,8 @@ RunRecorder::RunRecorder(std::string path, std::vector<std::string> config_names
   // base_link hangs under truth/base_link; the robot's own odom -> base_link stays in /odom.
   bag.write_tf = false;
   writer_ = std::make_unique<slam::BagWriter>(partial, bag);
+  if (options_.odometry && options_.odometry->Validate().empty())
+    odometry_.emplace(*options_.odometry);
   for (std::string& name : config_names) {
     configs_.emplace_back();
     configs_.back().name = std::move(name);
@@ -218,6 +220,10 @@ void RunRecorder::Record(const slamrig::Record& record) {
   }
   last_time_ = std::max(last_time_, time);
   writer_->Write(record);
+  if (odometry_) {
+    const std::optional<OdometryPose> pose = odometry_->Add(record);
+    if (pose && std::holds_alternative<WheelTicks>(record)) writer_->Write(slamrig::Record{*pose});
+  }
 }
 
 void RunRecorder::Truth(Time time, const Pose2& map_from_base) {

@@ -8,6 +8,7 @@
 
 #include "scenarios/scenario_result.h"
 #include "slam/io/bag/bag_writer.h"
+#include "slam/odometry/robot_odometry.h"
 #include "slam/pipeline/estimator.h"
 #include "slam/types/pose2.h"
 #include "slam/types/records.h"
@@ -21,6 +22,9 @@ struct RecorderOptions {
   double map_period_s = 5.0;
   /// Particle clouds are written at most this often (seconds of run time).
   double particles_period_s = 0.1;
+  /// The robot's own odometry on /odom from its wheel ticks (and gyro), as slamrig's bags have
+  /// it (slam::BagSink); none when the geometry is unknown or invalid.
+  std::optional<slam::WheelOdometryOptions> odometry;
 };
 
 /// Writes a whole scenario run as one MCAP file of ROS 2 messages (CDR, ros2msg schemas, zstd
@@ -34,7 +38,8 @@ struct RecorderOptions {
 ///                           static map -> <config>/map is the ATE alignment (known at the end),
 ///                           so that estimates overlay the truth;
 ///   <config>/base_link      its online pose (/tf from <config>/map).
-/// Topics: the sensor streams as in slamrig's bags (/scan, /odom, /imu, /joint_states, /clock,
+/// Topics: the sensor streams as in slamrig's bags (/scan, /odom (the robot's own odometry,
+/// from its wheel ticks or as a log has it), /imu, /joint_states, /clock,
 /// /ground_truth/odom, camera images), /tf, /tf_static; per configuration /<config>/pose,
 /// /<config>/health/<trace> (each scan), /<config>/particles (every particles_period_s),
 /// /<config>/map, /<config>/graph,
@@ -97,6 +102,7 @@ class RunRecorder {
   bool finished_ = false;
   RecorderOptions options_;
   std::unique_ptr<slam::BagWriter> writer_;
+  std::optional<slam::RobotOdometry> odometry_;
   std::vector<Config> configs_;
   std::optional<Time> first_time_;
   Time last_time_;

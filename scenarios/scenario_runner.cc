@@ -53,7 +53,10 @@ std::unique_ptr<RunRecorder> MakeRecorder(const RunnerOptions& options, Runners&
   if (options.record_path.empty()) return nullptr;
   std::vector<std::string> names;
   for (const auto& r : runners) names.push_back(r->config().name);
-  auto recorder = std::make_unique<RunRecorder>(options.record_path, names, RecorderOptions{});
+  RecorderOptions recording;
+  const slam::EstimatorConfig& first = runners.front()->config();
+  recording.odometry = slam::WheelOdometryOptions{first.odometry.robot, first.odometry.use_gyro};
+  auto recorder = std::make_unique<RunRecorder>(options.record_path, names, recording);
   for (std::size_t i = 0; i < runners.size(); ++i) {
     slam::EstimatorRunner* runner = runners[i].get();
     RunRecorder* rec = recorder.get();
