@@ -549,6 +549,10 @@ std::string SummaryHtml(const ScenarioResult& r) {
   if (!r.truth.empty()) h << ", <a href=\"truth.tum\">truth.tum</a>";
   for (const auto& c : r.configs)
     h << ", <a href=\"" << c.name << ".tum\">" << c.name << ".tum</a>";
+  if (!r.recording.empty()) {
+    h << ", <a href=\"run.mcap\">run.mcap</a> (the whole run for Foxglove: open it with the "
+         "layout foxglove/slamrig.json)";
+  }
   h << ".</p>";
   return h.str();
 }

@@ -6,17 +6,20 @@
 // topic in file order, header stamps) and /<config>/pose against <config>.tum (or
 // <config>_online.tum where the estimator revised its past), value for value.
 //
-// Usage: node record_check.mjs NODE_MODULES_PARENT full REPORT_DIR
+// Usage: node record_check.mjs NODE_MODULES_PARENT full REPORT_DIR [LAYOUT]
 //        node record_check.mjs NODE_MODULES_PARENT partial FILE
 // `partial`: FILE is what a killed run left (run.mcap.partial): the indexed reader must refuse
 // it (no summary, no footer: it does not look complete), and the stream reader must decode
 // every whole record up to the cut.
+// LAYOUT (foxglove/slamrig.json): every topic a panel names that belongs to this run's
+// configurations (or to no configuration) is in the file with a type the panel shows, and every
+// plotted path reads a number from its messages.
 // Exit 0 when everything holds; otherwise one line per failure (first 30) and exit 1.
 import fs from "node:fs";
 import path from "node:path";
 import { createRequire } from "node:module";
 
-const [, , modulesParent, mode, target] = process.argv;
+const [, , modulesParent, mode, target, layoutPath] = process.argv;
 const require = createRequire(path.join(path.resolve(modulesParent), "package.json"));
 const { McapIndexedReader, McapStreamReader } = require("@mcap/core");
 const { FileHandleReadable } = require("@mcap/nodejs");
@@ -192,7 +195,8 @@ for await (const m of reader.readMessages()) {
   if (stamp !== undefined && stamp !== m.logTime && !channel.topic.endsWith("/path")) {
     fail(`${where} (${channel.topic}): stamp ${stamp} != log time ${m.logTime}`);
   }
-  if (/\/pose$|\/path$|^\/tf$|\/map$|\/error$/.test(channel.topic) || channel.topic === "/tf_static") {
+  if (/\/pose$|\/path$|^\/tf$|\/map$|\/error$/.test(channel.topic) || channel.topic === "/tf_static" ||
+      t.msgs.length === 0) {
     t.msgs.push({ logTime: m.logTime, msg });
   }
   topics.set(channel.topic, t);
@@ -327,5 +331,52 @@ for (const topic of topics.keys()) {
   if (!known.test(topic) && !config) fail(`unexpected topic ${topic}`);
 }
 if (topics.has("/events")) expectType("/events", "std_msgs/msg/String");
+
+if (layoutPath) {
+  const layout = JSON.parse(fs.readFileSync(layoutPath, "utf8"));
+  const panels = Object.keys(layout.configById);
+  for (const kind of ["3D!", "Plot!", "Image!", "RawMessages!"]) {
+    if (!panels.some((p) => p.startsWith(kind))) fail(`layout: no ${kind} panel`);
+  }
+  // A topic of a configuration this run does not have is for other scenarios.
+  const ours = (topic) => {
+    const first = topic.split("/")[1];
+    const configTopic = !["scan", "truth", "events", "camera", "tf", "tf_static", "odom", "imu"].includes(first);
+    return !configTopic || configs.includes(first);
+  };
+  const shown3d = ["nav_msgs/msg/OccupancyGrid", "sensor_msgs/msg/LaserScan", "geometry_msgs/msg/PoseStamped",
+    "geometry_msgs/msg/PoseWithCovarianceStamped", "geometry_msgs/msg/PoseArray", "nav_msgs/msg/Path",
+    "visualization_msgs/msg/MarkerArray"];
+  let checked = 0;
+  for (const [id, config] of Object.entries(layout.configById)) {
+    if (id.startsWith("3D!")) {
+      if (config.followTf !== "map") fail(`layout ${id}: display frame ${config.followTf}`);
+      for (const topic of Object.keys(config.topics ?? {})) {
+        if (!ours(topic)) continue;
+        const t = topics.get(topic);
+        if (!t) fail(`layout ${id}: ${topic} is not in the run`);
+        else if (!shown3d.includes(t.type)) fail(`layout ${id}: ${topic} is a ${t.type}`);
+        ++checked;
+      }
+    }
+    for (const p of config.paths ?? []) {
+      const [topic, ...fields] = p.value.split(".");
+      if (!ours(topic)) continue;
+      const t = topics.get(topic);
+      if (!t) {
+        fail(`layout ${id}: ${topic} is not in the run`);
+        continue;
+      }
+      const value = fields.reduce((v, f) => v?.[f], t.msgs[0]?.msg);
+      if (typeof value !== "number") fail(`layout ${id}: ${p.value} is not a number (${value})`);
+      if (p.timestampMethod === "headerStamp" && !t.msgs[0]?.msg?.header) fail(`layout ${id}: ${topic} has no header`);
+      ++checked;
+    }
+    if (config.topicPath && ours(config.topicPath) && !topics.has(config.topicPath) && config.topicPath !== "/events") {
+      fail(`layout ${id}: ${config.topicPath} is not in the run`);
+    }
+  }
+  console.log(`record_check: layout ${layoutPath}: ${checked} topic references checked`);
+}
 const counts = [...topics].map(([t, v]) => `${t} ${v.count}`).join(", ");
 finish(`${file}: ${total} messages decoded by both definitions; ${counts}`);

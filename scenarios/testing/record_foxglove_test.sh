@@ -59,7 +59,7 @@ run() {
 
 # 1 and 2: the office run, twice.
 run office_loop --record --set duration_s=120 --out "$work/a"
-node "$here/record_check.mjs" "$modules" full "$work/a"
+node "$here/record_check.mjs" "$modules" full "$work/a" "$source_dir/foxglove/slamrig.json"
 run office_loop --record --set duration_s=120 --out "$work/b"
 if ! cmp "$work/a/run.mcap" "$work/b/run.mcap"; then
   echo "record_foxglove_test: the same run gave different run.mcap bytes" >&2
@@ -69,7 +69,7 @@ echo "record_foxglove_test: the same run gives the same run.mcap ($(stat -c %s "
 
 # 3: graph SLAM with loop closures, EKF-SLAM with landmarks, a kidnapping (events).
 run generated_office --record --set duration_s=90 --out "$work/graph"
-node "$here/record_check.mjs" "$modules" full "$work/graph"
+node "$here/record_check.mjs" "$modules" full "$work/graph" "$source_dir/foxglove/slamrig.json"
 run pillars --record --set duration_s=60 --out "$work/pillars"
 node "$here/record_check.mjs" "$modules" full "$work/pillars"
 run kidnapping --record --set duration_s=90 --out "$work/kidnap"
