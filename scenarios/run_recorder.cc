@@ -399,8 +399,12 @@ void RunRecorder::Finish(const ScenarioResult& result) {
   Events(result, &late);
   // Known only now, valid from the start: the alignments (static) and the true map (latched).
   writer_->FlushChunk();
+  // Stamped at the start, or with the last mount a camera's first frame added, so that /tf_static
+  // stays in time order in the file too.
+  const Time static_time = std::max(start, writer_->static_time().value_or(start));
   for (const ConfigResult& c : result.configs) {
-    writer_->AddStaticTransform({start, kMap, c.name + "/map", c.reference_from_estimate}, start);
+    writer_->AddStaticTransform({static_time, kMap, c.name + "/map", c.reference_from_estimate},
+                                static_time);
   }
   if (result.truth_map && result.truth_map->width() > 0) {
     slam::EncodeOccupancyGrid(ToRosGrid(*result.truth_map, start, kMap, Pose2()), &buffer_);

@@ -372,6 +372,11 @@ if (layoutPath) {
       if (p.timestampMethod === "headerStamp" && !t.msgs[0]?.msg?.header) fail(`layout ${id}: ${topic} has no header`);
       ++checked;
     }
+    const image = config.imageMode?.imageTopic;
+    if (image && [...topics.keys()].some((t) => t.startsWith("/camera/"))) {
+      if (topics.get(image)?.type !== "sensor_msgs/msg/Image") fail(`layout ${id}: ${image} is not an image of the run`);
+      ++checked;
+    }
     if (config.topicPath && ours(config.topicPath) && !topics.has(config.topicPath) && config.topicPath !== "/events") {
       fail(`layout ${id}: ${config.topicPath} is not in the run`);
     }

@@ -352,6 +352,7 @@ void BagWriter::FlushChunk() {
 
 void BagWriter::EmitStaticTransforms(Time time) {
   const BagFrames& f = options_.frames;
+  static_time_ = time;
   if (!static_extra_.empty()) {
     std::vector<RosTransform3d> all;
     if (static_laser_) {

@@ -145,6 +145,8 @@ class BagWriter {
 
   /// Messages written so far.
   std::uint64_t message_count() const { return message_count_; }
+  /// The time of the last /tf_static message, if one was written.
+  std::optional<Time> static_time() const { return static_time_; }
 
  private:
   struct Topic {
@@ -178,6 +180,7 @@ class BagWriter {
   std::optional<Eigen::Isometry3d> static_rgb_;    // base_from_optical of the colour camera
   std::optional<Eigen::Isometry3d> static_depth_;  // and of the depth camera
   std::vector<RosTransform> static_extra_;         // AddStaticTransform's
+  std::optional<Time> static_time_;
   std::vector<std::int64_t> tick_totals_;
   std::size_t right_wheels_ = 0;
   std::vector<std::string> joint_names_;
