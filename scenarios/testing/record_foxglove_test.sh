@@ -5,7 +5,8 @@
 #      /<config>/pose against <config>.tum;
 #   2. the same run again gives the same run.mcap bytes (nothing of the wall clock enters);
 #   3. runs with a graph and with landmark estimators (graph and landmark markers, events), a
-#      kidnapping, and a camera (images, the layout's image panel);
+#      kidnapping, a camera (images, the layout's image panel), and `slamrig slam --record` on
+#      a log;
 #   4. a run killed with SIGKILL mid-run leaves no run.mcap, and its run.mcap.partial is
 #      refused by the indexed reader and decoded by the stream reader up to the cut.
 # The readers are installed from the npm registry into the build folder (never the source tree).
@@ -79,6 +80,11 @@ node "$here/record_check.mjs" "$modules" full "$work/kidnap"
 # A robot with a camera: the images and their mounts, and the layout's image panel.
 run office_camera --record --set duration_s=8 --out "$work/camera"
 node "$here/record_check.mjs" "$modules" full "$work/camera" "$source_dir/foxglove/slamrig.json"
+
+# `slamrig slam LOG --record` on a log (a simulated CARMEN log: ODOM lines, no IMU).
+"$slamrig" simulate office --duration 30 --out "$work/log" --quiet
+"$slamrig" slam "$work/log/run.log" --out "$work/slam" --record --quiet >/dev/null
+node "$here/record_check.mjs" "$modules" full "$work/slam"
 
 # 4: SIGKILL mid-run.
 "$slamrig" run office_loop --record --out "$work/killed" --quiet >/dev/null 2>&1 &
