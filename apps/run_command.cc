@@ -23,7 +23,7 @@ int RunRunCommand(const std::vector<std::string>& args) {
   std::string out_dir;
   std::vector<std::string> overrides;
   std::uint64_t seed = 0;
-  bool has_seed = false, view = false, quiet = false;
+  bool has_seed = false, view = false, quiet = false, record = false;
   std::string seed_text;
   ArgParser parser(
       "slamrig run", "[SCENARIO] [--out DIR] [options]",
@@ -44,6 +44,10 @@ int RunRunCommand(const std::vector<std::string>& args) {
       "or a robot key (robot.lidar.range_noise_stddev_m=0.05)",
       &overrides);
   parser.AddFlag("view", "show the run live in a window (needs a display)", &view);
+  parser.AddFlag("record",
+                 "also write run.mcap in the report folder, the whole run for Foxglove "
+                 "(docs/foxglove.md); `record: true` in the scenario does the same",
+                 &record);
   parser.AddFlag("quiet", "print only errors and the verdict line", &quiet);
   if (!parser.Parse(args)) return 0;
   if (!seed_text.empty()) {
@@ -66,6 +70,7 @@ int RunRunCommand(const std::vector<std::string>& args) {
 
   scenario::RunnerOptions options;
   options.view = view;
+  if (record || spec.record) options.record_path = out_dir + "/run.mcap";
   const bool tty = ::isatty(STDERR_FILENO) != 0;
   if (!quiet) {
     options.progress = [tty](double t, double duration) {

@@ -116,7 +116,7 @@ struct SlamFlags {
   int clouds = 0, max_scans = 0;
   std::uint64_t seed = 1;
   std::vector<std::string> perturb;
-  bool no_gyro = false, lenient = false, quiet = false, strict = false;
+  bool no_gyro = false, lenient = false, quiet = false, strict = false, record = false;
 };
 
 // Reads the flags and checks the output folder; false when help was asked for.
@@ -173,6 +173,8 @@ bool ParseSlamFlags(const std::vector<std::string>& args, SlamFlags* f) {
                      "odometry.lost=[[T0, T1]], scans.drop_fraction, range.noise_m, range.max_m, "
                      "beams.drop_every, beams.drop_fraction); the reference is not perturbed",
                      &f->perturb);
+  parser.AddFlag("record", "also write DIR/run.mcap, the run for Foxglove (docs/foxglove.md)",
+                 &f->record);
   parser.AddFlag("quiet", "no progress output", &f->quiet);
   if (!parser.Parse(args)) return false;
   if (f->out_dir.empty()) throw ConfigError("slamrig slam: --out DIR is required");
@@ -291,6 +293,7 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   std::string clouds;
   if (flags.clouds > 0) clouds = "# time_s,particle,x_m,y_m,yaw_rad,weight\n";
   scenario::RunnerOptions options;
+  if (flags.record) options.record_path = flags.out_dir + "/run.mcap";
   options.on_scan = [&](std::size_t done, std::size_t total, const slam::SyncedScan& scan,
                         const slam::EstimatorRunner& runner) {
     progress(done, total);

@@ -9,6 +9,7 @@
 
 #include "scenarios/html.h"
 #include "scenarios/plot.h"
+#include "scenarios/run_recorder.h"
 #include "scenarios/scenario_result.h"
 #include "slam/eval/json_writer.h"
 #include "slam/eval/nees.h"
@@ -545,6 +546,10 @@ std::string SummaryHtml(const ScenarioResult& r) {
   if (!r.truth.empty()) h << ", <a href=\"truth.tum\">truth.tum</a>";
   for (const auto& c : r.configs)
     h << ", <a href=\"" << c.name << ".tum\">" << c.name << ".tum</a>";
+  if (!r.recording.empty()) {
+    h << ", <a href=\"run.mcap\">run.mcap</a> (the whole run for Foxglove: open it with the "
+         "layout foxglove/slamrig.json)";
+  }
   h << ".</p>";
   return h.str();
 }
@@ -593,6 +598,7 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
   // metrics.json, written last, marks a complete folder: an earlier run's must not vouch for
   // files this one only half replaced.
   fs::remove(file("metrics.json"));
+  if (!r.recording.empty()) RunRecorder::Commit(r.recording);
   slam::WriteFileAtomically(file("config.yaml"), r.spec->resolved_yaml);
   if (!r.truth.empty()) slam::WriteTum(file("truth.tum"), r.truth);
   WriteConfigFiles(r, file);

@@ -23,6 +23,8 @@ struct ConfigResult {
   Trajectory mean_estimate;  ///< the estimator's second estimate (a PF's mean), else empty
   slam::EstimatorRun run;    ///< everything it produced, in its own frame (map, traces, stats)
   Pose2 map_from_estimator;  ///< the reference pose at the estimator's first scan
+  /// The ATE alignment of `estimate` to the reference (identity without one).
+  Pose2 reference_from_estimate;
   /// The MetricsOf() names that apply to this configuration in this run (a reference, a camera,
   /// kidnappings, covariances, loop closures); NaN where one applies but could not be computed
   /// (a run too short for a spacing).
@@ -77,6 +79,9 @@ struct ScenarioResult {
   bool times_synthesised = false;
   std::vector<ExpectationOutcome> outcomes;
   bool passed = true;
+  /// A recorded run (RunnerOptions::record_path): the path run.mcap goes to. The file waits as
+  /// `recording`.partial until WriteReport renames it, after it removed metrics.json.
+  std::string recording;
 };
 
 /// Checks every expectation of `result.spec` against the configs' metrics, filling `outcomes`
@@ -85,7 +90,8 @@ void CheckExpectations(ScenarioResult* result);
 
 /// Writes the report folder: config.yaml (resolved), metrics.json, truth.tum and
 /// <config>.tum, maps (<config>_map.pgm/.yaml, map.png with truth and estimates), plots
-/// (errors over time, Neff over time, metrics per configuration) and report.html. Every file is
+/// (errors over time, Neff over time, metrics per configuration) and report.html, and renames a
+/// recording (`recording`.partial) into place. Every file is
 /// written atomically and metrics.json last (an earlier one is removed first), so a folder with
 /// a metrics.json is complete. Throws OutputError naming the file that cannot be written,
 /// Interrupted after SIGINT/SIGTERM.

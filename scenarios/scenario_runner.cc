@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "scenarios/live_view.h"
+#include "scenarios/run_recorder.h"
 #include "sim/camera/camera_rig.h"
 #include "sim/simulator.h"
 #include "slam/eval/landmark_score.h"
@@ -43,6 +44,29 @@ Runners MakeRunners(const ScenarioSpec& spec, const std::vector<Record>* log_rec
     runners.push_back(std::make_unique<slam::EstimatorRunner>(config, source, spec.seed));
   }
   return runners;
+}
+
+// The recording of a run, when asked for: every configuration's scans go to it as they are
+// taken, placed by the reference pose of the run's first scan (`map_from_start`, filled later).
+std::unique_ptr<RunRecorder> MakeRecorder(const RunnerOptions& options, Runners& runners,
+                                          const std::optional<Pose2>& map_from_start) {
+  if (options.record_path.empty()) return nullptr;
+  std::vector<std::string> names;
+  for (const auto& r : runners) names.push_back(r->config().name);
+  RecorderOptions recording;
+  const slam::EstimatorConfig& first = runners.front()->config();
+  recording.odometry = slam::WheelOdometryOptions{first.odometry.robot, first.odometry.use_gyro};
+  auto recorder = std::make_unique<RunRecorder>(options.record_path, names, recording);
+  for (std::size_t i = 0; i < runners.size(); ++i) {
+    slam::EstimatorRunner* runner = runners[i].get();
+    RunRecorder* rec = recorder.get();
+    runner->SetScanCallback([rec, runner, i, &map_from_start](std::size_t,
+                                                              const slam::SyncedScan& scan,
+                                                              const slam::ScanEstimate& estimate) {
+      rec->Scan(i, scan.scan.time, estimate, runner->estimator(), map_from_start.value_or(Pose2()));
+    });
+  }
+  return recorder;
 }
 
 bool InBlackout(const SimulatedSource& source, Time t) {
@@ -166,6 +190,7 @@ void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
   for (const auto& [name, value] : c->run.statistics) m[name] = value;
   if (c->estimate.size() < 2 || run.truth.size() < 2) return;
   const slam::TrajectoryMetrics t = slam::EvaluateTrajectory(c->estimate, run.truth);
+  c->reference_from_estimate = t.ate.reference_from_estimate;
   m["ate_rmse_m"] = t.ate.translation_m.rmse;
   m["ate_mean_m"] = t.ate.translation_m.mean;
   m["ate_median_m"] = t.ate.translation_m.median;
@@ -312,6 +337,8 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
     texture.emplace(layout, floor.TruthColors(layout), floor.FloorMask(layout));
   }
   Runners runners = MakeRunners(spec, nullptr);
+  std::optional<Pose2> map_from_start;  // true pose at the first scan SLAM sees
+  std::unique_ptr<RunRecorder> recorder = MakeRecorder(options, runners, map_from_start);
   slam::OccupancyGrid truth_map{slam::OccupancyGridOptions{}};
   std::unique_ptr<LiveView> view;
   if (options.view) view = std::make_unique<LiveView>("slamrig: " + spec.name);
@@ -319,7 +346,6 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
   std::optional<slam::TextureMap> live_texture;
   if (view && texture) live_texture.emplace(texture->options());
 
-  std::optional<Pose2> map_from_start;  // true pose at the first scan SLAM sees
   LaserScan truth_scan;
   std::size_t next_kidnap = 0;
   double next_progress_s = 0.0;
@@ -332,6 +358,7 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
         const Pose2& truth = sample.map_from_base;
         ++result.scans;
         result.truth.Append(scan->time, truth);
+        if (recorder) recorder->Truth(scan->time, truth);
         // The truth map: the noise-free ranges from the true poses, i.e. the world as the
         // lidar can see it, without the sensor's noise and outliers.
         truth_scan = *scan;
@@ -350,6 +377,7 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
           live_texture->Insert(*frame, *map_from_start * runners.front()->pose());
         }
       }
+      if (recorder) recorder->Record(record);
       for (auto& r : runners) r->Add(record);
     }
   };
@@ -388,6 +416,10 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
   result.truth_map.emplace(std::move(truth_map));
   Finish(runners, map_from_start.value_or(Pose2()), result.sim_time_s,
          texture ? &*texture : nullptr, &result);
+  if (recorder) {
+    recorder->Finish(result);
+    result.recording = options.record_path;
+  }
   return result;
 }
 
@@ -430,20 +462,24 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
   result.times_synthesised = data.times_synthesised;
   if (!data.reference_kind.empty()) result.reference_kind = data.reference_kind;
   Runners runners = MakeRunners(spec, &data.records);
+  std::optional<Pose2> map_from_start;
+  std::unique_ptr<RunRecorder> recorder = MakeRecorder(options, runners, map_from_start);
   if (options.on_scan) {
     const std::size_t total = ScansToRun(log, data.records);
     const slam::EstimatorRunner& first = *runners.front();
-    runners.front()->SetScanCallback(
-        [&](std::size_t i, const slam::SyncedScan& scan, const slam::ScanEstimate&) {
-          options.on_scan(i + 1, total, scan, first);
-        });
+    RunRecorder* rec = recorder.get();
+    runners.front()->SetScanCallback([&, rec, total](std::size_t i, const slam::SyncedScan& scan,
+                                                     const slam::ScanEstimate& estimate) {
+      if (rec)
+        rec->Scan(0, scan.scan.time, estimate, first.estimator(), map_from_start.value_or(Pose2()));
+      options.on_scan(i + 1, total, scan, first);
+    });
   }
   std::unique_ptr<LiveView> view;
   if (options.view) view = std::make_unique<LiveView>("slamrig: " + spec.name);
 
   // The reference map: the log's scans at its reference poses, one per scan in order.
   slam::OccupancyGrid truth_map{slam::OccupancyGridOptions{}};
-  std::optional<Pose2> map_from_start;
   std::optional<Time> first_time, last_time;
   std::size_t scans = 0;
   const bool limited = spec.has_duration;
@@ -458,6 +494,7 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
       if (scans < data.reference.size()) {
         const Pose2& reference = data.reference[scans].map_from_base;
         result.truth.Append(data.reference[scans].time, reference);
+        if (recorder) recorder->Truth(data.reference[scans].time, reference);
         if (!true_map) truth_map.InsertScan(*scan, reference);
         if (!map_from_start) map_from_start = reference;
       }
@@ -467,6 +504,7 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
       ++result.frames;  // a log's frames have no true floor to be scored against
     }
     last_time = last_time ? std::max(*last_time, t) : t;
+    if (recorder) recorder->Record(record);
     for (auto& r : runners) r->Add(record);
     if (view && is_scan) {
       ShowLive(*view, SecondsBetween(t, *first_time), runners, map_from_start.value_or(Pose2()),
@@ -493,6 +531,10 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
   }
   // A log without a reference is scored on nothing but its own statistics.
   Finish(runners, map_from_start.value_or(Pose2()), result.sim_time_s, nullptr, &result);
+  if (recorder) {
+    recorder->Finish(result);
+    result.recording = options.record_path;
+  }
   return result;
 }
 

@@ -11,6 +11,9 @@ namespace slamrig::scenario {
 /// How a scenario run behaves around the run itself (never what it computes).
 struct RunnerOptions {
   bool view = false;  ///< open a live window (needs a display)
+  /// Record the run as MCAP for Foxglove (RunRecorder) to this path (.partial until WriteReport
+  /// renames it); empty: no recording.
+  std::string record_path;
   /// Called about once per simulated second with (sim time, duration); for progress output.
   std::function<void(double, double)> progress;
   /// A log source: called after each scan the first configuration takes, with the scans taken,

@@ -304,6 +304,7 @@ std::string ResolvedYaml(const ScenarioSpec& spec, const std::vector<std::string
   out << YAML::Key << "name" << YAML::Value << spec.name;
   out << YAML::Key << "description" << YAML::Value << spec.description;
   out << YAML::Key << "seed" << YAML::Value << spec.seed;
+  if (spec.record) out << YAML::Key << "record" << YAML::Value << true;
   if (spec.simulated || spec.has_duration) {
     out << YAML::Key << "duration_s" << YAML::Value << FormatNumber(spec.duration_s);
   }
@@ -560,6 +561,7 @@ ScenarioSpec LoadScenario(const std::string& path, const std::vector<std::string
   }
   root.Read("seed", &spec.seed);
   if (seed) spec.seed = *seed;
+  root.Read("record", &spec.record);
 
   if (const auto source = root.Optional("source")) {
     spec.log = ReadLogSource(root, *source, path, sets);

@@ -105,6 +105,8 @@ struct ScenarioSpec {
   /// camera.
   slam::TextureMapOptions texture = DefaultScenarioTexture();
   std::vector<Expectation> expectations;
+  /// `record: true`: write run.mcap for Foxglove in the report folder (as `--record` does).
+  bool record = false;
   /// The whole resolved scenario, in the input schema (world and robot inline, every field):
   /// `slamrig run config.yaml` repeats the run bit for bit.
   std::string resolved_yaml;

@@ -41,6 +41,20 @@ TEST(ScenarioSpecTest, LogSourceTakesBagTopicNames) {
   EXPECT_NE(spec.resolved_yaml.find("ground_truth: /ground_truth/odom"), std::string::npos);
 }
 
+TEST(ScenarioSpecTest, RecordIsReadAndRepeatedInTheResolvedFile) {
+  const std::string path = WriteScenario("record", "{log: run.mcap}");
+  EXPECT_FALSE(LoadScenario(path).record);
+  std::ofstream(path, std::ios::app) << "record: true\n";
+  const ScenarioSpec spec = LoadScenario(path);
+  EXPECT_TRUE(spec.record);
+  EXPECT_NE(spec.resolved_yaml.find("record: true"), std::string::npos) << spec.resolved_yaml;
+  const std::string bad = WriteScenario("record_bad", "{log: run.mcap}");
+  std::ofstream(bad, std::ios::app) << "record: maybe\n";
+  const std::string error = ErrorOf(bad);
+  EXPECT_NE(error.find("s.yaml:5:"), std::string::npos) << error;
+  EXPECT_NE(error.find("record"), std::string::npos) << error;
+}
+
 TEST(ScenarioSpecTest, BadTopicNamesNameFileLineAndKey) {
   const std::string unknown = ErrorOf(WriteScenario("typo", "{log: run.mcap, topics: {scna: /x}}"));
   EXPECT_NE(unknown.find("s.yaml:2:"), std::string::npos) << unknown;

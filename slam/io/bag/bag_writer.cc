@@ -137,6 +137,9 @@ std::vector<std::string> BagWriterOptions::Validate() const {
   if (chunk_size_bytes < 1024) {
     errors.push_back(RuleViolation("chunk_size_bytes", chunk_size_bytes, "must be >= 1024"));
   }
+  if (single_file && storage != BagStorage::kMcap) {
+    errors.push_back(RuleViolation("single_file", "true", "needs storage mcap"));
+  }
   if (!(ticks_per_revolution > 0.0) || !std::isfinite(ticks_per_revolution)) {
     errors.push_back(
         RuleViolation("ticks_per_revolution", ticks_per_revolution, "must be finite and > 0"));
@@ -174,6 +177,16 @@ BagWriter::BagWriter(std::string folder, BagWriterOptions options)
   if (!errors.empty()) throw ConfigError("bag writer: " + errors.front());
   namespace fs = std::filesystem;
   while (folder_.size() > 1 && folder_.back() == '/') folder_.pop_back();
+  if (options_.single_file) {
+    McapWriterOptions mcap_options;
+    mcap_options.compression = options_.compression;
+    mcap_options.chunk_size_bytes = options_.chunk_size_bytes;
+    mcap_ = std::make_unique<McapWriter>(folder_, mcap_options);
+    if (options_.clock_rate_hz > 0.0) {
+      clock_period_ns_ = std::max<std::int64_t>(1, std::llround(1e9 / options_.clock_rate_hz));
+    }
+    return;
+  }
   if (fs::exists(folder_)) throw std::runtime_error(folder_ + ": already exists");
   tmp_folder_ = folder_ + ".tmp" + std::to_string(::getpid());
   fs::remove_all(tmp_folder_);
@@ -201,7 +214,7 @@ BagWriter::~BagWriter() {
     mcap_.reset();
     sqlite_.reset();
     std::error_code ec;
-    std::filesystem::remove_all(tmp_folder_, ec);
+    std::filesystem::remove_all(options_.single_file ? folder_ : tmp_folder_, ec);
   }
 }
 
@@ -233,12 +246,12 @@ BagWriter::Topic& BagWriter::GetTopic(const std::string& name, int type, bool la
   return topics_.back();
 }
 
-void BagWriter::Emit(Topic& topic, Time time) {
+void BagWriter::Emit(Topic& topic, Time time, std::string_view payload) {
   const auto t = static_cast<std::uint64_t>(time.ns);
   if (mcap_) {
-    mcap_->WriteMessage(topic.mcap_channel, topic.sequence, t, t, buffer_);
+    mcap_->WriteMessage(topic.mcap_channel, topic.sequence, t, t, payload);
   } else {
-    sqlite_->WriteMessage(topic.sqlite_id, time.ns, buffer_);
+    sqlite_->WriteMessage(topic.sqlite_id, time.ns, payload);
   }
   ++topic.sequence;
   ++topic.count;
@@ -319,9 +332,42 @@ void BagWriter::Write(const Record& record) {
   }
 }
 
+void BagWriter::WriteMessage(const std::string& topic, RosType type, bool latched, Time time,
+                             std::string_view cdr) {
+  if (time.ns < 0) {
+    throw std::invalid_argument("bag writer: " + topic + " at " + std::to_string(time.ns) +
+                                " ns is before 0");
+  }
+  Emit(GetTopic(topic, static_cast<int>(type), latched), time, cdr);
+}
+
+void BagWriter::AddStaticTransform(const RosTransform& transform, Time time) {
+  static_extra_.push_back(transform);
+  EmitStaticTransforms(time);
+}
+
+void BagWriter::FlushChunk() {
+  if (mcap_) mcap_->FlushChunk();
+}
+
 void BagWriter::EmitStaticTransforms(Time time) {
   const BagFrames& f = options_.frames;
-  if (!static_rgb_) {
+  static_time_ = time;
+  if (!static_extra_.empty()) {
+    std::vector<RosTransform3d> all;
+    if (static_laser_) {
+      all.push_back(RosTransform3d::From(RosTransform{time, f.base, f.laser, *static_laser_}));
+    }
+    if (static_rgb_) {
+      all.push_back(RosTransform3d::From(time, f.base, f.camera, *static_rgb_));
+      all.push_back(RosTransform3d::From(time, f.base, f.depth, *static_depth_));
+    }
+    for (RosTransform t : static_extra_) {
+      t.time = time;
+      all.push_back(RosTransform3d::From(t));
+    }
+    EncodeTfMessage(all, &buffer_);
+  } else if (!static_rgb_) {
     // The laser alone: the planar message every bag without a camera has always had.
     EncodeTfMessage({{time, f.base, f.laser, *static_laser_}}, &buffer_);
   } else {
@@ -380,6 +426,12 @@ std::string BagWriter::MetadataYaml() const {
 
 void BagWriter::Commit() {
   if (committed_) return;
+  if (options_.single_file) {
+    mcap_->Close();
+    mcap_.reset();
+    committed_ = true;
+    return;
+  }
   const std::string metadata = MetadataYaml();
   if (mcap_) {
     mcap_->Close();

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "slam/io/bag/mcap_writer.h"
+#include "slam/io/bag/ros_messages.h"
 #include "slam/io/dataset.h"
 #include "slam/types/records.h"
 
@@ -72,6 +73,10 @@ struct BagWriterOptions {
   bool write_tf = true;
   /// Rate of /clock messages, stamped with record times; 0 writes none.
   double clock_rate_hz = 100.0;
+  /// MCAP only: write one .mcap file at the writer's path instead of a rosbag2 folder: no
+  /// metadata.yaml and no rename; the caller picks a temporary name and renames it after
+  /// Commit(). Destroying an uncommitted writer removes the file.
+  bool single_file = false;
 
   /// One RuleViolation() message per broken rule; empty when valid.
   std::vector<std::string> Validate() const;
@@ -126,11 +131,22 @@ class BagWriter {
   void Write(const Record& record);
   /// Writes one reference pose to the ground-truth topic.
   void Write(const GroundTruthPose& truth);
+  /// Writes one CDR payload of `type` on `topic` (registered on first use; transient-local QoS
+  /// when `latched`), with log, publish and header time `time`. Messages may be written out of
+  /// time order: MCAP readers order them by their indexes.
+  void WriteMessage(const std::string& topic, RosType type, bool latched, Time time,
+                    std::string_view cdr);
+  /// Adds a planar transform to the ones /tf_static carries, and writes /tf_static at `time`.
+  void AddStaticTransform(const RosTransform& transform, Time time);
+  /// MCAP only: closes the open chunk, so that what follows is in chunks of its own.
+  void FlushChunk();
   /// Closes the storage file, writes metadata.yaml and renames the folder into place.
   void Commit();
 
   /// Messages written so far.
   std::uint64_t message_count() const { return message_count_; }
+  /// The time of the last /tf_static message, if one was written.
+  std::optional<Time> static_time() const { return static_time_; }
 
  private:
   struct Topic {
@@ -144,7 +160,8 @@ class BagWriter {
   };
 
   Topic& GetTopic(const std::string& name, int type, bool latched);
-  void Emit(Topic& topic, Time time);
+  void Emit(Topic& topic, Time time) { Emit(topic, time, buffer_); }
+  void Emit(Topic& topic, Time time, std::string_view payload);
   void MaybeClock(Time time);
   std::string MetadataYaml() const;
   std::string TicksText() const;
@@ -162,6 +179,8 @@ class BagWriter {
   std::optional<Pose2> static_laser_;
   std::optional<Eigen::Isometry3d> static_rgb_;    // base_from_optical of the colour camera
   std::optional<Eigen::Isometry3d> static_depth_;  // and of the depth camera
+  std::vector<RosTransform> static_extra_;         // AddStaticTransform's
+  std::optional<Time> static_time_;
   std::vector<std::int64_t> tick_totals_;
   std::size_t right_wheels_ = 0;
   std::vector<std::string> joint_names_;

@@ -53,6 +53,8 @@ class McapWriter {
   /// Appends one Message record to the open chunk.
   void WriteMessage(std::uint16_t channel_id, std::uint32_t sequence, std::uint64_t log_time_ns,
                     std::uint64_t publish_time_ns, std::string_view data);
+  /// Closes the open chunk (if any), so that the next message starts a new one.
+  void FlushChunk();
   /// Flushes the last chunk, writes the summary and footer, and closes the file.
   void Close();
 
@@ -64,7 +66,6 @@ class McapWriter {
   };
 
   void Write(std::string_view bytes);
-  void FlushChunk();
 
   std::string path_;
   McapWriterOptions options_;

@@ -79,12 +79,35 @@ const std::map<std::string, std::string>& NestedDefinitions() {
        "uint32 x_offset\nuint32 y_offset\nuint32 height\nuint32 width\nbool do_rectify\n"},
       {"geometry_msgs/TransformStamped",
        "std_msgs/Header header\nstring child_frame_id\ngeometry_msgs/Transform transform\n"},
+      {"builtin_interfaces/Duration", "int32 sec\nuint32 nanosec\n"},
+      {"geometry_msgs/PoseStamped", "std_msgs/Header header\ngeometry_msgs/Pose pose\n"},
+      {"nav_msgs/MapMetaData",
+       "builtin_interfaces/Time map_load_time\nfloat32 resolution\nuint32 width\nuint32 height\n"
+       "geometry_msgs/Pose origin\n"},
+      {"std_msgs/ColorRGBA", "float32 r\nfloat32 g\nfloat32 b\nfloat32 a\n"},
+      {"sensor_msgs/CompressedImage", "std_msgs/Header header\nstring format\nuint8[] data\n"},
+      {"visualization_msgs/UVCoordinate", "float32 u\nfloat32 v\n"},
+      {"visualization_msgs/MeshFile", "string filename\nuint8[] data\n"},
+      {"visualization_msgs/Marker",
+       "int32 ARROW=0\nint32 CUBE=1\nint32 SPHERE=2\nint32 CYLINDER=3\nint32 LINE_STRIP=4\n"
+       "int32 LINE_LIST=5\nint32 CUBE_LIST=6\nint32 SPHERE_LIST=7\nint32 POINTS=8\n"
+       "int32 TEXT_VIEW_FACING=9\nint32 MESH_RESOURCE=10\nint32 TRIANGLE_LIST=11\nint32 ADD=0\n"
+       "int32 MODIFY=0\nint32 DELETE=2\nint32 DELETEALL=3\nstd_msgs/Header header\nstring ns\n"
+       "int32 id\nint32 type\nint32 action\ngeometry_msgs/Pose pose\n"
+       "geometry_msgs/Vector3 scale\nstd_msgs/ColorRGBA color\n"
+       "builtin_interfaces/Duration lifetime\nbool frame_locked\ngeometry_msgs/Point[] points\n"
+       "std_msgs/ColorRGBA[] colors\nstring texture_resource\n"
+       "sensor_msgs/CompressedImage texture\nvisualization_msgs/UVCoordinate[] uv_coordinates\n"
+       "string text\nstring mesh_resource\nvisualization_msgs/MeshFile mesh_file\n"
+       "bool mesh_use_embedded_materials\n"},
   };
   return defs;
 }
 
+constexpr std::size_t kTypeCount = std::size(kAllRosTypes);
+
 const TypeInfo& Info(RosType type) {
-  static const std::array<TypeInfo, 8> infos = {{
+  static const std::array<TypeInfo, kTypeCount> infos = {{
       {"sensor_msgs/msg/LaserScan",
        "std_msgs/Header header\nfloat32 angle_min\nfloat32 angle_max\nfloat32 angle_increment\n"
        "float32 time_increment\nfloat32 scan_time\nfloat32 range_min\nfloat32 range_max\n"
@@ -109,6 +132,18 @@ const TypeInfo& Info(RosType type) {
        "std_msgs/Header header\nuint32 height\nuint32 width\nstring distortion_model\n"
        "float64[] d\nfloat64[9] k\nfloat64[9] r\nfloat64[12] p\nuint32 binning_x\n"
        "uint32 binning_y\nsensor_msgs/RegionOfInterest roi\n"},
+      {"geometry_msgs/msg/PoseStamped", "std_msgs/Header header\ngeometry_msgs/Pose pose\n"},
+      {"geometry_msgs/msg/PoseWithCovarianceStamped",
+       "std_msgs/Header header\ngeometry_msgs/PoseWithCovariance pose\n"},
+      {"nav_msgs/msg/Path", "std_msgs/Header header\ngeometry_msgs/PoseStamped[] poses\n"},
+      {"geometry_msgs/msg/PoseArray", "std_msgs/Header header\ngeometry_msgs/Pose[] poses\n"},
+      {"nav_msgs/msg/OccupancyGrid",
+       "std_msgs/Header header\nnav_msgs/MapMetaData info\nint8[] data\n"},
+      {"visualization_msgs/msg/MarkerArray", "visualization_msgs/Marker[] markers\n"},
+      {"std_msgs/msg/String", "string data\n"},
+      {"std_msgs/msg/Float64", "float64 data\n"},
+      {"geometry_msgs/msg/Vector3Stamped",
+       "std_msgs/Header header\ngeometry_msgs/Vector3 vector\n"},
   }};
   return infos[static_cast<std::size_t>(type)];
 }
@@ -164,8 +199,8 @@ void AppendDependencies(std::string_view fields, std::set<std::string>* seen, st
 }  // namespace
 
 const std::string& RosMessageDefinition(RosType type) {
-  static const std::array<std::string, 8> texts = [] {
-    std::array<std::string, 8> t;
+  static const std::array<std::string, kTypeCount> texts = [] {
+    std::array<std::string, kTypeCount> t;
     for (RosType ty : kAllRosTypes) {
       std::string text = Info(ty).fields;
       std::set<std::string> seen;
@@ -417,6 +452,136 @@ std::vector<RosTransform> DecodeTfMessage(std::string_view data) {
                                 YawFromQuaternion(q.x(), q.y(), q.z(), q.w()))});
   }
   return transforms;
+}
+
+namespace {
+
+// geometry_msgs/Pose of a planar pose.
+void WritePose(const Pose2& pose, CdrWriter* w) {
+  w->Float64(pose.x());
+  w->Float64(pose.y());
+  w->Float64(0.0);
+  WriteYawQuaternion(pose.theta(), w);
+}
+
+void WriteColor(const RosColor& c, CdrWriter* w) {
+  w->Float32(c.r);
+  w->Float32(c.g);
+  w->Float32(c.b);
+  w->Float32(c.a);
+}
+
+void WriteMarker(const RosMarker& m, CdrWriter* w) {
+  WriteHeader(m.time, m.frame_id, w);
+  w->String(m.ns);
+  w->Int32(m.id);
+  w->Int32(m.type);
+  w->Int32(m.action);
+  WritePose(m.pose, w);
+  for (int i = 0; i < 3; ++i) w->Float64(m.scale[i]);
+  WriteColor(m.color, w);
+  w->Int32(0);   // lifetime.sec: 0 = forever
+  w->Uint32(0);  // lifetime.nanosec
+  w->Uint8(0);   // frame_locked
+  w->Uint32(static_cast<std::uint32_t>(m.points.size()));
+  for (const Eigen::Vector2d& p : m.points) {
+    w->Float64(p.x());
+    w->Float64(p.y());
+    w->Float64(0.0);
+  }
+  w->Uint32(static_cast<std::uint32_t>(m.colors.size()));
+  for (const RosColor& c : m.colors) WriteColor(c, w);
+  w->String("");                // texture_resource
+  WriteHeader(Time{0}, "", w);  // texture: an empty CompressedImage
+  w->String("");                // texture.format
+  w->ByteSequence({});          // texture.data
+  w->Uint32(0);                 // uv_coordinates
+  w->String(m.text);
+  w->String("");        // mesh_resource
+  w->String("");        // mesh_file.filename
+  w->ByteSequence({});  // mesh_file.data
+  w->Uint8(0);          // mesh_use_embedded_materials
+}
+
+}  // namespace
+
+void EncodePoseStamped(Time time, std::string_view frame_id, const Pose2& pose, std::string* out) {
+  CdrWriter w(out);
+  WriteHeader(time, frame_id, &w);
+  WritePose(pose, &w);
+}
+
+void EncodePoseWithCovarianceStamped(Time time, std::string_view frame_id, const Pose2& pose,
+                                     const Eigen::Matrix3d& covariance, std::string* out) {
+  CdrWriter w(out);
+  WriteHeader(time, frame_id, &w);
+  WritePose(pose, &w);
+  // ROS order (x, y, z, rotation about x, y, z): the planar (x, y, yaw) sit at 0, 1 and 5.
+  constexpr int kIndex[3] = {0, 1, 5};
+  std::array<double, 36> full{};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c)
+      full[static_cast<std::size_t>(kIndex[r] * 6 + kIndex[c])] = covariance(r, c);
+  }
+  w.Float64Array(full);
+}
+
+void EncodePath(Time time, std::string_view frame_id, std::span<const StampedPose> poses,
+                std::string* out) {
+  CdrWriter w(out);
+  WriteHeader(time, frame_id, &w);
+  w.Uint32(static_cast<std::uint32_t>(poses.size()));
+  for (const StampedPose& p : poses) {
+    WriteHeader(p.time, frame_id, &w);
+    WritePose(p.pose, &w);
+  }
+}
+
+void EncodePoseArray(Time time, std::string_view frame_id, std::span<const Pose2> poses,
+                     std::string* out) {
+  CdrWriter w(out);
+  WriteHeader(time, frame_id, &w);
+  w.Uint32(static_cast<std::uint32_t>(poses.size()));
+  for (const Pose2& p : poses) WritePose(p, &w);
+}
+
+void EncodeOccupancyGrid(const RosOccupancyGrid& grid, std::string* out) {
+  if (grid.data.size() != static_cast<std::size_t>(grid.width) * grid.height) {
+    throw std::invalid_argument("occupancy grid: " + std::to_string(grid.data.size()) +
+                                " cells for " + std::to_string(grid.width) + " x " +
+                                std::to_string(grid.height));
+  }
+  CdrWriter w(out);
+  WriteHeader(grid.time, grid.frame_id, &w);
+  WriteStamp(grid.time, &w);
+  w.Float32(grid.resolution_m);
+  w.Uint32(grid.width);
+  w.Uint32(grid.height);
+  WritePose(grid.origin, &w);
+  w.ByteSequence({reinterpret_cast<const std::uint8_t*>(grid.data.data()), grid.data.size()});
+}
+
+void EncodeMarkerArray(std::span<const RosMarker> markers, std::string* out) {
+  CdrWriter w(out);
+  w.Uint32(static_cast<std::uint32_t>(markers.size()));
+  for (const RosMarker& m : markers) WriteMarker(m, &w);
+}
+
+void EncodeString(std::string_view text, std::string* out) {
+  CdrWriter w(out);
+  w.String(text);
+}
+
+void EncodeFloat64(double value, std::string* out) {
+  CdrWriter w(out);
+  w.Float64(value);
+}
+
+void EncodeVector3Stamped(Time time, std::string_view frame_id, const Eigen::Vector3d& v,
+                          std::string* out) {
+  CdrWriter w(out);
+  WriteHeader(time, frame_id, &w);
+  for (int i = 0; i < 3; ++i) w.Float64(v[i]);
 }
 
 void EncodeClock(Time time, std::string* out) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "slam/types/records.h"
+#include "slam/types/trajectory.h"
 
 namespace slamrig::slam {
 
@@ -22,13 +23,29 @@ enum class RosType {
   kTfMessage,
   kClock,
   kImage,
-  kCameraInfo
+  kCameraInfo,
+  kPoseStamped,
+  kPoseWithCovarianceStamped,
+  kPath,
+  kPoseArray,
+  kOccupancyGrid,
+  kMarkerArray,
+  kString,
+  kFloat64,
+  kVector3Stamped
 };
 
 /// All types, in a fixed order.
 inline constexpr RosType kAllRosTypes[] = {
-    RosType::kLaserScan, RosType::kImu,   RosType::kJointState, RosType::kOdometry,
-    RosType::kTfMessage, RosType::kClock, RosType::kImage,      RosType::kCameraInfo};
+    RosType::kLaserScan,     RosType::kImu,
+    RosType::kJointState,    RosType::kOdometry,
+    RosType::kTfMessage,     RosType::kClock,
+    RosType::kImage,         RosType::kCameraInfo,
+    RosType::kPoseStamped,   RosType::kPoseWithCovarianceStamped,
+    RosType::kPath,          RosType::kPoseArray,
+    RosType::kOccupancyGrid, RosType::kMarkerArray,
+    RosType::kString,        RosType::kFloat64,
+    RosType::kVector3Stamped};
 
 /// The type's ROS 2 name, e.g. "sensor_msgs/msg/LaserScan".
 std::string_view RosTypeName(RosType type);
@@ -111,6 +128,80 @@ void EncodeDepthImage(const RgbdFrame& frame, std::string_view frame_id, std::st
 /// sensor_msgs/CameraInfo of `frame`'s intrinsics: no distortion ("plumb_bob", five zeros),
 /// R identity, P = [K | 0].
 void EncodeCameraInfo(const RgbdFrame& frame, std::string_view frame_id, std::string* out);
+
+// The visualisation messages of a recorded run (slamrig run --record): planar poses at z = 0
+// with a yaw quaternion, as in EncodeOdometry.
+
+/// geometry_msgs/msg/PoseStamped.
+void EncodePoseStamped(Time time, std::string_view frame_id, const Pose2& pose, std::string* out);
+/// geometry_msgs/msg/PoseWithCovarianceStamped; `covariance` of (x, y, yaw) fills the rows and
+/// columns x, y and rotation about z of the 6x6 matrix, the rest is zero.
+void EncodePoseWithCovarianceStamped(Time time, std::string_view frame_id, const Pose2& pose,
+                                     const Eigen::Matrix3d& covariance, std::string* out);
+/// nav_msgs/msg/Path: each pose a PoseStamped with its own time, all in `frame_id`.
+void EncodePath(Time time, std::string_view frame_id, std::span<const StampedPose> poses,
+                std::string* out);
+/// geometry_msgs/msg/PoseArray.
+void EncodePoseArray(Time time, std::string_view frame_id, std::span<const Pose2> poses,
+                     std::string* out);
+
+/// A nav_msgs/OccupancyGrid: cells row by row from the origin cell, row = y; values 0..100
+/// (occupancy probability in percent) or -1 (unknown).
+struct RosOccupancyGrid {
+  Time time;
+  std::string frame_id;
+  float resolution_m = 0.05f;
+  std::uint32_t width = 0, height = 0;
+  Pose2 origin;  ///< the corner of cell (0, 0) in frame_id
+  std::vector<std::int8_t> data;
+};
+/// nav_msgs/msg/OccupancyGrid (map_load_time = time).
+void EncodeOccupancyGrid(const RosOccupancyGrid& grid, std::string* out);
+
+/// An RGBA colour, each in [0, 1].
+struct RosColor {
+  float r = 0.0f, g = 0.0f, b = 0.0f, a = 1.0f;
+};
+
+/// A visualization_msgs/Marker reduced to what slamrig draws: points in the marker's frame
+/// (z = 0), a pose, scale, colour, optional per-point colours and text.
+struct RosMarker {
+  /// Marker::type values (visualization_msgs/Marker's constants).
+  enum Type : std::int32_t {
+    kArrow = 0,
+    kCube = 1,
+    kSphere = 2,
+    kCylinder = 3,
+    kLineStrip = 4,
+    kLineList = 5,
+    kSphereList = 7,
+    kPoints = 8,
+    kText = 9,
+  };
+  Time time;
+  std::string frame_id;
+  std::string ns;
+  std::int32_t id = 0;
+  std::int32_t type = kSphere;
+  std::int32_t action = 0;  ///< 0 ADD, 2 DELETE, 3 DELETEALL
+  Pose2 pose;
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+  RosColor color;
+  std::vector<Eigen::Vector2d> points;
+  std::vector<RosColor> colors;  ///< one per point, or empty
+  std::string text;
+};
+/// visualization_msgs/msg/MarkerArray (ROS 2 Humble's Marker, lifetime 0 = forever, no
+/// texture or mesh).
+void EncodeMarkerArray(std::span<const RosMarker> markers, std::string* out);
+
+/// std_msgs/msg/String.
+void EncodeString(std::string_view text, std::string* out);
+/// std_msgs/msg/Float64.
+void EncodeFloat64(double value, std::string* out);
+/// geometry_msgs/msg/Vector3Stamped.
+void EncodeVector3Stamped(Time time, std::string_view frame_id, const Eigen::Vector3d& v,
+                          std::string* out);
 
 // Decoders: throw CdrError (slam/io/bag/cdr.h) when the payload is too short or a length is bad.
 

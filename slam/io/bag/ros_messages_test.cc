@@ -238,7 +238,7 @@ TEST(RosMessagesTest, DefinitionsNameEveryNestedTypeOnce) {
             std::string::npos);
   EXPECT_EQ(RosTypeFromName("sensor_msgs/LaserScan"), RosType::kLaserScan);
   EXPECT_EQ(RosTypeFromName("nav_msgs/msg/Odometry"), RosType::kOdometry);
-  EXPECT_EQ(RosTypeFromName("nav_msgs/msg/Path"), std::nullopt);
+  EXPECT_EQ(RosTypeFromName("nav_msgs/msg/GridCells"), std::nullopt);
 }
 
 TEST(Crc32Test, KnownVectors) {
