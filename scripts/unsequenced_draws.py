@@ -53,51 +53,19 @@ TOKEN = re.compile(r"\s*(?:([A-Za-z_]\w*)|(\d[\w.']*(?:[eEpP][-+]\d+)?\w*)|(" + 
                    r")|(\S))")
 
 
+BLANKED = re.compile(r"//[^\n]*|/\*.*?\*/|\bR\"([^(\s]*)\(.*?\)\1\"|\"(?:\\.|[^\"\\\n])*\"|"
+                     r"(?<![\w'])'(?:\\.|[^'\\\n])*'|^[ \t]*#(?:\\\n|[^\n])*", re.S | re.M)
+
+
 def StripComments(text):
-    """The source with comments, string/char literals and preprocessor lines blanked out; newlines
-    are kept so that offsets keep their line numbers."""
-    out, i, n = [], 0, len(text)
-    at_line_start = True
-    while i < n:
-        c = text[i]
-        if at_line_start and c == "#" :
-            j = i
-            while j < n and (text[j] != "\n" or text[j - 1] == "\\"):
-                j += 1
-            out.append(re.sub(r"[^\n]", " ", text[i:j]))
-            i = j
-            continue
-        if c == "\n":
-            at_line_start = True
-        elif not c.isspace():
-            at_line_start = False
-        if text.startswith("//", i):
-            j = text.find("\n", i)
-            j = n if j < 0 else j
-            out.append(" " * (j - i))
-            i = j
-        elif text.startswith("/*", i):
-            j = text.find("*/", i + 2)
-            j = n if j < 0 else j + 2
-            out.append(re.sub(r"[^\n]", " ", text[i:j]))
-            i = j
-        elif c == "R" and text.startswith('R"', i) and (i == 0 or not text[i - 1].isalnum()):
-            m = re.match(r'R"([^(\s]*)\(', text[i:])
-            end = text.find(")" + m.group(1) + '"', i) if m else -1
-            j = n if end < 0 else end + len(m.group(1)) + 2
-            out.append('0' + re.sub(r"[^\n]", " ", text[i + 1:j]))
-            i = j
-        elif c in "\"'" and not (c == "'" and i > 0 and text[i - 1].isalnum()):
-            j = i + 1
-            while j < n and text[j] != c and text[j] != "\n":
-                j += 2 if text[j] == "\\" else 1
-            j = min(j + 1, n)
-            out.append("0" + " " * (j - i - 1))
-            i = j
-        else:
-            out.append(c)
-            i += 1
-    return "".join(out)
+    """The source with comments, string/char literals and preprocessor lines blanked out (a
+    literal becomes the token 0); newlines are kept so that offsets keep their line numbers."""
+
+    def Blank(m):
+        kept = re.sub(r"[^\n]", " ", m.group(0))
+        return "0" + kept[1:] if m.group(0)[0] in "\"'R" else kept
+
+    return BLANKED.sub(Blank, text)
 
 
 def Tokens(text):
@@ -295,7 +263,8 @@ ANY_ENGINE = re.compile(r"\b(?:\w+_)?(?:rng|engine)_?\b|\b(?:" + ENGINE_TYPES + 
 
 
 def Findings(path, text):
-    if not ANY_ENGINE.search(text):
+    lower = text.lower()
+    if "rng" not in lower and "engine" not in lower and not ANY_ENGINE.search(text):
         return []  # most files: no engine, nothing draws (a fast path, same answer)
     return Scan(path, text).Run()
 
