@@ -189,8 +189,9 @@ TEST(TextureRunTest, ErrorPartsPutADistortionInSlowAndNoiseInJitter) {
   for (const StampedPose& p : d.truth.poses()) {
     const double grow = 0.05 * p.time.seconds() / 6.0;
     bent.Append(p.time, Pose2(p.pose.x() + grow, p.pose.y(), p.pose.theta()));
-    noisy.Append(p.time,
-                 Pose2(p.pose.x() + xy(rng), p.pose.y() + xy(rng), p.pose.theta() + yaw(rng)));
+    // Sequenced draws, the last coordinate first (the order these cases were generated in).
+    const double dtheta = yaw(rng), dy = xy(rng), dx = xy(rng);
+    noisy.Append(p.time, Pose2(p.pose.x() + dx, p.pose.y() + dy, p.pose.theta() + dtheta));
   }
   for (const Trajectory* t : {&bent, &noisy}) {
     const double full = truth_db - *d.run.WithAlignedPoses(*t, d.truth).score.psnr_db;

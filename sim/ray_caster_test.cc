@@ -82,13 +82,16 @@ struct RandomWorld {
     for (int i = 0; i < 60; ++i) {
       b2Body* body = i % 5 == 0 ? mover : ground;
       const b2Transform xf = body->GetTransform();
-      const b2Vec2 c(static_cast<float>(uniform(0, 20)), static_cast<float>(uniform(0, 20)));
+      // Every pair or triple of draws here is sequenced, the last argument first: the order the
+      // scenes were generated in (a call's arguments are drawn in the compiler's order).
+      const auto cy = static_cast<float>(uniform(0, 20));
+      const b2Vec2 c(static_cast<float>(uniform(0, 20)), cy);
       switch (i % 4) {
         case 0: {
           b2PolygonShape box;
-          box.SetAsBox(static_cast<float>(uniform(0.05, 1.5)),
-                       static_cast<float>(uniform(0.05, 1.5)), c,
-                       static_cast<float>(uniform(-3, 3)));
+          const auto angle = static_cast<float>(uniform(-3, 3));
+          const auto hy = static_cast<float>(uniform(0.05, 1.5));
+          box.SetAsBox(static_cast<float>(uniform(0.05, 1.5)), hy, c, angle);
           body->CreateFixture(&box, 1.0f);
           for (int k = 0; k < box.m_count; ++k) vertices.push_back(World(xf, box.m_vertices[k]));
           break;
@@ -119,7 +122,8 @@ struct RandomWorld {
         }
         default: {
           b2EdgeShape edge;
-          const b2Vec2 d(static_cast<float>(uniform(-3, 3)), static_cast<float>(uniform(-3, 3)));
+          const auto dy = static_cast<float>(uniform(-3, 3));
+          const b2Vec2 d(static_cast<float>(uniform(-3, 3)), dy);
           edge.SetTwoSided(c, c + d);
           body->CreateFixture(&edge, 0.0f);
           vertices.push_back(World(xf, c));
@@ -208,6 +212,13 @@ double ExactCircleRange(const b2Fixture* fixture, const Ray& ray, double* box2d_
   return -b - std::sqrt(b * b - (s.squaredNorm() - radius * radius));
 }
 
+// (sx * u, sy * v) for two uniform draws u, v; v is drawn first, the order the cases here were
+// generated in (the arguments of one call are drawn in the compiler's order).
+Eigen::Vector2d RandomPoint(RandomStream& rng, double sx, double sy) {
+  const double y = sy * rng.Uniform();
+  return {sx * rng.Uniform(), y};
+}
+
 TEST(RayCasterTest, AgreesWithBox2dRayCastOnRandomWorlds) {
   int rays = 0, hits = 0, grazing_corners = 0, grazing_incidence = 0, circle_hits = 0;
   double max_difference_m = 0.0, max_circle_error_m = 0.0;
@@ -216,13 +227,11 @@ TEST(RayCasterTest, AgreesWithBox2dRayCastOnRandomWorlds) {
     RayCaster caster(&w.world, w.robot);
     RandomStream rng(seed, "origins");
     for (int trial = 0; trial < 12; ++trial) {
-      const Eigen::Vector2d origin(20.0 * rng.Uniform(), 20.0 * rng.Uniform());
+      const Eigen::Vector2d origin = RandomPoint(rng, 20.0, 20.0);
       const double heading = 2.0 * std::numbers::pi * rng.Uniform();
       // Half the fans sweep from a fixed origin, half from a moving, turning one.
       const bool moving = trial % 2 == 1;
-      const Eigen::Vector2d motion =
-          moving ? Eigen::Vector2d(0.3 * rng.Uniform(), -0.2 * rng.Uniform())
-                 : Eigen::Vector2d::Zero();
+      const Eigen::Vector2d motion = moving ? RandomPoint(rng, 0.3, -0.2) : Eigen::Vector2d::Zero();
       const double turn = moving ? 0.02 * rng.Uniform() : 0.0;
       const double fov = trial % 4 < 2 ? 1.5 * std::numbers::pi : 1.98 * std::numbers::pi;
       const auto fan = Fan(origin, heading, fov, 1081, motion, turn);
@@ -369,10 +378,11 @@ TEST(RayCasterTest, CullingNeverChangesABitAgainstBruteForce) {
     ASSERT_NE(mover, nullptr);
     for (int trial = 0; trial < 6; ++trial) {
       // The moving body goes elsewhere between fans: its shapes are placed at cast time.
+      const auto angle = static_cast<float>(3.0 * rng.Uniform());  // drawn before the position
+      const Eigen::Vector2d position = RandomPoint(rng, 4.0, -4.0);
       mover->SetTransform(
-          b2Vec2(static_cast<float>(4.0 * rng.Uniform()), static_cast<float>(-4.0 * rng.Uniform())),
-          static_cast<float>(3.0 * rng.Uniform()));
-      const Eigen::Vector2d origin(20.0 * rng.Uniform(), 20.0 * rng.Uniform());
+          b2Vec2(static_cast<float>(position.x()), static_cast<float>(position.y())), angle);
+      const Eigen::Vector2d origin = RandomPoint(rng, 20.0, 20.0);
       const bool moving = trial % 2 == 1;
       const Eigen::Vector2d motion =
           moving ? Eigen::Vector2d(0.4 * rng.Uniform(), 0.1) : Eigen::Vector2d::Zero();

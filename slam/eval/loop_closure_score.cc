@@ -8,15 +8,13 @@
 namespace slamrig::slam {
 
 std::vector<std::string> LoopClosureScoreOptions::Validate() const {
-  std::vector<std::string> errors;
-  for (const auto& [field, value] : {std::pair{"tolerance_m", tolerance_m},
-                                     {"tolerance_rad", tolerance_rad},
-                                     {"revisit_radius_m", revisit_radius_m},
-                                     {"revisit_min_path_m", revisit_min_path_m},
-                                     {"episode_gap_m", episode_gap_m}}) {
-    if (!(value > 0.0)) errors.push_back(RuleViolation(field, value, "must be > 0"));
-  }
-  return errors;
+  Rules rules;
+  rules.Positive("tolerance_m", tolerance_m)
+      .Positive("tolerance_rad", tolerance_rad)
+      .Positive("revisit_radius_m", revisit_radius_m)
+      .Positive("revisit_min_path_m", revisit_min_path_m)
+      .Positive("episode_gap_m", episode_gap_m);
+  return rules.errors();
 }
 
 LoopClosureScore ScoreLoopClosures(const std::vector<LoopClosure>& closures,

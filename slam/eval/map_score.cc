@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <sstream>
 #include <unordered_set>
 
 #include "slam/types/check.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::slam {
 namespace {
@@ -26,17 +26,11 @@ bool HasWithin(const std::unordered_set<std::int64_t>& cells, int x, int y, int 
 }  // namespace
 
 std::vector<std::string> MapScoreOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (tolerance_cells < 0) {
-    errors.push_back("map_score.tolerance_cells = " + std::to_string(tolerance_cells) +
-                     "; must be >= 0");
-  }
-  if (!(occupied_probability > 0.5 && occupied_probability < 1.0)) {
-    std::ostringstream s;
-    s << "map_score.occupied_probability = " << occupied_probability << "; must be in (0.5, 1)";
-    errors.push_back(s.str());
-  }
-  return errors;
+  Rules rules;
+  rules.NonNegative("tolerance_cells", tolerance_cells)
+      .Require(occupied_probability > 0.5 && occupied_probability < 1.0, "occupied_probability",
+               occupied_probability, "must be in (0.5, 1)");
+  return PrefixErrors("map_score", rules.errors());
 }
 
 MapScore ScoreMap(const OccupancyGrid& estimate, const Pose2& truth_from_estimate,

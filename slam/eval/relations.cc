@@ -11,27 +11,16 @@
 
 #include "slam/odometry/gaussian.h"
 #include "slam/types/error.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::slam {
 
 std::vector<std::string> RelationGeneratorOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (consecutive_step < 0) {
-    errors.push_back("relations.consecutive_step = " + std::to_string(consecutive_step) +
-                     "; must be >= 0");
-  }
-  for (const double d : path_distances_m) {
-    if (!(d > 0.0)) {
-      std::ostringstream s;
-      s << "relations.path_distances_m = " << d << "; must be > 0";
-      errors.push_back(s.str());
-    }
-  }
-  if (num_random_pairs < 0) {
-    errors.push_back("relations.num_random_pairs = " + std::to_string(num_random_pairs) +
-                     "; must be >= 0");
-  }
-  return errors;
+  Rules rules;
+  rules.NonNegative("consecutive_step", consecutive_step);
+  for (const double d : path_distances_m) rules.Positive("path_distances_m", d);
+  rules.NonNegative("num_random_pairs", num_random_pairs);
+  return PrefixErrors("relations", rules.errors());
 }
 
 std::vector<Relation> GenerateRelations(const Trajectory& reference,

@@ -25,27 +25,20 @@ int LandmarkRow(int j) { return kP + 2 * j; }
 }  // namespace
 
 std::vector<std::string> EkfSlamOptions::Validate() const {
-  std::vector<std::string> errors = motion.Validate();
-  AppendErrors(&errors, PrefixErrors("extraction", extraction.Validate()));
-  if (!(gate_probability > 0.0 && gate_probability < 1.0)) {
-    errors.push_back(RuleViolation("gate_probability", gate_probability, "must be in (0, 1)"));
-  }
-  if (!(new_landmark_gate_probability >= gate_probability && new_landmark_gate_probability < 1.0)) {
-    errors.push_back(RuleViolation("new_landmark_gate_probability", new_landmark_gate_probability,
-                                   "must be in [gate_probability, 1)"));
-  }
-  if (min_sightings < 1)
-    errors.push_back(RuleViolation("min_sightings", min_sightings, "must be >= 1"));
-  if (!(tentative_radius_m > 0.0)) {
-    errors.push_back(RuleViolation("tentative_radius_m", tentative_radius_m, "must be > 0"));
-  }
-  if (tentative_max_age_scans < 1) {
-    errors.push_back(
-        RuleViolation("tentative_max_age_scans", tentative_max_age_scans, "must be >= 1"));
-  }
-  if (!(max_range_m >= 0.0))
-    errors.push_back(RuleViolation("max_range_m", max_range_m, "must be >= 0"));
-  return errors;
+  Rules rules;
+  rules.Nested("", motion.Validate())
+      .Nested("extraction", extraction.Validate())
+      .Require(gate_probability > 0.0 && gate_probability < 1.0, "gate_probability",
+               gate_probability, "must be in (0, 1)")
+      .Require(
+          new_landmark_gate_probability >= gate_probability && new_landmark_gate_probability < 1.0,
+          "new_landmark_gate_probability", new_landmark_gate_probability,
+          "must be in [gate_probability, 1)")
+      .AtLeast("min_sightings", min_sightings, 1)
+      .Positive("tentative_radius_m", tentative_radius_m)
+      .AtLeast("tentative_max_age_scans", tentative_max_age_scans, 1)
+      .NonNegative("max_range_m", max_range_m);
+  return rules.errors();
 }
 
 RangeBearingPrediction PredictRangeBearing(const Pose2& pose, const Eigen::Vector2d& landmark) {

@@ -20,8 +20,11 @@ TEST(RangeBearingTest, JacobiansMatchNumericDifferentiation) {
   std::uniform_real_distribution<double> u(-5.0, 5.0);
   const double h = 1e-6;
   for (int trial = 0; trial < 100; ++trial) {
-    const Pose2 pose(u(rng), u(rng), 0.6 * u(rng));
-    const Eigen::Vector2d landmark = pose.translation() + Eigen::Vector2d(u(rng), u(rng));
+    // Sequenced draws, the last coordinate first (the order these cases were generated in).
+    const double theta = 0.6 * u(rng), y = u(rng), x = u(rng);
+    const Pose2 pose(x, y, theta);
+    const double dy = u(rng);
+    const Eigen::Vector2d landmark = pose.translation() + Eigen::Vector2d(u(rng), dy);
     if ((landmark - pose.translation()).norm() < 0.5) continue;
     const RangeBearingPrediction p = PredictRangeBearing(pose, landmark);
     const auto diff = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
@@ -88,7 +91,8 @@ TEST(EkfSlamTest, AugmentationKeepsTheCovarianceSymmetricPsdWithProperCrossTerms
     slam.PredictWheels(0.3, 0.28, 0.4, std::nullopt);
     slam.PredictGyro(0.05, 0.1);
     const Eigen::MatrixXd before = slam.covariance();
-    const Eigen::Vector2d z(u(rng), b(rng));
+    const double bearing = b(rng);  // drawn first: the order these cases were generated in
+    const Eigen::Vector2d z(u(rng), bearing);
     const int index = slam.Augment(z, r);
     EXPECT_EQ(index, i);
     const Eigen::MatrixXd& p = slam.covariance();

@@ -127,31 +127,18 @@ bool LinesAreBetter(double circle_sse_m2, int circle_dof, double lines_sse_m2, i
 }
 
 std::vector<std::string> LandmarkExtractionOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (!(jump_m > 0.0)) errors.push_back(RuleViolation("jump_m", jump_m, "must be > 0"));
-  if (!(jump_rel >= 0.0)) errors.push_back(RuleViolation("jump_rel", jump_rel, "must be >= 0"));
-  if (min_points < 4) {
-    errors.push_back(RuleViolation("min_points", min_points, "must be >= 4 (a circle has 3 dof)"));
-  }
-  if (!(min_radius_m > 0.0))
-    errors.push_back(RuleViolation("min_radius_m", min_radius_m, "must be > 0"));
-  if (!(max_radius_m > min_radius_m)) {
-    errors.push_back(RuleViolation("max_radius_m", max_radius_m, "must be > min_radius_m"));
-  }
-  if (!(max_fit_rms_m > 0.0))
-    errors.push_back(RuleViolation("max_fit_rms_m", max_fit_rms_m, "must be > 0"));
-  if (!(model_test_probability >= 0.5 && model_test_probability < 1.0)) {
-    errors.push_back(
-        RuleViolation("model_test_probability", model_test_probability, "must be in [0.5, 1)"));
-  }
-  if (!(range_sigma_floor_m > 0.0)) {
-    errors.push_back(RuleViolation("range_sigma_floor_m", range_sigma_floor_m, "must be > 0"));
-  }
-  if (!(bearing_sigma_floor_rad > 0.0)) {
-    errors.push_back(
-        RuleViolation("bearing_sigma_floor_rad", bearing_sigma_floor_rad, "must be > 0"));
-  }
-  return errors;
+  Rules rules;
+  rules.Positive("jump_m", jump_m)
+      .NonNegative("jump_rel", jump_rel)
+      .Require(min_points >= 4, "min_points", min_points, "must be >= 4 (a circle has 3 dof)")
+      .Positive("min_radius_m", min_radius_m)
+      .Require(max_radius_m > min_radius_m, "max_radius_m", max_radius_m, "must be > min_radius_m")
+      .Positive("max_fit_rms_m", max_fit_rms_m)
+      .Require(model_test_probability >= 0.5 && model_test_probability < 1.0,
+               "model_test_probability", model_test_probability, "must be in [0.5, 1)")
+      .Positive("range_sigma_floor_m", range_sigma_floor_m)
+      .Positive("bearing_sigma_floor_rad", bearing_sigma_floor_rad);
+  return rules.errors();
 }
 
 std::vector<LandmarkObservation> ExtractLandmarks(const LaserScan& scan,

@@ -220,7 +220,8 @@ TEST(PoseEkfTest, MatcherPoseUpdatesAreConsistentOverMonteCarloRuns) {
   std::normal_distribution<double> normal;
   const auto draw = [&](const Eigen::Matrix3d& cov) {
     const Eigen::Matrix3d l = cov.llt().matrixL();
-    return Eigen::Vector3d(l * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)));
+    const double z = normal(rng), y = normal(rng), x = normal(rng);  // sequenced, z first
+    return Eigen::Vector3d(l * Eigen::Vector3d(x, y, z));
   };
   // `pose` moved by an additive (x, y, yaw) perturbation: the measurement model's noise.
   const auto plus = [](const Pose2& pose, const Eigen::Vector3d& d) {
@@ -249,8 +250,9 @@ TEST(PoseEkfTest, MatcherPoseUpdatesAreConsistentOverMonteCarloRuns) {
         ekf.PredictGyro(reading, dt);
       }
       const double distance = speed * 4 * dt;
+      const double lateral = distance * options.encoder_lateral_sigma_rel * normal(rng);
       const Eigen::Vector2d move(distance * (1.0 + options.encoder_sigma_rel * normal(rng)),
-                                 distance * options.encoder_lateral_sigma_rel * normal(rng));
+                                 lateral);
       // The translation follows the mean heading of the interval, as the filter's model says.
       const double heading = truth.theta() + 0.5 * turned;
       const Eigen::Vector2d world = Eigen::Rotation2Dd(heading) * move;

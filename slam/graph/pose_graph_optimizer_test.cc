@@ -30,7 +30,9 @@ void Perturb(PoseGraph* graph, double sigma, std::uint64_t seed) {
   std::normal_distribution<double> n(0.0, sigma);
   for (std::size_t i = 1; i < graph->vertices().size(); ++i) {
     const PoseGraphVertex& v = graph->vertices()[i];
-    graph->SetPose(v.id, v.pose * Pose2(n(rng), n(rng), 0.3 * n(rng)));
+    // Sequenced draws, yaw first (the order these cases were generated in).
+    const double yaw = 0.3 * n(rng), y = n(rng), x = n(rng);
+    graph->SetPose(v.id, v.pose * Pose2(x, y, yaw));
   }
 }
 

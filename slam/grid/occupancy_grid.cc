@@ -7,39 +7,18 @@
 namespace slamrig::slam {
 
 std::vector<std::string> OccupancyGridOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (!(resolution_m > 0.0)) {
-    errors.push_back(RuleViolation("resolution_m", resolution_m, "must be > 0"));
-  }
-  if (!(hit_log_odds > 0.0f)) {
-    errors.push_back(RuleViolation("hit_log_odds", hit_log_odds, "must be > 0"));
-  }
-  if (!(miss_log_odds < 0.0f)) {
-    errors.push_back(RuleViolation("miss_log_odds", miss_log_odds, "must be < 0"));
-  }
-  if (!(min_log_odds < 0.0f)) {
-    errors.push_back(RuleViolation("min_log_odds", min_log_odds, "must be < 0"));
-  }
-  if (!(max_log_odds > 0.0f)) {
-    errors.push_back(RuleViolation("max_log_odds", max_log_odds, "must be > 0"));
-  }
-  if (!(max_range_m > 0.0)) {
-    errors.push_back(RuleViolation("max_range_m", max_range_m, "must be > 0"));
-  }
-  if (!(no_return_clear_range_m >= 0.0)) {
-    errors.push_back(
-        RuleViolation("no_return_clear_range_m", no_return_clear_range_m, "must be >= 0"));
-  }
-  if (!(grow_margin_m >= 0.0)) {
-    errors.push_back(RuleViolation("grow_margin_m", grow_margin_m, "must be >= 0"));
-  }
-  if (!(range_stddev_m >= 0.0)) {
-    errors.push_back(RuleViolation("range_stddev_m", range_stddev_m, "must be >= 0"));
-  }
-  if (!(hit_window_sigmas >= 0.0)) {
-    errors.push_back(RuleViolation("hit_window_sigmas", hit_window_sigmas, "must be >= 0"));
-  }
-  return errors;
+  Rules rules;
+  rules.Positive("resolution_m", resolution_m)
+      .Positive("hit_log_odds", hit_log_odds)
+      .Require(miss_log_odds < 0.0f, "miss_log_odds", miss_log_odds, "must be < 0")
+      .Require(min_log_odds < 0.0f, "min_log_odds", min_log_odds, "must be < 0")
+      .Positive("max_log_odds", max_log_odds)
+      .Positive("max_range_m", max_range_m)
+      .NonNegative("no_return_clear_range_m", no_return_clear_range_m)
+      .NonNegative("grow_margin_m", grow_margin_m)
+      .NonNegative("range_stddev_m", range_stddev_m)
+      .NonNegative("hit_window_sigmas", hit_window_sigmas);
+  return rules.errors();
 }
 
 OccupancyGrid::OccupancyGrid(const OccupancyGridOptions& options) : options_(options) {

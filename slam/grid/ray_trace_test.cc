@@ -12,8 +12,9 @@ TEST(TraceRayTest, PropertiesOverRandomRays) {
   std::mt19937_64 rng(11);
   std::uniform_int_distribution<int> coord(-60, 60);
   for (int trial = 0; trial < 5000; ++trial) {
-    const Eigen::Array2i from(coord(rng), coord(rng));
-    const Eigen::Array2i to(coord(rng), coord(rng));
+    // Sequenced draws, the last coordinate first (the order these cases were generated in).
+    const int from_y = coord(rng), from_x = coord(rng), to_y = coord(rng), to_x = coord(rng);
+    const Eigen::Array2i from(from_x, from_y), to(to_x, to_y);
     std::vector<Eigen::Array2i> cells;
     TraceRay(from, to, [&](int x, int y) { cells.emplace_back(x, y); });
     const int dx = to.x() - from.x(), dy = to.y() - from.y();

@@ -20,7 +20,9 @@ struct RandomScan {
 RandomScan MakeRandomScan(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   RandomScan r;
-  r.pose = Pose2(-4.0 + 8.0 * u(rng), -4.0 + 8.0 * u(rng), std::numbers::pi * (2.0 * u(rng) - 1.0));
+  // Sequenced draws, the last coordinate first (the order these cases were generated in).
+  const double theta = std::numbers::pi * (2.0 * u(rng) - 1.0), y = -4.0 + 8.0 * u(rng);
+  r.pose = Pose2(-4.0 + 8.0 * u(rng), y, theta);
   LaserScan& scan = r.scan;
   const int beams = 20 + static_cast<int>(u(rng) * 200);
   scan.angle_min_rad = -2.0;

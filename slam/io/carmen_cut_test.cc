@@ -47,6 +47,14 @@ std::string ErrorOf(const std::function<void()>& read) {
   return "";
 }
 
+// (sx * u, sy * u, st * u) from three draws of u, the last drawn first: sequenced (the arguments
+// of one call are drawn in the compiler's order), in the order the logs here were generated with.
+Pose2 RandomPose(std::mt19937_64& rng, std::uniform_real_distribution<double>& u, double sx,
+                 double sy, double st) {
+  const double theta = st * u(rng), y = sy * u(rng);
+  return Pose2(sx * u(rng), y, theta);
+}
+
 // A log as `slamrig simulate` writes it: PARAMs, then ODOM, ROBOTLASER1 and TRUEPOS lines with
 // random values, stamps from 1000 s.
 std::string WriteTestLog(const TempDir& dir, int scans) {
@@ -59,8 +67,9 @@ std::string WriteTestLog(const TempDir& dir, int scans) {
   Pose2 odom;
   for (int k = 0; k < scans; ++k) {
     const Time t = Time::FromSeconds(1000.0 + 0.025 * k);
-    odom = odom * Pose2(0.01 * u(rng), 0.002 * u(rng), 0.01 * u(rng));
-    writer.WriteOdometry(OdometryPose{t, odom}, u(rng), u(rng));
+    odom = odom * RandomPose(rng, u, 0.01, 0.002, 0.01);
+    const double turn = u(rng);  // drawn first, as in RandomPose
+    writer.WriteOdometry(OdometryPose{t, odom}, u(rng), turn);
     LaserScan scan;
     scan.time = AddSeconds(t, 0.001);
     scan.angle_min_rad = -1.5;
@@ -68,7 +77,7 @@ std::string WriteTestLog(const TempDir& dir, int scans) {
     scan.range_max_m = 30.0;
     for (int i = 0; i < 61; ++i) scan.ranges_m.push_back(static_cast<float>(5.0 + 4.0 * u(rng)));
     writer.WriteLaser(scan, odom);
-    writer.WriteTruePos(GroundTruthPose{scan.time, Pose2(u(rng), u(rng), u(rng))}, odom);
+    writer.WriteTruePos(GroundTruthPose{scan.time, RandomPose(rng, u, 1.0, 1.0, 1.0)}, odom);
   }
   writer.Commit();
   return path;

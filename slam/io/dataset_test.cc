@@ -35,7 +35,9 @@ TEST(DatasetTest, RecoversRawOdometryFromCorrectedLog) {
       text += "ODOM " + PoseText(corrected.back() * step) + " 0 0 0 " + std::to_string(t += 0.1) +
               " h 0\n";
       odometry = odometry * step;
-      truth = corrected.back() * step * Pose2(noise(rng), noise(rng), 0.2 * noise(rng));
+      // Sequenced draws, the last coordinate first (the order these cases were generated in).
+      const double yaw = 0.2 * noise(rng), y = noise(rng), x = noise(rng);
+      truth = corrected.back() * step * Pose2(x, y, yaw);
     }
     corrected.push_back(truth);
     raw.push_back(odometry);

@@ -21,7 +21,9 @@ TEST(TumIoTest, RoundTripsRandomTrajectoriesExactly) {
   std::int64_t ns = 1'298'445'274'541'885'123;
   for (int i = 0; i < 1000; ++i) {
     ns += 25'000'000 + i;
-    t.Append(Time::FromNanoseconds(ns), Pose2(xy(rng), xy(rng), th(rng)));
+    // Sequenced draws, the last coordinate first (the order these cases were generated in).
+    const double theta = th(rng), y = xy(rng), x = xy(rng);
+    t.Append(Time::FromNanoseconds(ns), Pose2(x, y, theta));
   }
   WriteTum(dir.File("t.tum"), t);
   const Trajectory back = ReadTum(dir.File("t.tum"));

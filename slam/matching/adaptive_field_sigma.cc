@@ -10,19 +10,16 @@
 namespace slamrig::slam {
 
 std::vector<std::string> AdaptiveSigmaOptions::Validate() const {
-  std::vector<std::string> errors;
-  auto add = [&](const char* field, double got, const char* rule) {
-    errors.push_back(RuleViolation(field, got, rule));
-  };
-  if (!(residual_factor > 0.0)) add("residual_factor", residual_factor, "must be > 0");
-  if (!(min_m > 0.0)) add("min_m", min_m, "must be > 0");
-  if (!(max_m >= min_m)) add("max_m", max_m, "must be >= min_m");
-  if (!(window_m > 0.0)) add("window_m", window_m, "must be > 0");
-  if (min_points < 1) add("min_points", min_points, "must be >= 1");
-  if (!(rate > 0.0 && rate <= 1.0)) add("rate", rate, "must be in (0, 1]");
-  if (warmup_updates < 0) add("warmup_updates", warmup_updates, "must be >= 0");
-  if (!(change_ratio >= 0.0)) add("change_ratio", change_ratio, "must be >= 0");
-  return errors;
+  Rules rules;
+  rules.Positive("residual_factor", residual_factor)
+      .Positive("min_m", min_m)
+      .Require(max_m >= min_m, "max_m", max_m, "must be >= min_m")
+      .Positive("window_m", window_m)
+      .AtLeast("min_points", min_points, 1)
+      .InUnitInterval("rate", rate)
+      .NonNegative("warmup_updates", warmup_updates)
+      .NonNegative("change_ratio", change_ratio);
+  return rules.errors();
 }
 
 AdaptiveFieldSigma::AdaptiveFieldSigma(const AdaptiveSigmaOptions& options) : options_(options) {

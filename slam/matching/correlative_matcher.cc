@@ -30,29 +30,17 @@ bool BetterFirst(const Node& a, const Node& b) {
 }  // namespace
 
 std::vector<std::string> CorrelativeMatcherOptions::Validate() const {
-  std::vector<std::string> errors;
-  auto add = [&](const char* field, double value, const char* rule) {
-    errors.push_back(RuleViolation(std::string("correlative.") + field, value, rule));
-  };
-  if (!(linear_window_m >= 0.0)) add("linear_window_m", linear_window_m, "must be >= 0");
-  if (!(angular_window_rad >= 0.0 && angular_window_rad <= 3.14159265358979 + 1e-9)) {
-    add("angular_window_rad", angular_window_rad, "must be in [0, pi]");
-  }
-  if (!(angular_step_rad >= 0.0)) add("angular_step_rad", angular_step_rad, "must be >= 0");
-  if (branch_and_bound_depth < 1 || branch_and_bound_depth > 12) {
-    add("branch_and_bound_depth", branch_and_bound_depth, "must be in [1, 12]");
-  }
-  if (!std::isfinite(min_score)) add("min_score", min_score, "must be finite");
-  if (covariance_half_cells < 1) {
-    add("covariance_half_cells", covariance_half_cells, "must be >= 1");
-  }
-  if (covariance_half_steps < 1) {
-    add("covariance_half_steps", covariance_half_steps, "must be >= 1");
-  }
-  if (!(covariance_score_scale > 0.0)) {
-    add("covariance_score_scale", covariance_score_scale, "must be > 0");
-  }
-  return errors;
+  Rules rules;
+  rules.NonNegative("linear_window_m", linear_window_m)
+      .Require(angular_window_rad >= 0.0 && angular_window_rad <= 3.14159265358979 + 1e-9,
+               "angular_window_rad", angular_window_rad, "must be in [0, pi]")
+      .NonNegative("angular_step_rad", angular_step_rad)
+      .InRange("branch_and_bound_depth", branch_and_bound_depth, 1, 12)
+      .Require(std::isfinite(min_score), "min_score", min_score, "must be finite")
+      .AtLeast("covariance_half_cells", covariance_half_cells, 1)
+      .AtLeast("covariance_half_steps", covariance_half_steps, 1)
+      .Positive("covariance_score_scale", covariance_score_scale);
+  return PrefixErrors("correlative", rules.errors());
 }
 
 CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,

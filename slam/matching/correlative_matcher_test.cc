@@ -16,6 +16,16 @@ namespace {
 using testing::RangeFinderSpec;
 using testing::SegmentWorld;
 
+// 25 points uniform in [-0.8, 0.8)^2 (y drawn first, as in Uniform3).
+std::vector<Eigen::Vector2d> RandomPoints(RandomEngine& rng) {
+  std::vector<Eigen::Vector2d> points;
+  for (int p = 0; p < 25; ++p) {
+    const double y = 1.6 * Uniform01(rng) - 0.8;
+    points.emplace_back(1.6 * Uniform01(rng) - 0.8, y);
+  }
+  return points;
+}
+
 // Independent exhaustive search over the window, as CorrelativeMatcher's header defines it: every
 // yaw k, every (j, i) in order, the float sum of the raster at the discretised points; the first
 // strictly better pose wins, so ties go to the smallest (k, j, i). Poses within `distance_m` and
@@ -95,9 +105,7 @@ TEST(CorrelativeMatcherTest, BranchAndBoundEqualsExhaustiveSearch) {
       v = ties ? static_cast<float>(std::floor(3.0 * u) / 2.0) : static_cast<float>(u * u);
     }
     const GridView raster{values.data(), width, height, Eigen::Vector2d(-1.0, -0.9), 0.05};
-    std::vector<Eigen::Vector2d> points;
-    for (int p = 0; p < 25; ++p)
-      points.emplace_back(1.6 * Uniform01(rng) - 0.8, 1.6 * Uniform01(rng) - 0.8);
+    const std::vector<Eigen::Vector2d> points = RandomPoints(rng);
     CorrelativeMatcherOptions options;
     options.linear_window_m = 0.3 + 0.2 * Uniform01(rng);
     options.angular_window_rad = 0.2;
@@ -105,7 +113,8 @@ TEST(CorrelativeMatcherTest, BranchAndBoundEqualsExhaustiveSearch) {
     options.branch_and_bound_depth = 1 + trial % 6;
     options.min_score = trial % 3 == 0 ? 0.75 : 0.0;
     const CorrelativeMatcher matcher(options, raster);
-    const Pose2 initial(0.3 * Uniform01(rng), 0.3 * Uniform01(rng), 6.0 * Uniform01(rng));
+    const Eigen::Vector3d d = Uniform3(rng);
+    const Pose2 initial(0.3 * d.x(), 0.3 * d.y(), 6.0 * d.z());
     const std::optional<MatchResult> fast = matcher.Match(points, initial);
     const int wxy = static_cast<int>(std::ceil(options.linear_window_m / 0.05 - 1e-9));
     const std::optional<MatchResult> slow =
@@ -134,9 +143,7 @@ TEST(CorrelativeMatcherTest, DistinctPlacesAreTheExhaustiveSearchsSuppressedMaxi
       v = ties ? static_cast<float>(std::floor(3.0 * u) / 2.0) : static_cast<float>(u * u);
     }
     const GridView raster{values.data(), width, height, Eigen::Vector2d(-1.0, -0.9), 0.05};
-    std::vector<Eigen::Vector2d> points;
-    for (int p = 0; p < 25; ++p)
-      points.emplace_back(1.6 * Uniform01(rng) - 0.8, 1.6 * Uniform01(rng) - 0.8);
+    const std::vector<Eigen::Vector2d> points = RandomPoints(rng);
     CorrelativeMatcherOptions options;
     options.linear_window_m = 0.3 + 0.2 * Uniform01(rng);
     options.angular_window_rad = 0.2;
@@ -144,7 +151,8 @@ TEST(CorrelativeMatcherTest, DistinctPlacesAreTheExhaustiveSearchsSuppressedMaxi
     options.branch_and_bound_depth = 1 + trial % 6;
     options.min_score = trial % 4 == 0 ? 0.7 : 0.0;
     const CorrelativeMatcher matcher(options, raster);
-    const Pose2 initial(0.3 * Uniform01(rng), 0.3 * Uniform01(rng), 6.0 * Uniform01(rng));
+    const Eigen::Vector3d d = Uniform3(rng);
+    const Pose2 initial(0.3 * d.x(), 0.3 * d.y(), 6.0 * d.z());
     const double distance_m = 0.12 + 0.1 * Uniform01(rng), angle_rad = trial % 3 == 0 ? 0.1 : 1.0;
     const std::vector<MatchResult> fast =
         matcher.MatchDistinct(points, initial, 4, distance_m, angle_rad);
@@ -182,12 +190,12 @@ FarScan ScanFromFarAway(const SegmentWorld& world, const ScanPointsOptions& poin
   const Pose2 base =
       loop[static_cast<std::size_t>(Uniform01(rng) * static_cast<double>(loop.size()))];
   FarScan far;
-  far.truth = Pose2(base.x() + 0.4 * Uniform01(rng) - 0.2, base.y() + 0.4 * Uniform01(rng) - 0.2,
-                    6.28 * Uniform01(rng));
+  const Eigen::Vector3d t = Uniform3(rng);
+  far.truth = Pose2(base.x() + 0.4 * t.x() - 0.2, base.y() + 0.4 * t.y() - 0.2, 6.28 * t.z());
   far.points = ScanToBasePoints(world.Scan(far.truth, Time(), RangeFinderSpec{}, &rng), points);
-  far.initial =
-      Pose2(far.truth.x() + 4.0 * Uniform01(rng) - 2.0, far.truth.y() + 4.0 * Uniform01(rng) - 2.0,
-            far.truth.theta() + (2.0 * Uniform01(rng) - 1.0) * 3.0);
+  const Eigen::Vector3d i = Uniform3(rng);
+  far.initial = Pose2(far.truth.x() + 4.0 * i.x() - 2.0, far.truth.y() + 4.0 * i.y() - 2.0,
+                      far.truth.theta() + (2.0 * i.z() - 1.0) * 3.0);
   return far;
 }
 
@@ -320,8 +328,8 @@ TEST(CorrelativeMatcherTest, CovarianceIsLargestAlongACorridorsAxis) {
   ScanPointsOptions points;
   points.voxel_size_m = 0.1;
   for (int trial = 0; trial < 5; ++trial) {
-    const Pose2 truth(2.0 * Uniform01(rng) - 1.0, 0.4 * Uniform01(rng) - 0.2,
-                      0.2 * Uniform01(rng) - 0.1);
+    const Eigen::Vector3d d = Uniform3(rng);
+    const Pose2 truth(2.0 * d.x() - 1.0, 0.4 * d.y() - 0.2, 0.2 * d.z() - 0.1);
     const std::vector<Eigen::Vector2d> scan =
         ScanToBasePoints(corridor.Scan(truth, Time(), RangeFinderSpec{}, &rng), points);
     const std::optional<MatchResult> m =

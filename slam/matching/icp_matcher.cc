@@ -173,28 +173,17 @@ Pose2 PointToPointStep(const Reference& reference, const std::vector<Pair>& pair
 }  // namespace
 
 std::vector<std::string> IcpOptions::Validate() const {
-  std::vector<std::string> errors;
-  auto add = [&](const char* field, double value, const char* rule) {
-    errors.push_back(RuleViolation(std::string("icp.") + field, value, rule));
-  };
-  if (max_iterations < 1) add("max_iterations", max_iterations, "must be >= 1");
-  if (!(converged_translation_m >= 0.0)) {
-    add("converged_translation_m", converged_translation_m, "must be >= 0");
-  }
-  if (!(converged_rotation_rad >= 0.0)) {
-    add("converged_rotation_rad", converged_rotation_rad, "must be >= 0");
-  }
-  if (!(max_correspondence_distance_m > 0.0)) {
-    add("max_correspondence_distance_m", max_correspondence_distance_m, "must be > 0");
-  }
-  if (!(trim_fraction > 0.0 && trim_fraction <= 1.0)) {
-    add("trim_fraction", trim_fraction, "must be in (0, 1]");
-  }
-  if (!(kernel_scale_m > 0.0)) add("kernel_scale_m", kernel_scale_m, "must be > 0");
-  if (normal_neighbors < 3) add("normal_neighbors", normal_neighbors, "must be >= 3");
-  if (!(normal_radius_m > 0.0)) add("normal_radius_m", normal_radius_m, "must be > 0");
-  if (min_correspondences < 3) add("min_correspondences", min_correspondences, "must be >= 3");
-  return errors;
+  Rules rules;
+  rules.AtLeast("max_iterations", max_iterations, 1)
+      .NonNegative("converged_translation_m", converged_translation_m)
+      .NonNegative("converged_rotation_rad", converged_rotation_rad)
+      .Positive("max_correspondence_distance_m", max_correspondence_distance_m)
+      .InUnitInterval("trim_fraction", trim_fraction)
+      .Positive("kernel_scale_m", kernel_scale_m)
+      .AtLeast("normal_neighbors", normal_neighbors, 3)
+      .Positive("normal_radius_m", normal_radius_m)
+      .AtLeast("min_correspondences", min_correspondences, 3);
+  return PrefixErrors("icp", rules.errors());
 }
 
 IcpMatcher::IcpMatcher(const IcpOptions& options, std::vector<Eigen::Vector2d> reference)

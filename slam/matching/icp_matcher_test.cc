@@ -13,14 +13,20 @@ namespace {
 using testing::RangeFinderSpec;
 using testing::SegmentWorld;
 
-// A random pose in the office's lower corridor, clear of walls and pillars.
+// A random pose in the office's lower corridor, clear of walls and pillars. The draws are
+// sequenced (arguments of one call would be drawn in the compiler's order), theta first.
 Pose2 RandomCorridorPose(RandomEngine& rng) {
-  return Pose2(2.0 + 15.5 * Uniform01(rng), 1.4 + 1.2 * Uniform01(rng), 6.28 * Uniform01(rng));
+  const double theta = 6.28 * Uniform01(rng);
+  const double y = 1.4 + 1.2 * Uniform01(rng);
+  const double x = 2.0 + 15.5 * Uniform01(rng);
+  return Pose2(x, y, theta);
 }
 
 Pose2 RandomOffset(RandomEngine& rng, double xy_m, double yaw_rad) {
-  return Pose2(xy_m * (2.0 * Uniform01(rng) - 1.0), xy_m * (2.0 * Uniform01(rng) - 1.0),
-               yaw_rad * (2.0 * Uniform01(rng) - 1.0));
+  const double theta = yaw_rad * (2.0 * Uniform01(rng) - 1.0);
+  const double y = xy_m * (2.0 * Uniform01(rng) - 1.0);
+  const double x = xy_m * (2.0 * Uniform01(rng) - 1.0);
+  return Pose2(x, y, theta);
 }
 
 double YawError(const Pose2& a, const Pose2& b) {
@@ -144,9 +150,10 @@ TEST(IcpMatcherTest, CovarianceIsLargestAlongACorridorsAxis) {
   for (int trial = 0; trial < 10; ++trial) {
     const Pose2 a(0.0, 0.0, 6.28 * Uniform01(rng));
     const Pose2 offset = RandomOffset(rng, 0.03, 0.03);
+    const LaserScan src = world.Scan(a * offset, Time(), spec, &rng);  // noise drawn first
+    const LaserScan ref = world.Scan(a, Time(), spec, &rng);
     const std::optional<MatchResult> m =
-        IcpMatcher::MatchScans(IcpOptions{}, points, world.Scan(a, Time(), spec, &rng),
-                               world.Scan(a * offset, Time(), spec, &rng), Pose2());
+        IcpMatcher::MatchScans(IcpOptions{}, points, ref, src, Pose2());
     ASSERT_TRUE(m.has_value());
     // The covariance in the world frame: rotate the (x, y) block of the base-frame estimate.
     const Eigen::Matrix2d r = Eigen::Rotation2Dd(a.theta()).toRotationMatrix();
@@ -171,9 +178,11 @@ TEST(IcpMatcherTest, CovarianceIsNearlyIsotropicWhereWallsFaceEveryWay) {
   points.voxel_size_m = 0.05;
   for (int trial = 0; trial < 10; ++trial) {
     const Pose2 a = RandomCorridorPose(rng);
-    const std::optional<MatchResult> m = IcpMatcher::MatchScans(
-        IcpOptions{}, points, world.Scan(a, Time(), RangeFinderSpec{}, &rng),
-        world.Scan(a * Pose2(0.02, 0.01, 0.01), Time(), RangeFinderSpec{}, &rng), Pose2());
+    const LaserScan src =  // noise drawn first
+        world.Scan(a * Pose2(0.02, 0.01, 0.01), Time(), RangeFinderSpec{}, &rng);
+    const LaserScan ref = world.Scan(a, Time(), RangeFinderSpec{}, &rng);
+    const std::optional<MatchResult> m =
+        IcpMatcher::MatchScans(IcpOptions{}, points, ref, src, Pose2());
     ASSERT_TRUE(m.has_value());
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(m->covariance.topLeftCorner<2, 2>());
     EXPECT_LT(eig.eigenvalues()[1], 30.0 * eig.eigenvalues()[0]) << trial;

@@ -11,34 +11,26 @@
 
 namespace slamrig::slam {
 std::vector<std::string> IcpOdometryOptions::Validate() const {
+  Rules rules;
+  rules.AtLeast("local_map_keyframes", local_map_keyframes, 1)
+      .NonNegative("local_map_voxel_m", local_map_voxel_m)
+      .NonNegative("keyframe_distance_m", keyframe_distance_m)
+      .NonNegative("keyframe_angle_rad", keyframe_angle_rad)
+      .Positive("max_translation_stddev_m", max_translation_stddev_m)
+      .Require(max_covariance_ratio > 1.0, "max_covariance_ratio", max_covariance_ratio,
+               "must be > 1")
+      .Positive("max_yaw_stddev_rad", max_yaw_stddev_rad)
+      .Fraction("min_score", min_score)
+      .Positive("max_correction_m", max_correction_m)
+      .Positive("max_correction_rad", max_correction_rad)
+      .NonNegative("sigma_xy_per_m", sigma_xy_per_m)
+      .NonNegative("sigma_xy_floor_m", sigma_xy_floor_m)
+      .NonNegative("sigma_yaw_per_rad", sigma_yaw_per_rad)
+      .NonNegative("sigma_yaw_per_m", sigma_yaw_per_m)
+      .NonNegative("sigma_yaw_floor_rad", sigma_yaw_floor_rad);
   std::vector<std::string> errors = icp.Validate();
-  for (std::string& e : points.Validate()) errors.push_back(std::move(e));
-  auto add = [&](const char* field, double value, const char* rule) {
-    errors.push_back(RuleViolation(std::string("icp_odometry.") + field, value, rule));
-  };
-  if (local_map_keyframes < 1) add("local_map_keyframes", local_map_keyframes, "must be >= 1");
-  if (!(local_map_voxel_m >= 0.0)) add("local_map_voxel_m", local_map_voxel_m, "must be >= 0");
-  if (!(keyframe_distance_m >= 0.0)) {
-    add("keyframe_distance_m", keyframe_distance_m, "must be >= 0");
-  }
-  if (!(keyframe_angle_rad >= 0.0)) add("keyframe_angle_rad", keyframe_angle_rad, "must be >= 0");
-  if (!(max_translation_stddev_m > 0.0)) {
-    add("max_translation_stddev_m", max_translation_stddev_m, "must be > 0");
-  }
-  if (!(max_covariance_ratio > 1.0)) {
-    add("max_covariance_ratio", max_covariance_ratio, "must be > 1");
-  }
-  if (!(max_yaw_stddev_rad > 0.0)) add("max_yaw_stddev_rad", max_yaw_stddev_rad, "must be > 0");
-  if (!(min_score >= 0.0 && min_score <= 1.0)) add("min_score", min_score, "must be in [0, 1]");
-  if (!(max_correction_m > 0.0)) add("max_correction_m", max_correction_m, "must be > 0");
-  if (!(max_correction_rad > 0.0)) add("max_correction_rad", max_correction_rad, "must be > 0");
-  for (const auto& [field, value] : {std::pair{"sigma_xy_per_m", sigma_xy_per_m},
-                                     {"sigma_xy_floor_m", sigma_xy_floor_m},
-                                     {"sigma_yaw_per_rad", sigma_yaw_per_rad},
-                                     {"sigma_yaw_per_m", sigma_yaw_per_m},
-                                     {"sigma_yaw_floor_rad", sigma_yaw_floor_rad}}) {
-    if (!(value >= 0.0)) add(field, value, "must be >= 0");
-  }
+  AppendErrors(&errors, points.Validate());
+  AppendErrors(&errors, PrefixErrors("icp_odometry", rules.errors()));
   return errors;
 }
 

@@ -35,9 +35,9 @@ std::vector<Pose2> OfficeLoop() {
 // Wheel odometry with a 3 % scale error, a yaw bias that grows with distance and white noise.
 Pose2 NoisyIncrement(const Pose2& truth, RandomEngine& rng) {
   const double d = truth.translation().norm();
-  return Pose2(1.03 * truth.x() + 0.003 * StandardNormal(rng),
-               truth.y() + 0.003 * StandardNormal(rng),
-               1.04 * truth.theta() + 0.02 * d + 0.002 * StandardNormal(rng));
+  const Eigen::Vector3d n = StandardNormal3(rng);
+  return Pose2(1.03 * truth.x() + 0.003 * n.x(), truth.y() + 0.003 * n.y(),
+               1.04 * truth.theta() + 0.02 * d + 0.002 * n.z());
 }
 
 double PositionRmse(const std::vector<Pose2>& estimate, const std::vector<Pose2>& truth) {

@@ -13,15 +13,12 @@
 namespace slamrig::slam {
 
 std::vector<std::string> LikelihoodFieldOptions::Validate() const {
-  std::vector<std::string> errors;
-  auto add = [&](const char* field, double got, const char* rule) {
-    errors.push_back(RuleViolation(field, got, rule));
-  };
-  if (!(sigma_m > 0.0)) add("sigma_m", sigma_m, "must be > 0");
-  if (!(z_hit > 0.0)) add("z_hit", z_hit, "must be > 0");
-  if (!(z_rand > 0.0)) add("z_rand", z_rand, "must be > 0");
-  if (!(cutoff_sigmas > 0.0)) add("cutoff_sigmas", cutoff_sigmas, "must be > 0");
-  return errors;
+  Rules rules;
+  rules.Positive("sigma_m", sigma_m)
+      .Positive("z_hit", z_hit)
+      .Positive("z_rand", z_rand)
+      .Positive("cutoff_sigmas", cutoff_sigmas);
+  return rules.errors();
 }
 
 LikelihoodField::LikelihoodField(const LikelihoodFieldOptions& options) : options_(options) {

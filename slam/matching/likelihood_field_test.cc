@@ -87,14 +87,16 @@ TEST(LikelihoodFieldTest, FollowEqualsAWholeRecomputeBitForBit) {
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     Pose2 pose;
     for (int round = 0; round < 40; ++round) {
-      // A random walk, so the grid grows now and then, to every side.
-      pose = Pose2(pose.x() + 0.6 * u(rng), pose.y() + 0.6 * u(rng), 3.0 * u(rng));
+      // A random walk, so the grid grows now and then, to every side. Every pair or triple of
+      // draws here is sequenced, the last coordinate first.
+      const double theta = 3.0 * u(rng), dy = 0.6 * u(rng), dx = 0.6 * u(rng);
+      pose = Pose2(pose.x() + dx, pose.y() + dy, theta);
       grid.InsertScan(RandomScan(rng, 90), pose);
       // Walls appear and go by hand too, some at the grid's edge.
       std::uniform_int_distribution<int> cx(0, grid.width() - 1), cy(0, grid.height() - 1);
       for (int k = 0; k < 30; ++k) {
-        const Eigen::Array2i cell =
-            k % 10 == 0 ? Eigen::Array2i(0, cy(rng)) : Eigen::Array2i(cx(rng), cy(rng));
+        const int y = cy(rng);
+        const Eigen::Array2i cell(k % 10 == 0 ? 0 : cx(rng), y);
         grid.Set(cell, static_cast<float>(2.0 * u(rng)));
       }
       if (round % 3 == 0) continue;  // several changes between two Follow calls
@@ -104,7 +106,8 @@ TEST(LikelihoodFieldTest, FollowEqualsAWholeRecomputeBitForBit) {
       ASSERT_TRUE(SameBits(followed.view(), whole.view())) << threshold << " round " << round;
       for (int w = 0; w < 5; ++w) {
         const Eigen::Vector2d a = grid.CellCenter({cx(rng), cy(rng)});
-        const Eigen::Vector2d b = a + Eigen::Vector2d(3.0 * u(rng), 3.0 * u(rng));
+        const double height = 3.0 * u(rng);
+        const Eigen::Vector2d b = a + Eigen::Vector2d(3.0 * u(rng), height);
         Eigen::AlignedBox2d region(a.cwiseMin(b), a.cwiseMax(b));
         LikelihoodField window(options);
         window.Update(grid, region);

@@ -139,23 +139,15 @@ struct Scratch {
 }  // namespace
 
 std::vector<std::string> MapCorrelatorOptions::Validate() const {
-  std::vector<std::string> errors;
-  auto add = [&](const char* field, double got, const char* rule) {
-    errors.push_back(RuleViolation(field, got, rule));
-  };
-  if (xy_half_width_cells < 0 || xy_half_width_cells > 15) {
-    add("xy_half_width_cells", xy_half_width_cells, "must be in [0, 15]");
-  }
-  if (yaw_half_steps < 0) add("yaw_half_steps", yaw_half_steps, "must be >= 0");
-  if (yaw_half_steps > 0 && !(yaw_step_rad > 0.0)) {
-    add("yaw_step_rad", yaw_step_rad, "must be > 0 when yaw_half_steps > 0");
-  }
-  if (!(prior_sigma_xy_m >= 0.0)) add("prior_sigma_xy_m", prior_sigma_xy_m, "must be >= 0");
-  if (!(prior_sigma_yaw_rad >= 0.0)) {
-    add("prior_sigma_yaw_rad", prior_sigma_yaw_rad, "must be >= 0");
-  }
-  if (!(min_shift_gain >= 0.0f)) add("min_shift_gain", min_shift_gain, "must be >= 0");
-  return errors;
+  Rules rules;
+  rules.InRange("xy_half_width_cells", xy_half_width_cells, 0, 15)
+      .NonNegative("yaw_half_steps", yaw_half_steps)
+      .Require(yaw_half_steps <= 0 || yaw_step_rad > 0.0, "yaw_step_rad", yaw_step_rad,
+               "must be > 0 when yaw_half_steps > 0")
+      .NonNegative("prior_sigma_xy_m", prior_sigma_xy_m)
+      .NonNegative("prior_sigma_yaw_rad", prior_sigma_yaw_rad)
+      .NonNegative("min_shift_gain", min_shift_gain);
+  return rules.errors();
 }
 
 MapCorrelator::MapCorrelator(const MapCorrelatorOptions& options) : options_(options) {

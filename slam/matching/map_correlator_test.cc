@@ -65,8 +65,8 @@ TEST(MapCorrelatorTest, MatchesBruteForceOnRandomRastersIncludingEdges) {
         points.emplace_back(0.8 * std::cos(0.03 * i) + 0.001 * i,
                             0.8 * std::sin(0.03 * i) * (1 + trial % 3));
       }
-      const Pose2 pose(0.2 + 0.4 * Uniform01(rng), 0.3 + 0.4 * Uniform01(rng),
-                       6.0 * Uniform01(rng));
+      const Eigen::Vector3d d = Uniform3(rng);
+      const Pose2 pose(0.2 + 0.4 * d.x(), 0.3 + 0.4 * d.y(), 6.0 * d.z());
       std::vector<float> table;
       const CorrelationResult result = correlator.Correlate(raster.view, points, pose, &table);
       float best = -1e30f;
@@ -105,9 +105,9 @@ TEST(MapCorrelatorTest, RecoversARandomOffsetInsideItsWindow) {
   options.yaw_step_rad = 0.01;
   const MapCorrelator correlator(options);
   for (int trial = 0; trial < 20; ++trial) {
-    const Pose2 start(truth.x() + 0.17 * (2.0 * Uniform01(rng) - 1.0),
-                      truth.y() + 0.17 * (2.0 * Uniform01(rng) - 1.0),
-                      truth.theta() + 0.025 * (2.0 * Uniform01(rng) - 1.0));
+    const Eigen::Vector3d d = 2.0 * Uniform3(rng) - Eigen::Vector3d::Ones();
+    const Pose2 start(truth.x() + 0.17 * d.x(), truth.y() + 0.17 * d.y(),
+                      truth.theta() + 0.025 * d.z());
     const CorrelationResult r = correlator.Correlate(GridView::Of(grid), points, start);
     EXPECT_NEAR(r.pose.x(), truth.x(), 0.051) << trial;
     EXPECT_NEAR(r.pose.y(), truth.y(), 0.051) << trial;
@@ -183,8 +183,9 @@ TEST(MapCorrelatorTest, PriorStillRecoversAConstrainedOffset) {
       ScanToBasePoints(world.Scan(truth, Time{}, spec, &rng), ScanPointsOptions{});
   const MapCorrelator correlator(CorridorSearch());
   for (int trial = 0; trial < 10; ++trial) {
-    const Pose2 start(truth.x() + 0.1 * (2.0 * Uniform01(rng) - 1.0),
-                      truth.y() + 0.1 * (2.0 * Uniform01(rng) - 1.0), truth.theta());
+    const double dy = 2.0 * Uniform01(rng) - 1.0;  // y drawn first, as in Uniform3
+    const double dx = 2.0 * Uniform01(rng) - 1.0;
+    const Pose2 start(truth.x() + 0.1 * dx, truth.y() + 0.1 * dy, truth.theta());
     const CorrelationResult r = correlator.Correlate(field.view(), points, start);
     EXPECT_NEAR(r.pose.x(), truth.x(), 0.051) << trial;
     EXPECT_NEAR(r.pose.y(), truth.y(), 0.051) << trial;
@@ -253,11 +254,16 @@ TEST(MapCorrelatorTest, OccupiedMaskGivesTheFloatPathsResultBitForBit) {
   for (int round = 0; round < 30; ++round) {
     scan.ranges_m.clear();
     for (int i = 0; i < 400; ++i) scan.ranges_m.push_back(static_cast<float>(1.5 + 1.4 * u(rng)));
-    const Pose2 pose(0.8 * round * u(rng) / 10.0, 0.8 * u(rng), 3.0 * u(rng));
+    const double theta = 3.0 * u(rng);  // drawn last component first, as in Uniform3
+    const double y = 0.8 * u(rng);
+    const Pose2 pose(0.8 * round * u(rng) / 10.0, y, theta);
     grid.InsertScan(scan, pose);
     mask.Follow(grid);
     std::vector<Eigen::Vector2d> points;
-    for (int i = 0; i < 300 + 20 * round; ++i) points.emplace_back(2.5 * u(rng), 2.5 * u(rng));
+    for (int i = 0; i < 300 + 20 * round; ++i) {
+      const double py = 2.5 * u(rng);
+      points.emplace_back(2.5 * u(rng), py);
+    }
     MapCorrelatorOptions options;
     options.xy_half_width_cells = round % 16;
     options.yaw_half_steps = round % 3;

@@ -18,7 +18,7 @@ using testing::SegmentWorld;
 
 Eigen::Vector3d Gaussian3(const Eigen::Matrix3d& covariance, RandomEngine& rng) {
   const Eigen::Matrix3d l = covariance.llt().matrixL();
-  return l * Eigen::Vector3d(StandardNormal(rng), StandardNormal(rng), StandardNormal(rng));
+  return l * StandardNormal3(rng);
 }
 
 // A pose moved by an additive error in (x, y, yaw), IcpMatcher's parametrisation.
@@ -185,7 +185,7 @@ TEST(MapFrameDriftTest, SharesSumToTheIdentity) {
     for (int j = 0; j < 1 + trial % 10; ++j) {
       Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
       for (int i = 0; i < 5; ++i) {
-        const Eigen::Vector3d row(StandardNormal(rng), StandardNormal(rng), StandardNormal(rng));
+        const Eigen::Vector3d row = StandardNormal3(rng);
         h += row * row.transpose();
       }
       informations.push_back(h);
@@ -205,10 +205,9 @@ TEST(MapFrameDriftTest, SharesSumToTheIdentity) {
 TEST(MapFrameDriftTest, CovarianceAtRobotIsTheRigidMotionsLever) {
   RandomEngine rng(11);
   for (int trial = 0; trial < 50; ++trial) {
-    const Pose2 keyframe(3.0 * StandardNormal(rng), 3.0 * StandardNormal(rng), StandardNormal(rng));
-    const Pose2 robot(3.0 * StandardNormal(rng), 3.0 * StandardNormal(rng), StandardNormal(rng));
-    const Eigen::Vector3d error =
-        1e-6 * Eigen::Vector3d(StandardNormal(rng), StandardNormal(rng), StandardNormal(rng));
+    const Eigen::Vector3d k = StandardNormal3(rng), r = StandardNormal3(rng);
+    const Pose2 keyframe(3.0 * k.x(), 3.0 * k.y(), k.z()), robot(3.0 * r.x(), 3.0 * r.y(), r.z());
+    const Eigen::Vector3d error = 1e-6 * StandardNormal3(rng);
     // The robot held fixed in the keyframe's frame while the keyframe moves by `error`.
     const Pose2 moved = Perturbed(keyframe, error) * keyframe.Between(robot);
     const Eigen::Vector3d robot_error = PoseError(moved, robot);
@@ -225,7 +224,7 @@ TEST(MapFrameDriftTest, CovarianceAtRobotIsTheRigidMotionsLever) {
 Eigen::Matrix3d RandomInformation(RandomEngine& rng) {
   Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
   for (int i = 0; i < 5; ++i) {
-    const Eigen::Vector3d row(StandardNormal(rng), StandardNormal(rng), StandardNormal(rng));
+    const Eigen::Vector3d row = StandardNormal3(rng);
     h += row * row.transpose();
   }
   return h;
@@ -295,7 +294,7 @@ TEST(MapFrameDriftTest, KeyframeErrorsStateTheSeenFramesMoveGivenTheFrameBefore)
       moves.push_back(AboutPoint(frame_origin - seen[static_cast<std::size_t>(c)], robot));
       before.push_back(seen[static_cast<std::size_t>(c)]);
       seen[static_cast<std::size_t>(c)] = frame_origin;
-      const Eigen::Vector3d noise(StandardNormal(rng), StandardNormal(rng), StandardNormal(rng));
+      const Eigen::Vector3d noise = StandardNormal3(rng);
       chain.push_back(AboutOrigin(frame + l * noise, robot));
     }
     map.push_back(id);

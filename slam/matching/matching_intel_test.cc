@@ -35,9 +35,9 @@ TEST(MatchingIntelTest, CorrelativeSearchFindsScansInTheMapOfOtherVisits) {
     }
     const CorrelativeMatcher matcher(options, grid);
     const Pose2 truth = log.scans[k].logged_pose;
-    const Pose2 initial(truth.x() + 8.0 * Uniform01(rng) - 4.0,
-                        truth.y() + 8.0 * Uniform01(rng) - 4.0,
-                        truth.theta() + 6.0 * Uniform01(rng) - 3.0);
+    const Eigen::Vector3d d = Uniform3(rng);
+    const Pose2 initial(truth.x() + 8.0 * d.x() - 4.0, truth.y() + 8.0 * d.y() - 4.0,
+                        truth.theta() + 6.0 * d.z() - 3.0);
     const std::optional<MatchResult> m =
         matcher.Match(ScanToBasePoints(log.scans[k].scan, points), initial);
     if (!m) continue;  // a place seen only on this visit: no loop closure, which is right

@@ -8,23 +8,13 @@
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
-namespace {
-
-std::string Rule(const char* field, double value, const char* rule) {
-  return RuleViolation(field, value, rule);
-}
-
-}  // namespace
-
 std::vector<std::string> ScanPointsOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (!(min_range_m >= 0.0)) errors.push_back(Rule("min_range_m", min_range_m, "must be >= 0"));
-  if (!(max_range_m > min_range_m)) {
-    errors.push_back(Rule("max_range_m", max_range_m, "must be > min_range_m"));
-  }
-  if (beam_stride < 1) errors.push_back(Rule("beam_stride", beam_stride, "must be >= 1"));
-  if (!(voxel_size_m >= 0.0)) errors.push_back(Rule("voxel_size_m", voxel_size_m, "must be >= 0"));
-  return errors;
+  Rules rules;
+  rules.NonNegative("min_range_m", min_range_m)
+      .Require(max_range_m > min_range_m, "max_range_m", max_range_m, "must be > min_range_m")
+      .AtLeast("beam_stride", beam_stride, 1)
+      .NonNegative("voxel_size_m", voxel_size_m);
+  return rules.errors();
 }
 
 std::vector<Eigen::Vector2d> ScanToBasePoints(const LaserScan& scan,

@@ -71,20 +71,15 @@ double Square(double v) { return v * v; }
 }  // namespace
 
 std::vector<std::string> ScanRefinerOptions::Validate() const {
-  std::vector<std::string> errors;
-  auto add = [&](const char* field, double got, const char* rule) {
-    errors.push_back(RuleViolation(field, got, rule));
-  };
-  if (max_iterations < 0) add("max_iterations", max_iterations, "must be >= 0");
-  if (!(max_step_m > 0.0)) add("max_step_m", max_step_m, "must be > 0");
-  if (!(max_step_rad > 0.0)) add("max_step_rad", max_step_rad, "must be > 0");
-  if (!(converged_step_m >= 0.0)) add("converged_step_m", converged_step_m, "must be >= 0");
-  if (!(prior_sigma_xy_m >= 0.0)) add("prior_sigma_xy_m", prior_sigma_xy_m, "must be >= 0");
-  if (!(prior_sigma_yaw_rad >= 0.0)) {
-    add("prior_sigma_yaw_rad", prior_sigma_yaw_rad, "must be >= 0");
-  }
-  if (max_halvings < 0) add("max_halvings", max_halvings, "must be >= 0");
-  return errors;
+  Rules rules;
+  rules.NonNegative("max_iterations", max_iterations)
+      .Positive("max_step_m", max_step_m)
+      .Positive("max_step_rad", max_step_rad)
+      .NonNegative("converged_step_m", converged_step_m)
+      .NonNegative("prior_sigma_xy_m", prior_sigma_xy_m)
+      .NonNegative("prior_sigma_yaw_rad", prior_sigma_yaw_rad)
+      .NonNegative("max_halvings", max_halvings);
+  return rules.errors();
 }
 
 ScanRefiner::ScanRefiner(const ScanRefinerOptions& options) : options_(options) {

@@ -34,9 +34,9 @@ TEST(ScanRefinerTest, RecoversSubCellOffsets) {
   options.max_iterations = 20;
   const ScanRefiner refiner(options);
   for (int trial = 0; trial < 20; ++trial) {
-    const Pose2 start(truth.x() + 0.08 * (2 * Uniform01(rng) - 1),
-                      truth.y() + 0.08 * (2 * Uniform01(rng) - 1),
-                      truth.theta() + 0.02 * (2 * Uniform01(rng) - 1));
+    const Eigen::Vector3d d = 2.0 * Uniform3(rng) - Eigen::Vector3d::Ones();
+    const Pose2 start(truth.x() + 0.08 * d.x(), truth.y() + 0.08 * d.y(),
+                      truth.theta() + 0.02 * d.z());
     const RefineResult r =
         refiner.Refine(field.view(), static_cast<float>(field.Score(0.0)), points, start);
     EXPECT_NEAR(r.pose.x(), truth.x(), 0.015) << trial;
@@ -120,9 +120,9 @@ TEST(ScanRefinerTest, MaximisingTheScoreEndsNearItsMaximumWhereverItStarts) {
   constexpr int kTrials = 20;
   double climber_deficit = 0.0, hector_deficit = 0.0;
   for (int trial = 0; trial < kTrials; ++trial) {
-    const Pose2 start(truth.x() + 0.05 * (2 * Uniform01(rng) - 1),
-                      truth.y() + 0.05 * (2 * Uniform01(rng) - 1),
-                      truth.theta() + 0.02 * (2 * Uniform01(rng) - 1));
+    const Eigen::Vector3d d = 2.0 * Uniform3(rng) - Eigen::Vector3d::Ones();
+    const Pose2 start(truth.x() + 0.05 * d.x(), truth.y() + 0.05 * d.y(),
+                      truth.theta() + 0.02 * d.z());
     const RefineResult r = climber.Refine(field.view(), field_max, points, start);
     EXPECT_NEAR(r.pose.x(), best.x(), 0.008) << trial;
     EXPECT_NEAR(r.pose.y(), best.y(), 0.004) << trial;

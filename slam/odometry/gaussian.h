@@ -23,6 +23,14 @@ inline double StandardNormal(RandomEngine& rng) {
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
 }
 
+/// Three independent Uniform01 samples, the last component drawn first (see StandardNormal3).
+inline Eigen::Vector3d Uniform3(RandomEngine& rng) {
+  const double z = Uniform01(rng);
+  const double y = Uniform01(rng);
+  const double x = Uniform01(rng);
+  return {x, y, z};
+}
+
 /// Three independent standard normal samples. The last component is drawn first: three draws as
 /// the arguments of one call come in an order the compiler chooses (gcc: last first), so callers
 /// take them from here, in the order that made the results recorded so far.

@@ -14,10 +14,6 @@ namespace {
 // Below this translation the heading of travel is noise: all rotation goes into rot2.
 constexpr double kMinTranslationForHeading = 1e-6;
 
-std::string Rule(const char* field, double value, const char* rule) {
-  return RuleViolation(field, value, rule);
-}
-
 }  // namespace
 
 RotTransRot RotTransRot::FromIncrement(const Pose2& before_from_after) {
@@ -42,17 +38,14 @@ Pose2 RotTransRot::ToIncrement() const {
 }
 
 std::vector<std::string> RotTransRotNoise::Validate() const {
-  std::vector<std::string> errors;
-  const std::pair<const char*, double> fields[] = {{"alpha1", alpha1},
-                                                   {"alpha2", alpha2},
-                                                   {"alpha3", alpha3},
-                                                   {"alpha4", alpha4},
-                                                   {"min_trans_sigma_m", min_trans_sigma_m},
-                                                   {"min_rot_sigma_rad", min_rot_sigma_rad}};
-  for (const auto& [name, value] : fields) {
-    if (!(value >= 0.0)) errors.push_back(Rule(name, value, "must be >= 0"));
-  }
-  return errors;
+  Rules rules;
+  rules.NonNegative("alpha1", alpha1)
+      .NonNegative("alpha2", alpha2)
+      .NonNegative("alpha3", alpha3)
+      .NonNegative("alpha4", alpha4)
+      .NonNegative("min_trans_sigma_m", min_trans_sigma_m)
+      .NonNegative("min_rot_sigma_rad", min_rot_sigma_rad);
+  return rules.errors();
 }
 
 Pose2 SampleRotTransRot(const Pose2& before_from_after, const RotTransRotNoise& noise,

@@ -17,8 +17,8 @@ void ExpectPoseNear(const Pose2& a, const Pose2& b, double tol) {
 TEST(RotTransRotTest, DecomposeComposeRoundTripsRandomIncrements) {
   RandomEngine rng(7);
   for (int trial = 0; trial < 10000; ++trial) {
-    const Pose2 increment(2.0 * StandardNormal(rng), 2.0 * StandardNormal(rng),
-                          3.0 * StandardNormal(rng));
+    const Eigen::Vector3d n = StandardNormal3(rng);
+    const Pose2 increment(2.0 * n.x(), 2.0 * n.y(), 3.0 * n.z());
     const RotTransRot m = RotTransRot::FromIncrement(increment);
     ASSERT_LE(std::abs(m.rot1_rad), 0.5 * std::numbers::pi + 1e-12);
     const Pose2 back = m.ToIncrement();

@@ -8,6 +8,7 @@
 
 #include "slam/odometry/rot_trans_rot_model.h"
 #include "slam/types/check.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::slam {
 namespace {}  // namespace
@@ -52,9 +53,7 @@ Pose2 Interpolate(const OdometryPose& a, const OdometryPose& b, Time t) {
 }  // namespace
 
 std::vector<std::string> ScanSyncOptions::Validate() const {
-  std::vector<std::string> errors;
-  for (const std::string& e : robot.Validate()) errors.push_back("sync." + e);
-  return errors;
+  return PrefixErrors("sync", robot.Validate());
 }
 
 ScanSynchronizer::ScanSynchronizer(const ScanSyncOptions& options, OdometrySource source)

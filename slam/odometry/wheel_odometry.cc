@@ -15,24 +15,15 @@ double DiffDriveParams::MetresPerTick() const {
 }
 
 std::vector<std::string> DiffDriveParams::Validate() const {
-  std::vector<std::string> errors;
-  if (!(wheel_radius_m > 0.0)) {
-    errors.push_back(RuleViolation("diff_drive.wheel_radius_m", wheel_radius_m, "must be > 0"));
-  }
-  if (ticks_per_revolution <= 0) {
-    errors.push_back(
-        RuleViolation("diff_drive.ticks_per_revolution", ticks_per_revolution, "must be > 0"));
-  }
-  if (!(track_width_m > 0.0)) {
-    errors.push_back(RuleViolation("diff_drive.track_width_m", track_width_m, "must be > 0"));
-  }
-  return errors;
+  Rules rules;
+  rules.Positive("wheel_radius_m", wheel_radius_m)
+      .Positive("ticks_per_revolution", ticks_per_revolution)
+      .Positive("track_width_m", track_width_m);
+  return PrefixErrors("diff_drive", rules.errors());
 }
 
 std::vector<std::string> WheelOdometryOptions::Validate() const {
-  std::vector<std::string> errors;
-  for (const std::string& e : robot.Validate()) errors.push_back("wheel_odometry." + e);
-  return errors;
+  return PrefixErrors("wheel_odometry", robot.Validate());
 }
 
 WheelOdometry::WheelOdometry(const WheelOdometryOptions& options) : options_(options) {

@@ -9,19 +9,13 @@
 namespace slamrig::slam {
 
 std::vector<std::string> OdometryCalibrationOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (!(memory_m > 0.0)) errors.push_back(RuleViolation("memory_m", memory_m, "must be > 0"));
-  if (!(prior_m > 0.0)) errors.push_back(RuleViolation("prior_m", prior_m, "must be > 0"));
-  if (!(max_error_rad > 0.0)) {
-    errors.push_back(RuleViolation("max_error_rad", max_error_rad, "must be > 0"));
-  }
-  if (!(max_drift_rad_per_m >= 0.0)) {
-    errors.push_back(RuleViolation("max_drift_rad_per_m", max_drift_rad_per_m, "must be >= 0"));
-  }
-  if (!(min_significance >= 0.0)) {
-    errors.push_back(RuleViolation("min_significance", min_significance, "must be >= 0"));
-  }
-  return errors;
+  Rules rules;
+  rules.Positive("memory_m", memory_m)
+      .Positive("prior_m", prior_m)
+      .Positive("max_error_rad", max_error_rad)
+      .NonNegative("max_drift_rad_per_m", max_drift_rad_per_m)
+      .NonNegative("min_significance", min_significance);
+  return rules.errors();
 }
 
 double OdometryCalibration::drift_rad_per_m() const {

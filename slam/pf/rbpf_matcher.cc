@@ -15,10 +15,6 @@
 namespace slamrig::slam {
 namespace {
 
-std::string Rule(const char* field, double value, const char* rule) {
-  return RuleViolation(field, value, rule);
-}
-
 // floor() without the libm call (the matcher's hot loop); exact for |v| < 2^31.
 int FloorToInt(double v) {
   const int i = static_cast<int>(v);
@@ -47,32 +43,21 @@ class PointCells {
 }  // namespace
 
 std::vector<std::string> RbpfMatcherOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (kernel_cells < 0) errors.push_back(Rule("kernel_cells", kernel_cells, "must be >= 0"));
-  if (!(score_sigma_m > 0.0)) errors.push_back(Rule("score_sigma_m", score_sigma_m, "must be > 0"));
-  if (!(likelihood_sigma_m > 0.0)) {
-    errors.push_back(Rule("likelihood_sigma_m", likelihood_sigma_m, "must be > 0"));
-  }
-  if (!(no_match_log_likelihood < 0.0)) {
-    errors.push_back(Rule("no_match_log_likelihood", no_match_log_likelihood, "must be < 0"));
-  }
-  if (!(linear_step_m > 0.0)) errors.push_back(Rule("linear_step_m", linear_step_m, "must be > 0"));
-  if (!(angular_step_rad > 0.0)) {
-    errors.push_back(Rule("angular_step_rad", angular_step_rad, "must be > 0"));
-  }
-  if (!(yaw_search_rad >= 0.0)) {
-    errors.push_back(Rule("yaw_search_rad", yaw_search_rad, "must be >= 0"));
-  }
-  if (!(yaw_search_step_rad > 0.0)) {
-    errors.push_back(Rule("yaw_search_step_rad", yaw_search_step_rad, "must be > 0"));
-  }
-  if (refinements < 0) errors.push_back(Rule("refinements", refinements, "must be >= 0"));
-  if (!(prior_weight >= 0.0)) errors.push_back(Rule("prior_weight", prior_weight, "must be >= 0"));
-  if (max_iterations < 1) errors.push_back(Rule("max_iterations", max_iterations, "must be >= 1"));
-  if (!(min_matched_fraction >= 0.0 && min_matched_fraction <= 1.0)) {
-    errors.push_back(Rule("min_matched_fraction", min_matched_fraction, "must be in [0, 1]"));
-  }
-  return errors;
+  Rules rules;
+  rules.NonNegative("kernel_cells", kernel_cells)
+      .Positive("score_sigma_m", score_sigma_m)
+      .Positive("likelihood_sigma_m", likelihood_sigma_m)
+      .Require(no_match_log_likelihood < 0.0, "no_match_log_likelihood", no_match_log_likelihood,
+               "must be < 0")
+      .Positive("linear_step_m", linear_step_m)
+      .Positive("angular_step_rad", angular_step_rad)
+      .NonNegative("yaw_search_rad", yaw_search_rad)
+      .Positive("yaw_search_step_rad", yaw_search_step_rad)
+      .NonNegative("refinements", refinements)
+      .NonNegative("prior_weight", prior_weight)
+      .AtLeast("max_iterations", max_iterations, 1)
+      .Fraction("min_matched_fraction", min_matched_fraction);
+  return rules.errors();
 }
 
 std::vector<MatchPoint> MakeMatchPoints(const LaserScan& scan, const ScanPointsOptions& points,

@@ -8,6 +8,19 @@
 namespace slamrig::slam {
 namespace {
 
+// Two or three draws of `u` as a vector, the last coordinate drawn first: sequenced (the
+// arguments of one call are drawn in the compiler's order), in the order the cases here were
+// generated with.
+Eigen::Vector2d Draw2(std::mt19937& rng, std::uniform_real_distribution<double>& u) {
+  const double y = u(rng);
+  return {u(rng), y};
+}
+Eigen::Vector3d Draw3(std::mt19937& rng, std::uniform_real_distribution<double>& u) {
+  const double z = u(rng);
+  const double y = u(rng);
+  return {u(rng), y, z};
+}
+
 // A room 6 m x 4 m seen from inside: a scan of its walls and a TiledGrid built from it.
 LaserScan RoomScan(const Pose2& world_from_base) {
   LaserScan scan;
@@ -51,8 +64,9 @@ TEST(RbpfMatcherTest, ClimbRecoversRandomOffsetsWithinReach) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int trial = 0; trial < 20; ++trial) {
-    const Pose2 start(truth.x() + 0.06 * u(rng), truth.y() + 0.06 * u(rng),
-                      truth.theta() + 0.03 * u(rng));
+    const Eigen::Vector3d d = Draw3(rng, u);
+    const Pose2 start(truth.x() + 0.06 * d.x(), truth.y() + 0.06 * d.y(),
+                      truth.theta() + 0.03 * d.z());
     const ClimbResult r = matcher.Climb(map, points, start, PosePrior{start, 1.0, 1.0});
     EXPECT_NEAR(r.pose.x(), truth.x(), 0.025) << trial;
     EXPECT_NEAR(r.pose.y(), truth.y(), 0.025) << trial;
@@ -150,7 +164,7 @@ TEST(RbpfMatcherTest, DenseWallPointsCountAsWallLengthOverCorrelationLength) {
     const double spacing = 0.013 + 0.005 * u(rng);
     const int n = 60 + static_cast<int>(100 * (u(rng) + 1.0));
     const double a = 3.2 * u(rng);
-    const Eigen::Vector2d start(5.0 * u(rng), 5.0 * u(rng));
+    const Eigen::Vector2d start = 5.0 * Draw2(rng, u);
     const Eigen::Vector2d dir(std::cos(a), std::sin(a));
     std::vector<MatchPoint> points;
     for (int i = 0; i < n; ++i) {
@@ -174,7 +188,7 @@ TEST(RbpfMatcherTest, ScatteredPointsFartherApartThanTheLengthCountOneEach) {
   const double length = 0.1;
   std::vector<MatchPoint> points;
   while (points.size() < 40) {
-    const Eigen::Vector2d p(u(rng), u(rng));
+    const Eigen::Vector2d p = Draw2(rng, u);
     bool near = false;
     for (const MatchPoint& q : points) near = near || (q.hit - p).norm() < 1.5 * length;
     if (!near) points.push_back({p, p});
@@ -197,16 +211,17 @@ TEST(RbpfMatcherTest, IndependentCountMatchesThePairwiseRuleAndIgnoresRigidMotio
     std::vector<MatchPoint> points;
     const int clusters = 1 + trial % 7;
     for (int c = 0; c < clusters; ++c) {
-      const Eigen::Vector2d centre(4.0 * u(rng), 4.0 * u(rng));
+      const Eigen::Vector2d centre = 4.0 * Draw2(rng, u);
       const double spread = 0.5 * (u(rng) + 1.0);
       for (int i = 0; i < 40; ++i) {
-        const Eigen::Vector2d p = centre + spread * Eigen::Vector2d(u(rng), u(rng));
+        const Eigen::Vector2d p = centre + spread * Draw2(rng, u);
         points.push_back({p, p});
       }
     }
     const int count = CountIndependentPoints(points, length);
     EXPECT_EQ(count, BruteForceIndependent(points, length)) << trial;
-    const Pose2 motion(10.0 * u(rng), 10.0 * u(rng), 3.1 * u(rng));
+    const Eigen::Vector3d m = Draw3(rng, u);
+    const Pose2 motion(10.0 * m.x(), 10.0 * m.y(), 3.1 * m.z());
     std::vector<MatchPoint> moved;
     for (const MatchPoint& p : points) {
       const Eigen::Vector2d q = motion * p.hit;
@@ -225,15 +240,16 @@ TEST(RbpfMatcherTest, IndependenceWeightsMatchThePairwiseRuleAndIgnoreRigidMotio
     const double length = 0.05 + 0.1 * (u(rng) + 1.0);
     std::vector<MatchPoint> points;
     for (int c = 0; c < 1 + trial % 5; ++c) {
-      const Eigen::Vector2d centre(4.0 * u(rng), 4.0 * u(rng));
+      const Eigen::Vector2d centre = 4.0 * Draw2(rng, u);
       const double spread = 0.5 * (u(rng) + 1.0);
       for (int i = 0; i < 30; ++i) {
-        const Eigen::Vector2d p = centre + spread * Eigen::Vector2d(u(rng), u(rng));
+        const Eigen::Vector2d p = centre + spread * Draw2(rng, u);
         points.push_back({p, p});
       }
     }
     AssignIndependenceWeights(points, length);
-    const Pose2 motion(10.0 * u(rng), 10.0 * u(rng), 3.1 * u(rng));
+    const Eigen::Vector3d m = Draw3(rng, u);
+    const Pose2 motion(10.0 * m.x(), 10.0 * m.y(), 3.1 * m.z());
     std::vector<MatchPoint> moved;
     for (const MatchPoint& p : points) moved.push_back({motion * p.hit, motion * p.free});
     AssignIndependenceWeights(moved, length);

@@ -65,8 +65,11 @@ TEST(SolutionRemappingTest, RemappingKeepsOnlyTheConstrainedPartOfTheCorrection)
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int trial = 0; trial < 200; ++trial) {
-    const Pose2 predicted(5 * u(rng), 5 * u(rng), 3 * u(rng));
-    const Pose2 matched(predicted.x() + u(rng), predicted.y() + u(rng), predicted.theta() + u(rng));
+    // Sequenced draws, the last coordinate first (the order these cases were generated in).
+    const double theta = 3 * u(rng), y = 5 * u(rng), x = 5 * u(rng);
+    const Pose2 predicted(x, y, theta);
+    const double dtheta = u(rng), dy = u(rng), dx = u(rng);
+    const Pose2 matched(predicted.x() + dx, predicted.y() + dy, predicted.theta() + dtheta);
     const Pose2 remapped = RemapAlongWeakDirections(predicted, matched, c, 0.05);
     const Pose2 seen = predicted.Inverse() * Pose2(remapped.x(), remapped.y(), predicted.theta());
     const Pose2 wanted = predicted.Inverse() * Pose2(matched.x(), matched.y(), predicted.theta());

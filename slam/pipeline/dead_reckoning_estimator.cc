@@ -5,9 +5,9 @@
 namespace slamrig::slam {
 
 std::vector<std::string> DeadReckoningOptions::Validate() const {
-  std::vector<std::string> errors = PrefixErrors("map", map.Validate());
-  AppendErrors(&errors, PrefixErrors("noise", noise.Validate()));
-  return errors;
+  Rules rules;
+  rules.Nested("map", map.Validate()).Nested("noise", noise.Validate());
+  return rules.errors();
 }
 
 namespace {

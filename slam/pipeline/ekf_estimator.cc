@@ -31,33 +31,17 @@ EkfOptions WithRobotGyro(EkfOptions options, const EstimatorContext& context) {
 }  // namespace
 
 std::vector<std::string> EkfOptions::Validate() const {
-  std::vector<std::string> errors = filter.Validate();
-  if (!(match_covariance_scale > 0.0)) {
-    errors.push_back(
-        RuleViolation("match_covariance_scale", match_covariance_scale, "must be > 0"));
-  }
-  if (!(match_sigma_floor_xy_m >= 0.0)) {
-    errors.push_back(
-        RuleViolation("match_sigma_floor_xy_m", match_sigma_floor_xy_m, "must be >= 0"));
-  }
-  if (!(match_sigma_floor_yaw_rad >= 0.0)) {
-    errors.push_back(
-        RuleViolation("match_sigma_floor_yaw_rad", match_sigma_floor_yaw_rad, "must be >= 0"));
-  }
-  if (!(increment_sigma_floor_xy_m >= 0.0)) {
-    errors.push_back(
-        RuleViolation("increment_sigma_floor_xy_m", increment_sigma_floor_xy_m, "must be >= 0"));
-  }
-  if (!(increment_sigma_floor_yaw_rad >= 0.0)) {
-    errors.push_back(RuleViolation("increment_sigma_floor_yaw_rad", increment_sigma_floor_yaw_rad,
-                                   "must be >= 0"));
-  }
-  if (!(map_drift_share >= 0.0)) {
-    errors.push_back(RuleViolation("map_drift_share", map_drift_share, "must be >= 0"));
-  }
-  if (!(slip_gate >= 0.0)) errors.push_back(RuleViolation("slip_gate", slip_gate, "must be >= 0"));
-  AppendErrors(&errors, PrefixErrors("map", map.Validate()));
-  return errors;
+  Rules rules;
+  rules.Nested("", filter.Validate())
+      .Positive("match_covariance_scale", match_covariance_scale)
+      .NonNegative("match_sigma_floor_xy_m", match_sigma_floor_xy_m)
+      .NonNegative("match_sigma_floor_yaw_rad", match_sigma_floor_yaw_rad)
+      .NonNegative("increment_sigma_floor_xy_m", increment_sigma_floor_xy_m)
+      .NonNegative("increment_sigma_floor_yaw_rad", increment_sigma_floor_yaw_rad)
+      .NonNegative("map_drift_share", map_drift_share)
+      .NonNegative("slip_gate", slip_gate)
+      .Nested("map", map.Validate());
+  return rules.errors();
 }
 
 EkfEstimator::EkfEstimator(const EkfOptions& options, const EstimatorContext& context)

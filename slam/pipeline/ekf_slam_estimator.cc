@@ -13,11 +13,11 @@ namespace {
 }  // namespace
 
 std::vector<std::string> EkfSlamEstimatorOptions::Validate() const {
-  std::vector<std::string> errors = filter.Validate();
-  AppendErrors(&errors, PrefixErrors("map", map.Validate()));
-  if (map_every_scans < 1)
-    errors.push_back(RuleViolation("map_every_scans", map_every_scans, "must be >= 1"));
-  return errors;
+  Rules rules;
+  rules.Nested("", filter.Validate())
+      .Nested("map", map.Validate())
+      .AtLeast("map_every_scans", map_every_scans, 1);
+  return rules.errors();
 }
 
 EkfSlamEstimator::EkfSlamEstimator(const EkfSlamEstimatorOptions& options,

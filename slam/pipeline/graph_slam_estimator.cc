@@ -5,9 +5,9 @@
 namespace slamrig::slam {
 
 std::vector<std::string> GraphSlamEstimatorOptions::Validate() const {
-  std::vector<std::string> errors = graph.Validate();
-  AppendErrors(&errors, PrefixErrors("map", map.Validate()));
-  return errors;
+  Rules rules;
+  rules.Nested("", graph.Validate()).Nested("map", map.Validate());
+  return rules.errors();
 }
 
 GraphSlamEstimator::GraphSlamEstimator(const GraphSlamEstimatorOptions& options,

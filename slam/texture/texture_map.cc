@@ -16,32 +16,21 @@ int TextureMapOptions::height() const {
 }
 
 std::vector<std::string> TextureMapOptions::Validate() const {
-  std::vector<std::string> e;
-  if (!(resolution_m > 0.0) || !std::isfinite(resolution_m)) {
-    e.push_back(RuleViolation("texture.resolution_m", resolution_m, "must be > 0"));
-    return e;
+  Rules rules;
+  rules.Require(resolution_m > 0.0 && std::isfinite(resolution_m), "resolution_m", resolution_m,
+                "must be > 0");
+  // Without a resolution the extents' cell count below means nothing.
+  if (!rules.errors().empty()) return PrefixErrors("texture", rules.errors());
+  rules.Require(max_m.x() > min_m.x(), "max_m.x", max_m.x(), "must be > texture.min_m.x")
+      .Require(max_m.y() > min_m.y(), "max_m.y", max_m.y(), "must be > texture.min_m.y");
+  if (rules.errors().empty()) {
+    rules.Require(static_cast<double>(width()) * height() <= 1e8, "resolution_m", resolution_m,
+                  "gives more than 1e8 cells over the extents");
   }
-  if (!(max_m.x() > min_m.x())) {
-    e.push_back(RuleViolation("texture.max_m.x", max_m.x(), "must be > texture.min_m.x"));
-  }
-  if (!(max_m.y() > min_m.y())) {
-    e.push_back(RuleViolation("texture.max_m.y", max_m.y(), "must be > texture.min_m.y"));
-  }
-  if (e.empty() && static_cast<double>(width()) * height() > 1e8) {
-    e.push_back(RuleViolation("texture.resolution_m", resolution_m,
-                              "gives more than 1e8 cells over the extents"));
-  }
-  if (!(floor_height_threshold_m > 0.0)) {
-    e.push_back(
-        RuleViolation("texture.floor_height_threshold_m", floor_height_threshold_m, "must be > 0"));
-  }
-  if (!(max_depth_m > 0.0)) {
-    e.push_back(RuleViolation("texture.max_depth_m", max_depth_m, "must be > 0"));
-  }
-  if (pixel_stride < 1) {
-    e.push_back(RuleViolation("texture.pixel_stride", pixel_stride, "must be >= 1"));
-  }
-  return e;
+  rules.Positive("floor_height_threshold_m", floor_height_threshold_m)
+      .Positive("max_depth_m", max_depth_m)
+      .AtLeast("pixel_stride", pixel_stride, 1);
+  return PrefixErrors("texture", rules.errors());
 }
 
 TextureMap::TextureMap(const TextureMapOptions& options) : options_(options) {

@@ -14,7 +14,9 @@ constexpr double kPi = std::numbers::pi;
 Pose2 RandomPose(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> xy(-100.0, 100.0);
   std::uniform_real_distribution<double> angle(-10.0, 10.0);
-  return Pose2(xy(rng), xy(rng), angle(rng));
+  // Sequenced draws, the last coordinate first (the order these cases were generated in).
+  const double theta = angle(rng), y = xy(rng), x = xy(rng);
+  return Pose2(x, y, theta);
 }
 
 void ExpectPoseNear(const Pose2& a, const Pose2& b, double tol) {
@@ -96,7 +98,8 @@ TEST(Pose2Test, RotationMatchesPointTransform) {
   std::uniform_real_distribution<double> xy(-10.0, 10.0);
   for (int i = 0; i < kNumTrials; ++i) {
     const Pose2 a = RandomPose(rng);
-    const Eigen::Vector2d p(xy(rng), xy(rng));
+    const double y = xy(rng);  // drawn first, as in RandomPose
+    const Eigen::Vector2d p(xy(rng), y);
     ASSERT_NEAR((a * p - (a.Rotation() * p + a.translation())).norm(), 0.0, 1e-9);
     ASSERT_NEAR((a.Rotation().transpose() * a.Rotation() - Eigen::Matrix2d::Identity()).norm(), 0.0,
                 1e-12);

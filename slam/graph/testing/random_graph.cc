@@ -11,7 +11,11 @@ RandomPoseGraph MakeRandomPoseGraph(const RandomPoseGraphOptions& options) {
   RandomPoseGraph out;
   Pose2 pose;
   for (int i = 0; i < options.num_poses; ++i) {
-    if (i > 0) pose = pose * Pose2(step(rng), 0.2 * turn(rng), turn(rng));
+    if (i > 0) {
+      // Sequenced draws, the last coordinate first: the order the graphs were generated in.
+      const double yaw = turn(rng), y = 0.2 * turn(rng);
+      pose = pose * Pose2(step(rng), y, yaw);
+    }
     out.truth.push_back(pose);
     out.graph.AddVertex(i, pose);
   }
@@ -23,8 +27,9 @@ RandomPoseGraph MakeRandomPoseGraph(const RandomPoseGraphOptions& options) {
         1.0 / (options.sigma_theta_rad * options.sigma_theta_rad);
   }
   const auto measure = [&](int from, int to, EdgeKind kind) {
-    const Pose2 noise(options.sigma_xy_m * normal(rng), options.sigma_xy_m * normal(rng),
-                      options.sigma_theta_rad * normal(rng));
+    const double yaw = options.sigma_theta_rad * normal(rng);
+    const double y = options.sigma_xy_m * normal(rng);
+    const Pose2 noise(options.sigma_xy_m * normal(rng), y, yaw);
     out.graph.AddEdge({.from = from,
                        .to = to,
                        .measurement = out.truth[from].Between(out.truth[to]) * noise,

@@ -293,13 +293,13 @@ struct Decoder {
 }  // namespace
 
 std::vector<std::string> BagReaderOptions::Validate() const {
-  std::vector<std::string> errors = topics.Validate();
-  if (!(ticks_per_revolution >= 0.0) || !std::isfinite(ticks_per_revolution)) {
-    errors.push_back(RuleViolation("ticks_per_revolution", ticks_per_revolution,
-                                   "must be finite and > 0 (or 0: from the bag)"));
-  }
-  if (base_frame.empty()) errors.push_back(RuleViolation("base_frame", "''", "must not be empty"));
-  return errors;
+  Rules rules;
+  rules.Nested("", topics.Validate())
+      .Require(ticks_per_revolution >= 0.0 && std::isfinite(ticks_per_revolution),
+               "ticks_per_revolution", ticks_per_revolution,
+               "must be finite and > 0 (or 0: from the bag)")
+      .Require(!base_frame.empty(), "base_frame", "''", "must not be empty");
+  return rules.errors();
 }
 
 Dataset ReadBag(const std::string& path, const BagReaderOptions& options) {

@@ -1,13 +1,14 @@
 #include "slam/io/bag/bag_sink.h"
 
 #include "slam/types/error.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::slam {
 
 std::vector<std::string> BagSinkOptions::Validate() const {
-  std::vector<std::string> errors = writer.Validate();
-  for (std::string& e : odometry.Validate()) errors.push_back(std::move(e));
-  return errors;
+  Rules rules;
+  rules.Nested("", writer.Validate()).Nested("", odometry.Validate());
+  return rules.errors();
 }
 
 namespace {

@@ -120,34 +120,28 @@ const char* BagTopicNames::Keys() {
 }
 
 std::vector<std::string> BagFrames::Validate() const {
-  std::vector<std::string> errors;
+  Rules rules;
   for (const auto& [field, value] :
-       {std::pair{"frames.map", &map}, std::pair{"frames.odom", &odom},
-        std::pair{"frames.base", &base}, std::pair{"frames.laser", &laser},
-        std::pair{"frames.imu", &imu}, std::pair{"frames.camera", &camera},
-        std::pair{"frames.depth", &depth}}) {
-    if (value->empty()) errors.push_back(RuleViolation(field, "''", "must not be empty"));
+       {std::pair{"map", &map}, std::pair{"odom", &odom}, std::pair{"base", &base},
+        std::pair{"laser", &laser}, std::pair{"imu", &imu}, std::pair{"camera", &camera},
+        std::pair{"depth", &depth}}) {
+    rules.Require(!value->empty(), field, "''", "must not be empty");
   }
-  return errors;
+  return PrefixErrors("frames", rules.errors());
 }
 
 std::vector<std::string> BagWriterOptions::Validate() const {
-  std::vector<std::string> errors = topics.Validate();
-  for (std::string& e : frames.Validate()) errors.push_back(std::move(e));
-  if (chunk_size_bytes < 1024) {
-    errors.push_back(RuleViolation("chunk_size_bytes", chunk_size_bytes, "must be >= 1024"));
-  }
-  if (single_file && storage != BagStorage::kMcap) {
-    errors.push_back(RuleViolation("single_file", "true", "needs storage mcap"));
-  }
-  if (!(ticks_per_revolution > 0.0) || !std::isfinite(ticks_per_revolution)) {
-    errors.push_back(
-        RuleViolation("ticks_per_revolution", ticks_per_revolution, "must be finite and > 0"));
-  }
-  if (!(clock_rate_hz >= 0.0) || !std::isfinite(clock_rate_hz)) {
-    errors.push_back(RuleViolation("clock_rate_hz", clock_rate_hz, "must be finite and >= 0"));
-  }
-  return errors;
+  Rules rules;
+  rules.Nested("", topics.Validate())
+      .Nested("", frames.Validate())
+      .AtLeast("chunk_size_bytes", chunk_size_bytes, decltype(chunk_size_bytes){1024})
+      .Require(!single_file || storage == BagStorage::kMcap, "single_file", "true",
+               "needs storage mcap")
+      .Require(ticks_per_revolution > 0.0 && std::isfinite(ticks_per_revolution),
+               "ticks_per_revolution", ticks_per_revolution, "must be finite and > 0")
+      .Require(clock_rate_hz >= 0.0 && std::isfinite(clock_rate_hz), "clock_rate_hz", clock_rate_hz,
+               "must be finite and >= 0");
+  return rules.errors();
 }
 
 std::vector<std::string> WheelJointNames(std::size_t right, std::size_t left) {

@@ -36,15 +36,10 @@ std::string_view McapCompressionName(McapCompression compression) {
 }
 
 std::vector<std::string> McapWriterOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (chunk_size_bytes < 1024) {
-    errors.push_back(RuleViolation("chunk_size_bytes", chunk_size_bytes, "must be >= 1024"));
-  }
-  if (zstd_level < 1 || zstd_level > ZSTD_maxCLevel()) {
-    errors.push_back(RuleViolation("zstd_level", zstd_level,
-                                   "must be in [1, " + std::to_string(ZSTD_maxCLevel()) + "]"));
-  }
-  return errors;
+  Rules rules;
+  rules.AtLeast("chunk_size_bytes", chunk_size_bytes, decltype(chunk_size_bytes){1024})
+      .InRange("zstd_level", zstd_level, 1, ZSTD_maxCLevel());
+  return rules.errors();
 }
 
 McapWriter::McapWriter(std::string path, McapWriterOptions options)
