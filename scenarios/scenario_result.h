@@ -37,6 +37,15 @@ struct ConfigResult {
   std::optional<TextureResult> texture;
 };
 
+/// A configuration that produced nothing to score (an external program that crashed, timed out
+/// or wrote no usable output): the other configurations' results stand, the run's verdict is
+/// FAIL and this line says why.
+struct ConfigFailure {
+  std::string name;
+  std::string algorithm;
+  std::string message;  ///< one line, with the last lines of the program's stderr
+};
+
 /// One checked expectation.
 struct ExpectationOutcome {
   Expectation expectation;
@@ -56,6 +65,8 @@ struct ScenarioResult {
   /// scans inserted at its reference poses.
   std::optional<slam::OccupancyGrid> truth_map;
   std::vector<ConfigResult> configs;
+  /// The configurations that failed, in the scenario's order (not in `configs`).
+  std::vector<ConfigFailure> failures;
   double sim_time_s = 0.0;    ///< simulated seconds, or the log's time span
   int scans = 0;              ///< scans the lidar produced (or the log holds)
   int scans_blacked_out = 0;  ///< of them, withheld by lidar_blackout faults
@@ -80,7 +91,8 @@ struct ScenarioResult {
 };
 
 /// Checks every expectation of `result.spec` against the configs' metrics, filling `outcomes`
-/// and `passed`.
+/// and `passed`; a failed configuration fails the run (and its expectations, which have no
+/// value).
 void CheckExpectations(ScenarioResult* result);
 
 /// Writes the report folder: config.yaml (resolved), metrics.json, truth.tum and
