@@ -115,6 +115,16 @@ Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& optio
   int pipe_fds[2] = {-1, -1};
   if (to_pipe && ::pipe2(pipe_fds, O_CLOEXEC) != 0)
     throw std::runtime_error(std::string("pipe failed: ") + std::strerror(errno));
+  // Closed by the exec (or the child's exit): once it reads end of file, what runs in the child
+  // is the program, not this process's copy (whose memory the child's /proc status would show).
+  int exec_fds[2] = {-1, -1};
+  if (::pipe2(exec_fds, O_CLOEXEC) != 0) {
+    if (to_pipe) {
+      ::close(pipe_fds[0]);
+      ::close(pipe_fds[1]);
+    }
+    throw std::runtime_error(std::string("pipe failed: ") + std::strerror(errno));
+  }
   // SIGINT and SIGTERM blocked across fork: the child starts with this process's handlers, which
   // only record a signal in the child's copy of memory, lost at exec. Blocked, a signal sent to
   // the child before it restores the default action stays pending and then ends it.
@@ -157,6 +167,13 @@ Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& optio
   }
   const int fork_errno = errno;
   ::sigprocmask(SIG_SETMASK, &old_mask, nullptr);
+  ::close(exec_fds[1]);
+  if (pid > 0) {
+    char byte = 0;
+    while (::read(exec_fds[0], &byte, 1) < 0 && errno == EINTR) {
+    }
+  }
+  ::close(exec_fds[0]);
   if (pid < 0) {
     if (to_pipe) {
       ::close(pipe_fds[0]);
