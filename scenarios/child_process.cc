@@ -156,6 +156,10 @@ Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& optio
           ::write(STDERR_FILENO, message.data(), message.size());
       ::_exit(127);
     };
+    if (options.null_stdin) {
+      const int null = ::open("/dev/null", O_RDONLY);
+      if (null >= 0) ::dup2(null, STDIN_FILENO);
+    }
     if (!options.working_dir.empty() && ::chdir(options.working_dir.c_str()) != 0)
       fail(chdir_failed);
     if (options.search_path) {

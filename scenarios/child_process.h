@@ -67,6 +67,7 @@ struct SpawnOptions {
   std::string stderr_path;
   std::string working_dir;   ///< empty: this process's
   bool search_path = false;  ///< args[0] without a slash is looked up on PATH (execvp)
+  bool null_stdin = false;   ///< stdin from /dev/null, else this process's
 };
 
 /// SpawnChild with the choices of `options`. A program that cannot be started exits with code

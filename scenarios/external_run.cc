@@ -212,6 +212,7 @@ ExternalOutcome RunExternal(const std::string& name, const slam::ExternalEstimat
   spawn.stderr_path = (fs::path(work_dir) / (name + "_stderr.txt")).string();
   spawn.working_dir = dir.string();
   spawn.search_path = true;
+  spawn.null_stdin = true;
   Children children;
   const long parent_kb = ProcessResidentKb();
   Child child = SpawnChild(args, spawn, 0);

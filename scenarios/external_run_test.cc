@@ -94,6 +94,13 @@ TEST(ExternalRunTest, ProgramsFailAloneAndTheClientMatchesBuiltInDeadReckoning) 
       "import subprocess, sys; subprocess.run([sys.executable, '" + client +
       "', sys.argv[1], sys.argv[2]], check=True); lines = open(sys.argv[2]).readlines(); "
       "open(sys.argv[2], 'w').writelines(lines[:-5])";
+  // The client, then a 20 x 20 map_server map beside its output: all free but a wall row.
+  const std::string mapped =
+      "import subprocess, sys; subprocess.run([sys.executable, '" + client +
+      "', sys.argv[1], sys.argv[2]], check=True); "
+      "open('output.pgm', 'wb').write(b'P5 20 20 255 ' + bytes([254] * 380 + [0] * 20)); "
+      "open('output.yaml', 'w').write('image: output.pgm\\\\nresolution: 0.1\\\\norigin: [-1, -1, "
+      "0]\\\\nnegate: 0\\\\noccupied_thresh: 0.65\\\\nfree_thresh: 0.196\\\\n')";
   std::ofstream(dir / "s.yaml")
       << "name: external_test\nworld: " << source << "/worlds/office.yaml\nrobot: " << source
       << "/robots/ece276a.yaml\nseed: 3\nduration_s: 20\nslam:\n"
@@ -107,6 +114,8 @@ TEST(ExternalRunTest, ProgramsFailAloneAndTheClientMatchesBuiltInDeadReckoning) 
       << "  garbage: {algorithm: external, command: [python3, -c, \"import sys; "
          "open(sys.argv[1], 'w').write('no trajectory here')\", \"{output}\"]}\n"
       << "  too_few: {algorithm: external, command: [python3, -c, \"" << too_few
+      << "\", \"{input}\", \"{output}\"]}\n"
+      << "  mapped: {algorithm: external, command: [python3, -c, \"" << mapped
       << "\", \"{input}\", \"{output}\"]}\n"
       << "  mcap: {algorithm: external, command: [\"true\"], input: mcap}\n"
       << "expect:\n  dead_reckoning: {ate_rmse_m_max: 1.0}\n  external_dr: {ate_rmse_m_max: 1.0}\n";
@@ -143,6 +152,15 @@ TEST(ExternalRunTest, ProgramsFailAloneAndTheClientMatchesBuiltInDeadReckoning) 
   EXPECT_GT(ate_builtin, 0.005);
   EXPECT_NEAR(ate_external, ate_builtin, 0.01 * ate_builtin);
   EXPECT_NEAR(external->metrics.at("final_error_m"), builtin->metrics.at("final_error_m"), 0.005);
+  // No map written, no map metrics; a map written is scored.
+  EXPECT_EQ(external->metrics.count("map_f1"), 0u);
+  const ConfigResult* with_map = Find(r, "mapped");
+  ASSERT_TRUE(with_map) << Failure(r, "mapped");
+  EXPECT_EQ(with_map->run.map.width(), 20);
+  // Scored (its toy wall lies nowhere near the office's, so its F1 is what it is).
+  EXPECT_EQ(with_map->metrics.count("map_f1"), 1u);
+  EXPECT_EQ(with_map->metrics.count("map_precision"), 1u);
+  EXPECT_GE(builtin->metrics.at("map_f1"), 0.0);
   EXPECT_GT(external->metrics.at("peak_rss_mib"), 1.0);
   EXPECT_GT(external->metrics.at("child_wall_s"), 0.0);
 

@@ -23,6 +23,9 @@ struct ConfigResult {
   Trajectory mean_estimate;  ///< the estimator's second estimate (a PF's mean), else empty
   slam::EstimatorRun run;    ///< everything it produced, in its own frame (map, traces, stats)
   Pose2 map_from_estimator;  ///< the reference pose at the estimator's first scan
+  /// False when the configuration reported no map (an external program that wrote none): it
+  /// has no map metrics.
+  bool has_map = true;
   /// The MetricsOf() names that apply to this configuration in this run (a reference, a camera,
   /// kidnappings, covariances, loop closures); NaN where one applies but could not be computed
   /// (a run too short for a spacing).

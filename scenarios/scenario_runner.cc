@@ -197,7 +197,7 @@ void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
     }
   }
   if (algorithm && algorithm->closes_loops) ScoreLoops(run, c);
-  if (run.truth_map) {
+  if (run.truth_map && c->has_map) {
     // A simulation's map is scored where the estimate starts (on the truth); a log's reference
     // is itself an estimate, whose first pose is no better an anchor than any other, so there the
     // map is scored in the ATE alignment's frame.
@@ -280,6 +280,7 @@ bool TakeExternal(const slam::ExternalEstimator& external, const std::string& wo
   }
   c->run.online = outcome.poses;
   c->run.final = std::move(outcome.poses);
+  c->has_map = outcome.map.has_value();
   if (outcome.map) c->run.map = std::move(*outcome.map);
   c->run.wall_s = outcome.child_wall_s;
   c->run.statistics = {{"peak_rss_mib", static_cast<double>(outcome.peak_rss_kb) / 1024.0},
