@@ -79,6 +79,7 @@ int RunRunCommand(const std::vector<std::string>& args) {
     std::printf("%s: %s\n", spec.name.c_str(), spec.description.c_str());
   }
   const auto start = std::chrono::steady_clock::now();
+  options.work_dir = out_dir;
   scenario::ScenarioResult result = scenario::RunScenario(spec, options);
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -105,7 +106,14 @@ int RunRunCommand(const std::vector<std::string>& args) {
                   c.name.c_str(), get("ate_rmse_m"), get("ate_max_m"), get("final_error_m"),
                   get("map_f1"));
     }
+    for (const auto& f : result.failures)
+      std::printf("  %-16s FAILED (see below)\n", f.name.c_str());
     std::fputs(scenario::ExpectationTable(result).c_str(), stdout);
+  }
+  // Quiet or not, a failed configuration is named: it is why the verdict is FAIL.
+  if (quiet) {
+    for (const auto& f : result.failures)
+      std::printf("  %s (%s) failed: %s\n", f.name.c_str(), f.algorithm.c_str(), f.message.c_str());
   }
   std::printf("%s: %s -> %s/report.html\n", spec.name.c_str(), result.passed ? "PASS" : "FAIL",
               out_dir.c_str());

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <optional>
+#include <stdexcept>
 
 #include "apps/cli_args.h"
 #include "apps/commands.h"
@@ -300,7 +301,10 @@ int RunSlamCommand(const std::vector<std::string>& args) {
     if (flags.clouds > 0 && (done - 1) % static_cast<std::size_t>(flags.clouds) == 0)
       clouds += CloudLines(scan.scan.time.seconds(), runner.estimator().View());
   };
+  options.work_dir = flags.out_dir;
   scenario::ScenarioResult result = scenario::RunScenario(spec, options);
+  // One configuration: when it failed there is nothing to write but why.
+  if (!result.failures.empty()) throw std::runtime_error(result.failures.front().message);
   if (!result.truncated.empty()) std::fprintf(stderr, "note: %s\n", result.truncated.c_str());
   if (const auto late = result.configs.front().run.final.out_of_order(); late > 0) {
     result.notes.push_back(std::to_string(late) +

@@ -34,6 +34,7 @@ BenchmarkFigures ReadFigures(const std::string& metrics_path, const std::string&
     for (const std::string& name : FigureNames()) {
       if (mine[name] && mine[name].IsScalar()) figures.estimator[name] = mine[name].as<double>();
     }
+    if (mine["failure"]) figures.failure = mine["failure"].as<std::string>();
     if (mine["run"] && mine["run"]["wall_time_s"])
       figures.estimator["wall_time_s"] = mine["run"]["wall_time_s"].as<double>();
   }
@@ -69,7 +70,11 @@ std::vector<std::string> BenchmarkRow(const BenchmarkSuite& suite, const Benchma
   } else {
     try {
       figures = ReadFigures(metrics_path, suite.estimators[run.estimator].name);
-      status = JudgeBenchmarkRun(figures, &reason);
+      if (figures.failure.empty()) {
+        status = JudgeBenchmarkRun(figures, &reason);
+      } else {
+        reason = figures.failure;  // an external program that failed: status stays "error"
+      }
     } catch (const YAML::Exception& e) {
       reason = metrics_path + ": " + e.what();
     }

@@ -21,6 +21,8 @@ const std::vector<std::string>& BenchmarkTimingColumns();
 struct BenchmarkFigures {
   std::map<std::string, double> estimator;  ///< ate_rmse_m, ate_max_m, ... of the estimator
   double baseline_ate_rmse_m = -1.0;        ///< dead reckoning's on the same data; < 0: none
+  /// Why the estimator produced nothing (an external program's failure), else empty.
+  std::string failure;
 };
 
 /// The verdict of a run that produced figures: "pass", or "fail" with the reason when its ATE is

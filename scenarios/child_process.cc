@@ -7,8 +7,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -89,19 +91,40 @@ std::string LastErrorLine(const Child& child, const std::string& fallback) {
 
 Child SpawnChild(const std::vector<std::string>& args, const std::string& log_path,
                  std::size_t run) {
+  SpawnOptions options;
+  options.stdout_path = log_path;
+  return SpawnChild(args, options, run);
+}
+
+Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& options,
+                 std::size_t run) {
   Child child;
   child.run = run;
   child.start = Clock::now();
-  child.log_path = log_path;
+  child.log_path = options.stdout_path;
   // Everything the child needs is made before fork: between fork and exec it only calls
   // async-signal-safe functions.
   std::vector<std::string> argv_text = args;
   std::vector<char*> argv;
   for (auto& a : argv_text) argv.push_back(a.data());
   argv.push_back(nullptr);
-  int pipe_fds[2];
-  if (::pipe2(pipe_fds, O_CLOEXEC) != 0)
+  const std::string exec_failed =
+      "cannot start " + (args.empty() ? std::string() : args.front()) + ": exec failed\n";
+  const std::string chdir_failed = "cannot enter " + options.working_dir + "\n";
+  const bool to_pipe = options.stderr_path.empty();
+  int pipe_fds[2] = {-1, -1};
+  if (to_pipe && ::pipe2(pipe_fds, O_CLOEXEC) != 0)
     throw std::runtime_error(std::string("pipe failed: ") + std::strerror(errno));
+  // Closed by the exec (or the child's exit): once it reads end of file, what runs in the child
+  // is the program, not this process's copy (whose memory the child's /proc status would show).
+  int exec_fds[2] = {-1, -1};
+  if (::pipe2(exec_fds, O_CLOEXEC) != 0) {
+    if (to_pipe) {
+      ::close(pipe_fds[0]);
+      ::close(pipe_fds[1]);
+    }
+    throw std::runtime_error(std::string("pipe failed: ") + std::strerror(errno));
+  }
   // SIGINT and SIGTERM blocked across fork: the child starts with this process's handlers, which
   // only record a signal in the child's copy of memory, lost at exec. Blocked, a signal sent to
   // the child before it restores the default action stays pending and then ends it.
@@ -120,26 +143,64 @@ Child SpawnChild(const std::vector<std::string>& args, const std::string& log_pa
     // (not SIGKILL), so that it still removes its temporary files.
     ::prctl(PR_SET_PDEATHSIG, SIGTERM);
     if (::getppid() != parent) ::_exit(128 + SIGTERM);  // the sweep died before prctl
-    const int log = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int log = ::open(options.stdout_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (log >= 0) ::dup2(log, STDOUT_FILENO);
-    ::dup2(pipe_fds[1], STDERR_FILENO);  // dup2 clears O_CLOEXEC on the copy
-    ::execv(argv[0], argv.data());
-    static constexpr char kMessage[] = "execv failed\n";
-    [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, kMessage, sizeof(kMessage) - 1);
-    ::_exit(127);
+    if (to_pipe) {
+      ::dup2(pipe_fds[1], STDERR_FILENO);  // dup2 clears O_CLOEXEC on the copy
+    } else {
+      const int err = ::open(options.stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (err >= 0) ::dup2(err, STDERR_FILENO);
+    }
+    const auto fail = [](const std::string& message) {
+      [[maybe_unused]] const ssize_t written =
+          ::write(STDERR_FILENO, message.data(), message.size());
+      ::_exit(127);
+    };
+    if (options.null_stdin) {
+      const int null = ::open("/dev/null", O_RDONLY);
+      if (null >= 0) ::dup2(null, STDIN_FILENO);
+    }
+    if (!options.working_dir.empty() && ::chdir(options.working_dir.c_str()) != 0)
+      fail(chdir_failed);
+    if (options.search_path) {
+      ::execvp(argv[0], argv.data());
+    } else {
+      ::execv(argv[0], argv.data());
+    }
+    fail(exec_failed);
   }
   const int fork_errno = errno;
   ::sigprocmask(SIG_SETMASK, &old_mask, nullptr);
+  ::close(exec_fds[1]);
+  if (pid > 0) {
+    char byte = 0;
+    while (::read(exec_fds[0], &byte, 1) < 0 && errno == EINTR) {
+    }
+  }
+  ::close(exec_fds[0]);
   if (pid < 0) {
-    ::close(pipe_fds[0]);
-    ::close(pipe_fds[1]);
+    if (to_pipe) {
+      ::close(pipe_fds[0]);
+      ::close(pipe_fds[1]);
+    }
     throw std::runtime_error(std::string("fork failed: ") + std::strerror(fork_errno));
   }
-  ::close(pipe_fds[1]);
-  ::fcntl(pipe_fds[0], F_SETFL, O_NONBLOCK);
+  if (to_pipe) {
+    ::close(pipe_fds[1]);
+    ::fcntl(pipe_fds[0], F_SETFL, O_NONBLOCK);
+    child.stderr_fd = pipe_fds[0];
+  }
   child.pid = pid;
-  child.stderr_fd = pipe_fds[0];
   return child;
+}
+
+long ProcessPeakKb(pid_t pid) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::strtol(line.c_str() + 6, nullptr, 10);
+  }
+  return 0;
 }
 
 std::optional<std::pair<Child, int>> Children::WaitAny() {
@@ -147,6 +208,7 @@ std::optional<std::pair<Child, int>> Children::WaitAny() {
     const Clock::time_point now = Clock::now();
     for (auto& [pid, child] : running_) {
       DrainStderr(&child);
+      child.polled_peak_kb = std::max(child.polled_peak_kb, ProcessPeakKb(pid));
       if (!child.timed_out && now > child.deadline) {
         child.timed_out = true;
         ::kill(pid, SIGKILL);

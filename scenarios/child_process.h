@@ -26,7 +26,14 @@ struct Child {
   std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
   bool timed_out = false;
   long peak_rss_kb = 0;  ///< its peak resident memory, once it has ended (ru_maxrss)
+  /// The largest VmHWM of its /proc status WaitAny saw while it ran (polled every 20 ms), of
+  /// the program after exec alone. ru_maxrss also counts the copy of the parent that fork
+  /// made before exec, which dwarfs a small program started by a large process.
+  long polled_peak_kb = 0;
 };
+
+/// A process's VmHWM (peak resident memory since its last exec) in KiB, 0 when unknown.
+long ProcessPeakKb(pid_t pid);
 
 /// Exit code of a slamrig command that could not write its output (apps/main.cc).
 inline constexpr int kExitOutputError = 74;
@@ -50,6 +57,23 @@ std::string LastErrorLine(const Child& child, const std::string& fallback);
 /// Starts `args` (args[0] is the program's path) with stdout to `log_path` (truncated) and
 /// stderr to a pipe. The child gets SIGTERM when the calling process dies (PR_SET_PDEATHSIG).
 Child SpawnChild(const std::vector<std::string>& args, const std::string& log_path,
+                 std::size_t run);
+
+/// Where a child started by SpawnChild(args, SpawnOptions, run) writes and runs.
+struct SpawnOptions {
+  std::string stdout_path;  ///< truncated; its stdout
+  /// Its whole stderr, truncated first; empty: a pipe, kept in Child::stderr_text and appended
+  /// to stdout_path at the end (a sweep's children).
+  std::string stderr_path;
+  std::string working_dir;   ///< empty: this process's
+  bool search_path = false;  ///< args[0] without a slash is looked up on PATH (execvp)
+  bool null_stdin = false;   ///< stdin from /dev/null, else this process's
+};
+
+/// SpawnChild with the choices of `options`. A program that cannot be started exits with code
+/// 127 and "cannot start PROGRAM: exec failed" on its stderr; a working folder it cannot enter,
+/// with 127 and "cannot enter FOLDER".
+Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& options,
                  std::size_t run);
 
 /// The child processes of a sweep. However the sweep ends (done, interrupted, an error thrown),

@@ -54,6 +54,19 @@ std::vector<std::string> RunOptions::Validate() const {
   return errors;
 }
 
+std::vector<std::pair<std::string, std::string>> CarmenLogParams(
+    const sim::SimulatorOptions& options) {
+  const sim::RobotSpec& robot = options.robot;
+  return {{"robot_front_laser_max", FormatNumber(robot.lidar.range_max_m)},
+          {"robot_frontlaser_offset", FormatNumber(robot.lidar.mount.x_m)},
+          // ROBOTLASER1 has no field for these; slamrig's reader applies them to every laser line.
+          {"laser_time_increment_s", FormatNumber(robot.lidar.time_increment_s())},
+          {"laser_range_min_m", FormatNumber(robot.lidar.range_min_m)},
+          {"slamrig_world", options.world.name.empty() ? "unnamed" : options.world.name},
+          {"slamrig_robot", robot.name.empty() ? "unnamed" : robot.name},
+          {"slamrig_seed", std::to_string(options.seed)}};
+}
+
 namespace {
 
 // The one sink of a recording, by format; the concrete one is kept for its counters.
@@ -85,15 +98,7 @@ void OpenSinks(const sim::SimulatorOptions& options, const RecordingOptions& rec
   } else if (recording.format == RecordingFormat::kCarmen) {
     slam::CarmenSinkOptions carmen;
     carmen.odometry = odometry;
-    carmen.params = {
-        {"robot_front_laser_max", FormatNumber(robot.lidar.range_max_m)},
-        {"robot_frontlaser_offset", FormatNumber(robot.lidar.mount.x_m)},
-        // ROBOTLASER1 has no field for these; slamrig's reader applies them to every laser line.
-        {"laser_time_increment_s", FormatNumber(robot.lidar.time_increment_s())},
-        {"laser_range_min_m", FormatNumber(robot.lidar.range_min_m)},
-        {"slamrig_world", options.world.name.empty() ? "unnamed" : options.world.name},
-        {"slamrig_robot", robot.name.empty() ? "unnamed" : robot.name},
-        {"slamrig_seed", std::to_string(options.seed)}};
+    carmen.params = CarmenLogParams(options);
     sinks->carmen = std::make_unique<slam::CarmenSink>(dir + run_name, carmen);
   } else {
     slam::BagSinkOptions bag;

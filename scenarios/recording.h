@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sim/simulator.h"
@@ -56,6 +57,11 @@ struct RunSummary {
   double path_length_m = 0.0;      ///< true distance driven
   std::vector<std::string> files;  ///< paths written
 };
+
+/// The PARAM lines of a CARMEN log of a simulated run: the lidar's range and mounting, what
+/// slamrig's reader needs beyond ROBOTLASER1 (time increment, minimum range), world, robot, seed.
+std::vector<std::pair<std::string, std::string>> CarmenLogParams(
+    const sim::SimulatorOptions& options);
 
 /// Runs a simulation and records it into `out_dir` (created if missing), every file atomically.
 /// The simulator only emits records and the truth; what is written is the sinks' business:

@@ -141,6 +141,17 @@ std::string MetricsJson(const ScenarioResult& r) {
     j.EndObject();
     j.EndObject();
   }
+  // A failed configuration: what went wrong instead of metrics.
+  for (const ConfigFailure& f : r.failures) {
+    j.BeginObject(f.name);
+    j.String("algorithm", f.algorithm).String("failure", f.message);
+    j.BeginObject("config");
+    for (const slam::EstimatorConfig& config : r.spec->configs) {
+      if (config.name == f.name) slam::WriteEstimatorConfigJson(config, &j);
+    }
+    j.EndObject();
+    j.EndObject();
+  }
   j.EndObject();
   j.BeginObject("expectations");
   for (const ExpectationOutcome& o : r.outcomes) {
@@ -244,11 +255,14 @@ void CheckExpectations(ScenarioResult* result) {
     result->passed = result->passed && o.passed;
     result->outcomes.push_back(o);
   }
+  if (!result->failures.empty()) result->passed = false;
 }
 
 std::string ExpectationTable(const ScenarioResult& r) {
   std::string out;
-  if (r.outcomes.empty()) return "  (no expectations)\n";
+  for (const ConfigFailure& f : r.failures)
+    out += "  FAIL   " + f.name + " (" + f.algorithm + ") failed: " + f.message + "\n";
+  if (r.outcomes.empty()) return out + "  (no expectations)\n";
   std::size_t width = 0;
   for (const auto& o : r.outcomes)
     width = std::max(width, o.expectation.config.size() + o.expectation.metric.size() + 1);
@@ -618,6 +632,14 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
   h << "<h1>" << EscapeHtml(r.spec->name) << " <span class=\""
     << (r.passed ? "pass\">PASS" : "fail\">FAIL") << "</span></h1>";
   if (!r.spec->description.empty()) h << "<p>" << EscapeHtml(r.spec->description) << "</p>";
+  if (!r.failures.empty()) {
+    h << "<h2>Failed configurations</h2><ul>";
+    for (const ConfigFailure& f : r.failures) {
+      h << "<li class=\"fail\">" << EscapeHtml(f.name) << " (" << EscapeHtml(f.algorithm)
+        << "): " << EscapeHtml(f.message) << "</li>";
+    }
+    h << "</ul>";
+  }
   h << SummaryHtml(r) << TablesHtml(r);
   if (!r.notes.empty()) {
     h << "<h2>Notes</h2><ul>";

@@ -25,6 +25,9 @@ struct ConfigResult {
   Pose2 map_from_estimator;  ///< the reference pose at the estimator's first scan
   /// The ATE alignment of `estimate` to the reference (identity without one).
   Pose2 reference_from_estimate;
+  /// False when the configuration reported no map (an external program that wrote none): it
+  /// has no map metrics.
+  bool has_map = true;
   /// The MetricsOf() names that apply to this configuration in this run (a reference, a camera,
   /// kidnappings, covariances, loop closures); NaN where one applies but could not be computed
   /// (a run too short for a spacing).
@@ -37,6 +40,15 @@ struct ConfigResult {
   std::vector<bool> loop_is_true;
   /// The floor texture mapped with `estimate` (a run with a camera), else none.
   std::optional<TextureResult> texture;
+};
+
+/// A configuration that produced nothing to score (an external program that crashed, timed out
+/// or wrote no usable output): the other configurations' results stand, the run's verdict is
+/// FAIL and this line says why.
+struct ConfigFailure {
+  std::string name;
+  std::string algorithm;
+  std::string message;  ///< one line, with the last lines of the program's stderr
 };
 
 /// One checked expectation.
@@ -58,6 +70,8 @@ struct ScenarioResult {
   /// scans inserted at its reference poses.
   std::optional<slam::OccupancyGrid> truth_map;
   std::vector<ConfigResult> configs;
+  /// The configurations that failed, in the scenario's order (not in `configs`).
+  std::vector<ConfigFailure> failures;
   double sim_time_s = 0.0;    ///< simulated seconds, or the log's time span
   int scans = 0;              ///< scans the lidar produced (or the log holds)
   int scans_blacked_out = 0;  ///< of them, withheld by lidar_blackout faults
@@ -85,7 +99,8 @@ struct ScenarioResult {
 };
 
 /// Checks every expectation of `result.spec` against the configs' metrics, filling `outcomes`
-/// and `passed`.
+/// and `passed`; a failed configuration fails the run (and its expectations, which have no
+/// value).
 void CheckExpectations(ScenarioResult* result);
 
 /// Writes the report folder: config.yaml (resolved), metrics.json, truth.tum and

@@ -5,7 +5,9 @@
 #include <memory>
 #include <optional>
 
+#include "scenarios/external_run.h"
 #include "scenarios/live_view.h"
+#include "scenarios/recording.h"
 #include "scenarios/run_recorder.h"
 #include "sim/camera/camera_rig.h"
 #include "sim/simulator.h"
@@ -20,6 +22,7 @@
 #include "slam/io/map_server.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator_runner.h"
+#include "slam/pipeline/external_estimator.h"
 #include "slam/types/error.h"
 #include "slam/types/interrupt.h"
 
@@ -219,7 +222,7 @@ void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
     }
   }
   if (algorithm && algorithm->closes_loops) ScoreLoops(run, c);
-  if (run.truth_map) {
+  if (run.truth_map && c->has_map) {
     // A simulation's map is scored where the estimate starts (on the truth); a log's reference
     // is itself an estimate, whose first pose is no better an anchor than any other, so there the
     // map is scored in the ATE alignment's frame.
@@ -279,8 +282,44 @@ void UseRecordRate(const std::string& log_path, slam::EstimatorRun* run) {
   run->odometry_source = slam::OdometrySource::kWheelTicks;
 }
 
+// What an external program's input files say besides the records.
+ExternalSource ExternalSourceOf(const ScenarioSpec& spec) {
+  ExternalSource source;
+  if (spec.simulated) {
+    source.carmen_params = CarmenLogParams(spec.simulated->options);
+    source.ticks_per_revolution = spec.simulated->options.robot.encoders.ticks_per_revolution;
+  }
+  return source;
+}
+
+// An external configuration: its program runs on the records now, and its poses and map replace
+// the in-process part's placeholders. False, with the failure in `result`, when the program or
+// its output failed.
+bool TakeExternal(const slam::ExternalEstimator& external, const std::string& work_dir,
+                  const Pose2& map_from_start, ConfigResult* c, ScenarioResult* result) {
+  ExternalOutcome outcome =
+      RunExternal(c->name, external, ExternalSourceOf(*result->spec), work_dir);
+  if (!outcome.failure.empty()) {
+    result->failures.push_back({c->name, c->algorithm, outcome.failure});
+    return false;
+  }
+  c->run.online = outcome.poses;
+  c->run.final = std::move(outcome.poses);
+  c->has_map = outcome.map.has_value();
+  if (outcome.map) c->run.map = std::move(*outcome.map);
+  c->run.wall_s = outcome.child_wall_s;
+  c->run.statistics = {{"peak_rss_mib", static_cast<double>(outcome.peak_rss_kb) / 1024.0},
+                       {"input_write_s", outcome.input_write_s},
+                       {"child_wall_s", outcome.child_wall_s}};
+  // The program's frame is its own: placed so that its first pose is the reference pose at the
+  // first scan, as every estimator's first pose is.
+  if (!c->run.final.empty())
+    c->map_from_estimator = map_from_start * c->run.final.poses().front().pose.Inverse();
+  return true;
+}
+
 void Finish(Runners& runners, const Pose2& map_from_start, double data_time_s,
-            const TextureRun* texture, ScenarioResult* result) {
+            const TextureRun* texture, const RunnerOptions& options, ScenarioResult* result) {
   if (texture) ScoreTruthTexture(*result->spec, *texture, result);
   const bool records_only = result->spec->log && result->scans == 0;
   for (auto& r : runners) {
@@ -288,9 +327,12 @@ void Finish(Runners& runners, const Pose2& map_from_start, double data_time_s,
     ConfigResult c;
     c.name = r->config().name;
     c.algorithm = r->config().algorithm;
+    c.map_from_estimator = map_from_start;
+    const auto* external = dynamic_cast<const slam::ExternalEstimator*>(&r->estimator());
     c.run = r->TakeResult();
     if (records_only) UseRecordRate(result->spec->log->path, &c.run);
-    c.map_from_estimator = map_from_start;
+    if (external && !TakeExternal(*external, options.work_dir, map_from_start, &c, result))
+      continue;
     c.estimate = InMapFrame(c.run.final, map_from_start);
     c.online = InMapFrame(c.run.online, map_from_start);
     c.mean_estimate = InMapFrame(c.run.mean, map_from_start);
@@ -415,7 +457,7 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
   result.sim_time_s = simulator.time().seconds();
   result.truth_map.emplace(std::move(truth_map));
   Finish(runners, map_from_start.value_or(Pose2()), result.sim_time_s,
-         texture ? &*texture : nullptr, &result);
+         texture ? &*texture : nullptr, options, &result);
   if (recorder) {
     recorder->Finish(result);
     result.recording = options.record_path;
@@ -530,7 +572,7 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
     result.truth_map.emplace(std::move(truth_map));
   }
   // A log without a reference is scored on nothing but its own statistics.
-  Finish(runners, map_from_start.value_or(Pose2()), result.sim_time_s, nullptr, &result);
+  Finish(runners, map_from_start.value_or(Pose2()), result.sim_time_s, nullptr, options, &result);
   if (recorder) {
     recorder->Finish(result);
     result.recording = options.record_path;
@@ -541,6 +583,13 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
 }  // namespace
 
 ScenarioResult RunScenario(const ScenarioSpec& spec, const RunnerOptions& options) {
+  for (const slam::EstimatorConfig& config : spec.configs) {
+    if (config.algorithm == "external" && options.work_dir.empty()) {
+      throw ConfigError(spec.path + ": slam." + config.name +
+                        ": algorithm external runs its program in the report folder, and this "
+                        "command writes none");
+    }
+  }
   return spec.simulated ? RunSimulated(spec, options) : RunLog(spec, options);
 }
 

@@ -21,6 +21,10 @@ struct RunnerOptions {
   std::function<void(std::size_t done, std::size_t total, const slam::SyncedScan& scan,
                      const slam::EstimatorRunner& runner)>
       on_scan;
+  /// The report folder: an `external` configuration writes its input and output below
+  /// `external/<name>/` there, and its program's stdout and stderr beside the report. A scenario
+  /// with one and no folder is a ConfigError.
+  std::string work_dir;
 };
 
 /// Runs a scenario: the simulator, every SLAM configuration and the evaluation advance together

@@ -8,7 +8,8 @@
 // The visitor interface every VisitFields may use:
 //   v(key, scalar)                  double, float, int, bool, std::string, std::uint64_t,
 //                                   Eigen::Vector2d ([x, y]), Eigen::Vector3d ([x, y, z]),
-//                                   std::vector<Eigen::Vector2d>
+//                                   std::vector<Eigen::Vector2d>, std::vector<std::string>
+//                                   (a list of texts: a command's arguments)
 //   v.Enum(key, e, {{E::kA, "a"}})  an enum by name; absent keeps the default
 //   v.RequiredEnum(key, e, names)   the same, but the key must be there
 //   v.Struct(key, s)                a nested map (its own VisitFields and Validate())
@@ -61,6 +62,20 @@ class FieldReader {
     if (!child) return;
     values.clear();
     for (const YamlNode& element : child->Elements()) values.push_back(ReadPoint(element));
+  }
+  /// `[text, ...]`: every element a scalar, read as text.
+  void operator()(const char* key, std::vector<std::string>& values) {
+    auto child = node_.Optional(key);
+    if (!child) return;
+    if (child->IsScalar()) child->Fail("expected a list of texts, got a single value");
+    values.clear();
+    for (const YamlNode& element : child->Elements()) {
+      if (!element.IsScalar())
+        element.Fail(
+            "expected a text (one argument), got a list or a map (quote a placeholder: "
+            "\"{input}\")");
+      values.push_back(element.As<std::string>());
+    }
   }
   /// One of `names` (pairs of enum value and name); absent keeps the default.
   template <typename E>
@@ -170,6 +185,11 @@ class FieldWriter {
   void operator()(const char* key, const std::vector<Eigen::Vector2d>& values) {
     out_ << YAML::Key << key << YAML::Value << YAML::BeginSeq;
     for (const auto& v : values) WritePoint(v);
+    out_ << YAML::EndSeq;
+  }
+  void operator()(const char* key, const std::vector<std::string>& values) {
+    out_ << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (const auto& v : values) out_ << YAML::DoubleQuoted << v;
     out_ << YAML::EndSeq;
   }
   /// An enum by its name in `names`.

@@ -12,7 +12,7 @@ namespace slamrig::slam {
 
 /// The JSON side of the field tables (slam/config/fields.h): writes an options struct into
 /// metrics.json with the same keys the YAML reader takes, through the struct's VisitFields.
-/// Only what estimator options use: scalars, enums and nested maps.
+/// Only what estimator options use: scalars, lists of texts, enums and nested maps.
 class JsonFieldWriter {
  public:
   /// Writes into the currently open object of `json`.
@@ -28,6 +28,9 @@ class JsonFieldWriter {
   }
   void operator()(const char* key, const bool& value) { json_.Bool(key, value); }
   void operator()(const char* key, const std::string& value) { json_.String(key, value); }
+  void operator()(const char* key, const std::vector<std::string>& values) {
+    json_.StringArray(key, values);
+  }
   template <typename E>
   void Enum(const char* key, E& value, const std::vector<std::pair<E, const char*>>& names) {
     for (const auto& [option, name] : names) {

@@ -69,7 +69,7 @@ void WriteTum(const std::string& path, const Trajectory& trajectory) {
   WriteFileAtomically(path, FormatTum(trajectory));
 }
 
-Trajectory ReadTum(const std::string& path) {
+Trajectory ReadTum(const std::string& path, bool in_time_order) {
   LineReader reader(path);
   Trajectory trajectory;
   std::string_view line;
@@ -119,7 +119,7 @@ Trajectory ReadTum(const std::string& path) {
       throw ParseError(where + "quaternion: rotation leaves the plane (qx, qy not 0)");
     }
     const Time t = *stamp;
-    if (!trajectory.empty() && t < trajectory.poses().back().time) {
+    if (in_time_order && !trajectory.empty() && t < trajectory.poses().back().time) {
       throw ParseError(where + "timestamp: " + std::to_string(t.seconds()) +
                        " is earlier than the line before");
     }

@@ -5,6 +5,7 @@
 #include "slam/pipeline/dead_reckoning_estimator.h"
 #include "slam/pipeline/ekf_estimator.h"
 #include "slam/pipeline/ekf_slam_estimator.h"
+#include "slam/pipeline/external_estimator.h"
 #include "slam/pipeline/graph_slam_estimator.h"
 #include "slam/pipeline/icp_odometry_estimator.h"
 #include "slam/pipeline/particle_filter_estimator.h"
@@ -91,6 +92,19 @@ const std::vector<Algorithm>& Algorithms() {
        },
        /*maps_landmarks=*/false,
        /*closes_loops=*/true,
+       /*statistics_declared=*/false},
+      {"external",
+       "any program as an estimator: `command:` (no shell; {input}, {output}, {seed} replaced) "
+       "reads the records as `input:` (carmen, mcap, sqlite3, ece276a) and writes a TUM "
+       "trajectory, and a map_server map beside it if it has one (docs/external.md)",
+       {"default"},
+       ExternalEstimator::StatisticNames(),
+       [](const std::string&) -> std::unique_ptr<AlgorithmOptions> {
+         return std::make_unique<ExternalAlgorithmOptions>();
+       },
+       /*maps_landmarks=*/false,
+       /*closes_loops=*/false,
+       // The scenario runner adds them after the program ends; the in-process part has none.
        /*statistics_declared=*/false},
   };
   return algorithms;

@@ -1,0 +1,75 @@
+#include "slam/pipeline/external_estimator.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include "slam/types/validation.h"
+
+namespace slamrig::slam {
+
+std::vector<std::string> ExternalEstimatorOptions::Validate() const {
+  std::vector<std::string> errors;
+  if (command.empty()) {
+    errors.push_back(
+        "command: required, a non-empty list (the program, then its arguments, e.g. [python3, "
+        "./my_slam.py, \"{input}\", \"{output}\"])");
+  } else if (command.front().empty()) {
+    errors.push_back("command[0]: the program is an empty text");
+  }
+  if (!(std::isfinite(timeout_s) && timeout_s > 0.0))
+    errors.push_back(RuleViolation("timeout_s", timeout_s, "must be > 0"));
+  return errors;
+}
+
+std::vector<std::string> SubstituteExternalArguments(const std::vector<std::string>& command,
+                                                     const std::string& input,
+                                                     const std::string& output,
+                                                     std::uint64_t seed) {
+  const std::pair<std::string, std::string> replacements[] = {
+      {kExternalInputPlaceholder, input},
+      {kExternalOutputPlaceholder, output},
+      {kExternalSeedPlaceholder, std::to_string(seed)}};
+  std::vector<std::string> args;
+  for (const std::string& argument : command) {
+    // One pass from left to right: text that a replacement brings in is never replaced again.
+    std::string out;
+    std::size_t i = 0;
+    while (i < argument.size()) {
+      bool replaced = false;
+      for (const auto& [placeholder, value] : replacements) {
+        if (argument.compare(i, placeholder.size(), placeholder) == 0) {
+          out += value;
+          i += placeholder.size();
+          replaced = true;
+          break;
+        }
+      }
+      if (!replaced) out += argument[i++];
+    }
+    args.push_back(std::move(out));
+  }
+  return args;
+}
+
+ExternalEstimator::ExternalEstimator(const ExternalEstimatorOptions& options,
+                                     const EstimatorContext& context)
+    : options_(options), context_(context) {}
+
+void ExternalAlgorithmOptions::Visit(FieldReader& reader) {
+  namespace fs = std::filesystem;
+  const std::vector<std::string> before = options_.command;
+  VisitFields(reader, options_);
+  if (options_.command == before) return;  // not set here: already resolved
+  // Relative to the scenario file, like a python estimator's module; written resolved, so that
+  // config.yaml runs from anywhere.
+  std::error_code error;
+  const fs::path file(reader.node().file());
+  const fs::path folder = fs::is_regular_file(file, error) ? fs::absolute(file, error).parent_path()
+                                                           : fs::current_path();
+  for (std::string& argument : options_.command) {
+    if (argument.rfind("./", 0) == 0 || argument.rfind("../", 0) == 0)
+      argument = (folder / argument).lexically_normal().string();
+  }
+}
+
+}  // namespace slamrig::slam

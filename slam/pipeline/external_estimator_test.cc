@@ -1,0 +1,101 @@
+#include "slam/pipeline/external_estimator.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "slam/pipeline/estimator_config.h"
+#include "slam/types/error.h"
+
+namespace slamrig::slam {
+namespace {
+
+const ExternalEstimatorOptions& OptionsOf(const EstimatorConfig& config) {
+  return dynamic_cast<const ExternalAlgorithmOptions&>(*config.options).options();
+}
+
+// The message of the ConfigError that reading `text` as configuration `mine` of s.yaml throws.
+std::string Error(const std::string& text) {
+  try {
+    const YamlNode node = YamlNode::LoadString(text, "s.yaml");
+    ParseEstimatorConfig("mine", node);
+    node.CheckAllKeysUsed();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(ExternalEstimatorTest, ReadsWritesAndRereadsItsOptions) {
+  const YamlNode node = YamlNode::LoadString(
+      "algorithm: external\ncommand: [python3, ./my slam.py, \"{input}\", \"--out={output}\", "
+      "7, /bin/x]\ninput: mcap\ntimeout_s: 2.5\n",
+      "s.yaml");
+  const EstimatorConfig config = ParseEstimatorConfig("mine", node);
+  node.CheckAllKeysUsed();
+  const ExternalEstimatorOptions& o = OptionsOf(config);
+  // ./ is relative to the scenario file (here none: the current folder), made absolute.
+  const std::string script =
+      (std::filesystem::current_path() / "my slam.py").lexically_normal().string();
+  EXPECT_THAT(o.command, ::testing::ElementsAre("python3", script, "{input}", "--out={output}", "7",
+                                                "/bin/x"));
+  EXPECT_EQ(o.input, ExternalInput::kMcap);
+  EXPECT_EQ(o.timeout_s, 2.5);
+
+  YAML::Emitter out;
+  WriteEstimatorConfig(config, &out);
+  const YamlNode again = YamlNode::LoadString(out.c_str(), "again.yaml");
+  const EstimatorConfig reread = ParseEstimatorConfig("mine", again);
+  again.CheckAllKeysUsed();
+  EXPECT_EQ(OptionsOf(reread).command, o.command);
+  EXPECT_EQ(OptionsOf(reread).input, ExternalInput::kMcap);
+  YAML::Emitter out2;
+  WriteEstimatorConfig(reread, &out2);
+  EXPECT_EQ(std::string(out.c_str()), std::string(out2.c_str()));
+  JsonWriter json;
+  WriteEstimatorConfigJson(config, &json);
+  EXPECT_THAT(json.Finish(), ::testing::HasSubstr("\"--out={output}\""));
+}
+
+TEST(ExternalEstimatorTest, BadOptionsAreOneLineNamingFileLineAndKey) {
+  EXPECT_THAT(Error("algorithm: external\n"),
+              ::testing::AllOf(::testing::HasSubstr("s.yaml:1"),
+                               ::testing::HasSubstr("command: required")));
+  EXPECT_THAT(Error("algorithm: external\ncommand: []\n"),
+              ::testing::HasSubstr("command: required"));
+  EXPECT_THAT(Error("algorithm: external\ncommand: ./x.py\n"),
+              ::testing::HasSubstr("s.yaml:2:10: command: expected a list of texts"));
+  // An unquoted {input} is a YAML map, not a text.
+  EXPECT_THAT(Error("algorithm: external\ncommand: [x, {input}]\n"),
+              ::testing::HasSubstr("s.yaml:2:14: command[1]: expected a text"));
+  EXPECT_THAT(Error("algorithm: external\ncommand: [x]\ninput: rosbag\n"),
+              ::testing::HasSubstr("s.yaml:3:8: input: 'rosbag' is not one of: carmen, mcap, "
+                                   "sqlite3, ece276a"));
+  EXPECT_THAT(Error("algorithm: external\ncommand: [x]\ntimeout_s: 0\n"),
+              ::testing::HasSubstr("timeout_s = 0; must be > 0"));
+  EXPECT_THAT(Error("algorithm: external\ncommand: [x]\ntimeout_s: -3\n"),
+              ::testing::HasSubstr("timeout_s = -3; must be > 0"));
+  EXPECT_THAT(Error("algorithm: external\ncommand: [x]\ntimeout: 3\n"),
+              ::testing::HasSubstr("timeout"));
+  EXPECT_THAT(Error("algorithm: external\ncommand: [\"\", a]\n"),
+              ::testing::HasSubstr("command[0]: the program is an empty text"));
+  EXPECT_EQ(Error("algorithm: external\ncommand: [x]\n"), "no error");
+}
+
+TEST(ExternalEstimatorTest, SubstitutesEveryPlaceholderOnceAndNothingElse) {
+  const std::vector<std::string> command = {
+      "prog",    "{input}", "--out={output}", "{seed}{seed}", "{inputs}",
+      "{Input}", "{",       "plain",          "x{input}y"};
+  EXPECT_THAT(SubstituteExternalArguments(command, "/d/in.log", "/d/out.tum", 42),
+              ::testing::ElementsAre("prog", "/d/in.log", "--out=/d/out.tum", "4242", "{inputs}",
+                                     "{Input}", "{", "plain", "x/d/in.logy"));
+  // A value holding a placeholder is not replaced again.
+  EXPECT_THAT(SubstituteExternalArguments({"{input}", "{output}"}, "{output}", "{seed}",
+                                          18446744073709551615ull),
+              ::testing::ElementsAre("{output}", "{seed}"));
+  EXPECT_THAT(SubstituteExternalArguments({"a{seed}b"}, "", "", 0), ::testing::ElementsAre("a0b"));
+}
+
+}  // namespace
+}  // namespace slamrig::slam
