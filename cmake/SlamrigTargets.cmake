@@ -45,15 +45,17 @@ function(slamrig_add_library name)
   endif()
 endfunction()
 
-# slamrig_add_test(name SOURCES ... DEPS ... [LABEL unit|integration|scenario])
+# slamrig_add_test(name SOURCES ... DEPS ... [LABEL unit|integration|scenario] [SLOW_CASES ...])
 # One gtest executable, run by ctest as one test (all its cases in one process: a process that
 # links OpenCV costs ~0.1 s to start, so one ctest entry per case would dominate the unit suite).
+# SLOW_CASES (gtest names, Suite.Case) of a unit test run as a second ctest entry, <name>.slow,
+# labelled integration, so that the unit label stays fast without splitting the sources.
 # Run a single case with `build/<dir>/<name> --gtest_filter=Suite.Case`.
 function(slamrig_add_test name)
   if(NOT SLAMRIG_BUILD_TESTS)
     return()
   endif()
-  cmake_parse_arguments(ARG "" "LABEL" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "LABEL" "SOURCES;DEPS;SLOW_CASES" ${ARGN})
   if(NOT ARG_LABEL)
     set(ARG_LABEL unit)
   endif()
@@ -62,7 +64,16 @@ function(slamrig_add_test name)
   target_compile_definitions(${name} PRIVATE SLAMRIG_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR})
   slamrig_set_target_options(${name})
-  add_test(NAME ${name} COMMAND ${name} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  if(ARG_SLOW_CASES)
+    list(JOIN ARG_SLOW_CASES ":" slow)
+    add_test(NAME ${name} COMMAND ${name} --gtest_filter=-${slow}
+             WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    add_test(NAME ${name}.slow COMMAND ${name} --gtest_filter=${slow}
+             WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    set_tests_properties(${name}.slow PROPERTIES LABELS integration)
+  else()
+    add_test(NAME ${name} COMMAND ${name} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  endif()
   set_tests_properties(${name} PROPERTIES LABELS ${ARG_LABEL})
   # `cmake --build B --target slamrig_unit_tests` builds what `ctest -L unit` runs, and nothing
   # else (the sanitizer stage of scripts/test.sh).
