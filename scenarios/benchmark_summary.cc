@@ -17,17 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-double Number(const std::string& s) {
-  if (s.empty()) return std::nan("");
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(s, &used);
-    return used == s.size() ? v : std::nan("");
-  } catch (const std::exception&) {
-    return std::nan("");
-  }
-}
-
 std::string Metres(double v) {
   if (!std::isfinite(v)) return "n/a";
   char buffer[32];
@@ -149,7 +138,7 @@ Leaderboard BuildLeaderboard(const BenchmarkSuite& suite, const std::vector<std:
     LeaderboardCell& cell = board.cells[run.estimator][run.dataset];
     ++cell.runs;
     BenchmarkCase c{found->second, row[id_col], row[status_col], row[failure_col],
-                    Number(row[ate_col])};
+                    CsvNumber(row[ate_col])};
     if (c.status != "pass") ++cell.failures;
     if (std::isfinite(c.ate_rmse_m)) cell.ate.push_back(c.ate_rmse_m);
     cases.push_back(std::move(c));

@@ -26,17 +26,6 @@ std::string CsvField(const std::string& text) {
   return quoted + "\"";
 }
 
-double Number(const std::string& s) {
-  if (s.empty()) return std::nan("");
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(s, &used);
-    return used == s.size() ? v : std::nan("");
-  } catch (const std::exception&) {
-    return std::nan("");
-  }
-}
-
 std::string Format(double v) {
   if (!std::isfinite(v)) return "n/a";
   char buffer[32];
@@ -61,7 +50,7 @@ std::vector<double> Positions(const SweepParameter& parameter, bool* numeric) {
   std::vector<double> xs;
   *numeric = true;
   for (const auto& v : parameter.values) {
-    xs.push_back(Number(v));
+    xs.push_back(CsvNumber(v));
     *numeric = *numeric && std::isfinite(xs.back());
   }
   if (!*numeric) {
@@ -246,8 +235,8 @@ int AneesSection(const SweepSpec& spec, const std::vector<std::string>& header,
       for (std::size_t q = 0; q < num_params; ++q)
         label += (label.empty() ? "" : ", ") + spec.parameters[q].key + "=" + row[1 + q];
       if (label.empty()) label = "all runs";
-      const double v = Number(row[m]);
-      const double w = weight_column > 0 ? Number(row[weight_column]) : 1.0;
+      const double v = CsvNumber(row[m]);
+      const double w = weight_column > 0 ? CsvNumber(row[weight_column]) : 1.0;
       if (!std::isfinite(v) || !std::isfinite(w) || !(w > 0.0)) continue;
       if (!samples.count(label)) labels.push_back(label);
       samples[label].emplace_back(v, w);
@@ -340,6 +329,17 @@ std::vector<std::string> SplitCsv(const std::string& line) {
   return fields;
 }
 
+double CsvNumber(const std::string& s) {
+  if (s.empty()) return std::nan("");
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(s, &used);
+    return used == s.size() ? v : std::nan("");
+  } catch (const std::exception&) {
+    return std::nan("");
+  }
+}
+
 std::string RunDir(const std::string& out_dir, std::size_t index) {
   char name[16];
   std::snprintf(name, sizeof(name), "%04zu", index);
@@ -394,7 +394,7 @@ SweepAggregate AggregateSweep(
     auto& values = samples[point];
     values.resize(a.metrics.size());
     for (std::size_t m = 0; m < a.metrics.size(); ++m) {
-      const double v = Number(row[first_metric + m]);
+      const double v = CsvNumber(row[first_metric + m]);
       if (std::isfinite(v)) values[m].push_back(v);
     }
   }

@@ -13,6 +13,8 @@ namespace slamrig::scenario {
 /// results.csv's fields: RFC 4180 quoting (a field with a comma, quote or newline is quoted).
 std::string JoinCsv(const std::vector<std::string>& fields);
 std::vector<std::string> SplitCsv(const std::string& line);
+/// A results.csv cell as a number: NaN for an empty cell or one that is not wholly a number.
+double CsvNumber(const std::string& cell);
 
 /// `out_dir`/runs/<index, 4 digits>: the folder of grid row `index` (ExpandSweep order).
 std::string RunDir(const std::string& out_dir, std::size_t index);
