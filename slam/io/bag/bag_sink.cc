@@ -24,6 +24,9 @@ const BagSinkOptions& Checked(const BagSinkOptions& options) {
 BagSink::BagSink(const std::string& folder, const BagSinkOptions& options)
     : writer_(folder, Checked(options).writer), odometry_(options.odometry) {}
 
+BagSink::BagSink(McapWriter::Output output, const BagSinkOptions& options)
+    : writer_(std::move(output), Checked(options).writer), odometry_(options.odometry) {}
+
 void BagSink::Add(const Record& record, const GroundTruthPose* truth) {
   writer_.Write(record);
   const std::optional<OdometryPose> pose = odometry_.Add(record);

@@ -32,9 +32,13 @@ class BagSink final : public RecordSink {
   /// Throws ConfigError for invalid options, std::runtime_error if `folder` exists or cannot
   /// be written (see BagWriter).
   BagSink(const std::string& folder, const BagSinkOptions& options);
+  /// The same messages as an MCAP stream through `output` (BagWriter's stream form).
+  BagSink(McapWriter::Output output, const BagSinkOptions& options);
 
   void Add(const Record& record, const GroundTruthPose* truth) override;
   void Commit() override;
+  /// The writer, for what a stream adds (metadata records).
+  BagWriter& writer() { return writer_; }
 
   int scans() const { return scans_; }
   /// RGB-D frames written (each an rgb and a depth image and a camera info).

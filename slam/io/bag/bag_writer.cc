@@ -203,8 +203,19 @@ BagWriter::BagWriter(std::string folder, BagWriterOptions options)
   }
 }
 
+BagWriter::BagWriter(McapWriter::Output output, BagWriterOptions options)
+    : options_(std::move(options)) {
+  std::vector<std::string> errors = options_.Validate();
+  if (options_.storage != BagStorage::kMcap) errors.push_back("storage: a stream is MCAP");
+  if (!errors.empty()) throw ConfigError("bag writer: " + errors.front());
+  mcap_ = std::make_unique<McapWriter>(std::move(output), McapWriterOptions{});
+  if (options_.clock_rate_hz > 0.0) {
+    clock_period_ns_ = std::max<std::int64_t>(1, std::llround(1e9 / options_.clock_rate_hz));
+  }
+}
+
 BagWriter::~BagWriter() {
-  if (!committed_) {
+  if (!committed_ && !folder_.empty()) {
     mcap_.reset();
     sqlite_.reset();
     std::error_code ec;
@@ -344,6 +355,12 @@ void BagWriter::FlushChunk() {
   if (mcap_) mcap_->FlushChunk();
 }
 
+void BagWriter::AddMetadata(std::string_view name,
+                            const std::map<std::string, std::string>& metadata) {
+  if (!mcap_) throw std::logic_error("bag writer: metadata records need storage mcap");
+  mcap_->AddMetadata(name, metadata);
+}
+
 void BagWriter::EmitStaticTransforms(Time time) {
   const BagFrames& f = options_.frames;
   static_time_ = time;
@@ -420,7 +437,7 @@ std::string BagWriter::MetadataYaml() const {
 
 void BagWriter::Commit() {
   if (committed_) return;
-  if (options_.single_file) {
+  if (options_.single_file || folder_.empty()) {
     mcap_->Close();
     mcap_.reset();
     committed_ = true;

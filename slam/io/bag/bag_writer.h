@@ -122,6 +122,10 @@ class BagWriter {
   /// Throws ConfigError if the options are invalid, std::runtime_error if `folder` exists or
   /// cannot be written.
   BagWriter(std::string folder, BagWriterOptions options);
+  /// The same messages as an MCAP stream through `output` (McapWriter's stream form: unchunked,
+  /// no summary, no folder and no metadata.yaml); storage must be mcap. Commit() ends the
+  /// stream (DataEnd, Footer, magic).
+  BagWriter(McapWriter::Output output, BagWriterOptions options);
   ~BagWriter();
   BagWriter(const BagWriter&) = delete;
   BagWriter& operator=(const BagWriter&) = delete;
@@ -140,6 +144,8 @@ class BagWriter {
   void AddStaticTransform(const RosTransform& transform, Time time);
   /// MCAP only: closes the open chunk, so that what follows is in chunks of its own.
   void FlushChunk();
+  /// MCAP only: one Metadata record `name` with the text pairs of `metadata`.
+  void AddMetadata(std::string_view name, const std::map<std::string, std::string>& metadata);
   /// Closes the storage file, writes metadata.yaml and renames the folder into place.
   void Commit();
 

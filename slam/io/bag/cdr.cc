@@ -109,6 +109,14 @@ std::vector<float> CdrReader::Float32Sequence() {
   return values;
 }
 
+std::string CdrReader::ByteSequence() {
+  const std::uint32_t count = SequenceLength(1);
+  Need(count, "byte sequence");
+  std::string bytes(data_.substr(pos_, count));
+  pos_ += count;
+  return bytes;
+}
+
 std::vector<double> CdrReader::Float64Sequence() {
   const std::uint32_t count = SequenceLength(sizeof(double));
   return Float64Array(count);

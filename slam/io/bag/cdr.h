@@ -74,6 +74,8 @@ class CdrReader {
   std::string String();
   std::vector<float> Float32Sequence();
   std::vector<double> Float64Sequence();
+  /// `sequence<uint8>` (or int8): count, then the bytes.
+  std::string ByteSequence();
   /// A fixed array of `n` doubles.
   std::vector<double> Float64Array(std::size_t n);
   /// Skips a fixed array of `n` doubles.

@@ -49,12 +49,23 @@ McapWriter::McapWriter(std::string path, McapWriterOptions options)
   file_ = std::fopen(path_.c_str(), "wb");
   if (file_ == nullptr) throw OutputError(path_ + ": cannot write: " + std::strerror(errno));
   std::setvbuf(file_, nullptr, _IOFBF, 1 << 20);
-  if (options_.compression == McapCompression::kZstd) {
+  Start();
+}
+
+McapWriter::McapWriter(Output output, McapWriterOptions options)
+    : path_("MCAP stream"), output_(std::move(output)), options_(std::move(options)) {
+  const std::vector<std::string> errors = options_.Validate();
+  if (!errors.empty()) throw ConfigError("mcap writer: " + errors.front());
+  Start();
+}
+
+void McapWriter::Start() {
+  if (options_.compression == McapCompression::kZstd && !output_) {
     ZSTD_CCtx* ctx = ZSTD_createCCtx();
     ZSTD_CCtx_setParameter(ctx, ZSTD_c_compressionLevel, options_.zstd_level);
     zstd_ = ctx;
   }
-  chunk_.reserve(options_.chunk_size_bytes + (1 << 16));
+  if (!output_) chunk_.reserve(options_.chunk_size_bytes + (1 << 16));
   crc_ = crc32_z(0L, Z_NULL, 0);
   Write(std::string_view(mcap::kMagic, sizeof(mcap::kMagic)));
   std::string header;
@@ -71,7 +82,9 @@ McapWriter::~McapWriter() {
 }
 
 void McapWriter::Write(std::string_view bytes) {
-  if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) {
+  if (output_) {
+    output_(bytes);
+  } else if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) {
     throw OutputError(path_ + ": write failed: " + std::strerror(errno));
   }
   crc_ = crc32_z(crc_, reinterpret_cast<const Bytef*>(bytes.data()), bytes.size());
@@ -123,6 +136,21 @@ void McapWriter::WriteMessage(std::uint16_t channel_id, std::uint32_t sequence,
                               std::string_view data) {
   if (channel_id >= channel_counts_.size()) {
     throw std::logic_error("McapWriter: unknown channel " + std::to_string(channel_id));
+  }
+  if (output_) {
+    std::string record;
+    record.reserve(9 + 2 + 4 + 8 + 8 + data.size());
+    Put(&record, static_cast<std::uint8_t>(mcap::kMessage));
+    Put(&record, static_cast<std::uint64_t>(2 + 4 + 8 + 8 + data.size()));
+    Put(&record, channel_id);
+    Put(&record, sequence);
+    Put(&record, log_time_ns);
+    Put(&record, publish_time_ns);
+    record.append(data);
+    Write(record);
+    ++message_count_;
+    ++channel_counts_[channel_id];
+    return;
   }
   const bool first_in_chunk = chunk_.empty();
   std::string& index = chunk_message_index_[channel_id];
@@ -205,8 +233,46 @@ void McapWriter::FlushChunk() {
   chunk_message_index_.clear();
 }
 
+void McapWriter::AddMetadata(std::string_view name,
+                             const std::map<std::string, std::string>& metadata) {
+  std::string content;
+  PutString(&content, name);
+  std::string map;
+  for (const auto& [key, value] : metadata) {
+    PutString(&map, key);
+    PutString(&map, value);
+  }
+  Put(&content, static_cast<std::uint32_t>(map.size()));
+  content += map;
+  std::string record;
+  PutRecord(&record, mcap::kMetadata, content);
+  Write(record);
+  ++metadata_count_;
+}
+
+void McapWriter::CloseStream() {
+  std::string record;
+  std::string content;
+  Put(&content, static_cast<std::uint32_t>(crc_));
+  PutRecord(&record, mcap::kDataEnd, content);
+  Write(record);
+  record.clear();
+  Put(&record, static_cast<std::uint8_t>(mcap::kFooter));
+  Put(&record, std::uint64_t{8 + 8 + 4});
+  Put(&record, std::uint64_t{0});  // no summary section
+  Put(&record, std::uint64_t{0});  // no summary offsets
+  Put(&record, std::uint32_t{0});  // so no summary CRC
+  record.append(mcap::kMagic, sizeof(mcap::kMagic));
+  Write(record);
+  closed_ = true;
+}
+
 void McapWriter::Close() {
   if (closed_) return;
+  if (output_) {
+    CloseStream();
+    return;
+  }
   FlushChunk();
   const auto data_crc = static_cast<std::uint32_t>(crc_);
   std::string record;
@@ -237,7 +303,7 @@ void McapWriter::Close() {
   Put(&content, static_cast<std::uint16_t>(schema_records_.size()));
   Put(&content, static_cast<std::uint32_t>(channel_records_.size()));
   Put(&content, std::uint32_t{0});  // attachments
-  Put(&content, std::uint32_t{0});  // metadata
+  Put(&content, metadata_count_);
   Put(&content, static_cast<std::uint32_t>(chunk_indexes_.size()));
   Put(&content, start_time_);
   Put(&content, end_time_);

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <string>
 #include <string_view>
@@ -37,9 +38,20 @@ struct McapWriterOptions {
 /// the summary CRC, and the closing magic. Every chunk carries the CRC-32 of its uncompressed
 /// records. Throws ConfigError for invalid options, std::runtime_error naming the path if it
 /// cannot write.
+///
+/// As a stream (the second constructor) it writes through a function instead of a file, in an
+/// order a reader takes as it comes: magic, Header, then Schema, Channel, Metadata and Message
+/// records as they are added (no chunks, no indexes), and at Close() DataEnd with the data
+/// section's CRC, a Footer without a summary (all zeros) and the closing magic: a valid MCAP
+/// file too.
 class McapWriter {
  public:
+  /// Where a stream's bytes go, in order; it may throw (the writer stops there).
+  using Output = std::function<void(std::string_view)>;
+
   McapWriter(std::string path, McapWriterOptions options);
+  /// A stream: every record goes to `output` as soon as it is complete.
+  McapWriter(Output output, McapWriterOptions options);
   ~McapWriter();
   McapWriter(const McapWriter&) = delete;
   McapWriter& operator=(const McapWriter&) = delete;
@@ -50,7 +62,9 @@ class McapWriter {
   std::uint16_t AddChannel(std::uint16_t schema_id, std::string_view topic,
                            std::string_view message_encoding,
                            const std::map<std::string, std::string>& metadata);
-  /// Appends one Message record to the open chunk.
+  /// Writes one Metadata record (a name and text pairs) in the data section.
+  void AddMetadata(std::string_view name, const std::map<std::string, std::string>& metadata);
+  /// Appends one Message record to the open chunk (a stream: writes it).
   void WriteMessage(std::uint16_t channel_id, std::uint32_t sequence, std::uint64_t log_time_ns,
                     std::uint64_t publish_time_ns, std::string_view data);
   /// Closes the open chunk (if any), so that the next message starts a new one.
@@ -65,9 +79,12 @@ class McapWriter {
     std::map<std::uint16_t, std::uint64_t> index_offsets;
   };
 
+  void Start();
   void Write(std::string_view bytes);
+  void CloseStream();
 
   std::string path_;
+  Output output_;  // a stream's, else empty
   McapWriterOptions options_;
   std::FILE* file_ = nullptr;
   std::uint64_t offset_ = 0;
@@ -83,6 +100,7 @@ class McapWriter {
   std::string compressed_;
   void* zstd_ = nullptr;  // ZSTD_CCtx*
   std::uint64_t message_count_ = 0, start_time_ = 0, end_time_ = 0;
+  std::uint32_t metadata_count_ = 0;
   bool closed_ = false;
 };
 

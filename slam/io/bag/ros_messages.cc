@@ -3,6 +3,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -559,6 +560,39 @@ void EncodeOccupancyGrid(const RosOccupancyGrid& grid, std::string* out) {
   w.Uint32(grid.height);
   WritePose(grid.origin, &w);
   w.ByteSequence({reinterpret_cast<const std::uint8_t*>(grid.data.data()), grid.data.size()});
+}
+
+Pose2 RosPoseStamped::Planar() const {
+  return Pose2(position.x(), position.y(), YawFromQuaternion(qx, qy, qz, qw));
+}
+
+RosPoseStamped DecodePoseStamped(std::string_view data) {
+  CdrReader r(data);
+  RosPoseStamped pose;
+  pose.time = ReadHeader(&r, &pose.frame_id);
+  for (int i = 0; i < 3; ++i) pose.position[i] = r.Float64();
+  pose.qx = r.Float64();
+  pose.qy = r.Float64();
+  pose.qz = r.Float64();
+  pose.qw = r.Float64();
+  return pose;
+}
+
+RosOccupancyGrid DecodeOccupancyGrid(std::string_view data) {
+  CdrReader r(data);
+  RosOccupancyGrid grid;
+  grid.time = ReadHeader(&r, &grid.frame_id);
+  ReadStamp(&r);  // map_load_time
+  grid.resolution_m = r.Float32();
+  grid.width = r.Uint32();
+  grid.height = r.Uint32();
+  const double x = r.Float64(), y = r.Float64();
+  r.Float64();  // z
+  grid.origin = Pose2(x, y, ReadYawQuaternion(&r));
+  const std::string cells = r.ByteSequence();
+  grid.data.resize(cells.size());
+  std::memcpy(grid.data.data(), cells.data(), cells.size());
+  return grid;
 }
 
 void EncodeMarkerArray(std::span<const RosMarker> markers, std::string* out) {

@@ -221,6 +221,22 @@ std::vector<RosTransform3d> DecodeTfMessage3d(std::string_view data);
 /// rosgraph_msgs/msg/Clock.
 Time DecodeClock(std::string_view data);
 
+/// A geometry_msgs/msg/PoseStamped as written: stamp, frame and the 3-D position and quaternion,
+/// for a reader that checks the pose is planar before taking Planar().
+struct RosPoseStamped {
+  Time time;
+  std::string frame_id;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  double qx = 0.0, qy = 0.0, qz = 0.0, qw = 1.0;
+
+  /// (x, y, yaw), the yaw by YawFromQuaternion.
+  Pose2 Planar() const;
+};
+/// geometry_msgs/msg/PoseStamped.
+RosPoseStamped DecodePoseStamped(std::string_view data);
+/// nav_msgs/msg/OccupancyGrid (map_load_time is not kept; the origin's yaw from its quaternion).
+RosOccupancyGrid DecodeOccupancyGrid(std::string_view data);
+
 /// Yaw of the quaternion (x, y, z, w) about z. For a planar quaternion the doubles around
 /// 2 atan2(z, w) are searched for one whose (sin(t/2), cos(t/2)) is exactly (z, w), as the
 /// encoders write it. That is the yaw that was written in about 96% of cases; otherwise a
