@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -115,14 +116,27 @@ Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& optio
   int pipe_fds[2] = {-1, -1};
   if (to_pipe && ::pipe2(pipe_fds, O_CLOEXEC) != 0)
     throw std::runtime_error(std::string("pipe failed: ") + std::strerror(errno));
+  // stdin and stdout pipes: [0] read end, [1] write end, close-on-exec in this process (so no
+  // other child holds them open), made the child's 0 and 1 by dup2.
+  int in_fds[2] = {-1, -1}, out_fds[2] = {-1, -1};
+  const auto close_all = [](std::initializer_list<int*> fds) {
+    for (int* pair : fds) {
+      for (int i = 0; i < 2; ++i) {
+        if (pair[i] >= 0) ::close(pair[i]);
+        pair[i] = -1;
+      }
+    }
+  };
+  if (options.pipe_stdio && (::pipe2(in_fds, O_CLOEXEC) != 0 || ::pipe2(out_fds, O_CLOEXEC) != 0)) {
+    const int error = errno;
+    close_all({pipe_fds, in_fds, out_fds});
+    throw std::runtime_error(std::string("pipe failed: ") + std::strerror(error));
+  }
   // Closed by the exec (or the child's exit): once it reads end of file, what runs in the child
   // is the program, not this process's copy (whose memory the child's /proc status would show).
   int exec_fds[2] = {-1, -1};
   if (::pipe2(exec_fds, O_CLOEXEC) != 0) {
-    if (to_pipe) {
-      ::close(pipe_fds[0]);
-      ::close(pipe_fds[1]);
-    }
+    close_all({pipe_fds, in_fds, out_fds});
     throw std::runtime_error(std::string("pipe failed: ") + std::strerror(errno));
   }
   // SIGINT and SIGTERM blocked across fork: the child starts with this process's handlers, which
@@ -143,8 +157,13 @@ Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& optio
     // (not SIGKILL), so that it still removes its temporary files.
     ::prctl(PR_SET_PDEATHSIG, SIGTERM);
     if (::getppid() != parent) ::_exit(128 + SIGTERM);  // the sweep died before prctl
-    const int log = ::open(options.stdout_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (log >= 0) ::dup2(log, STDOUT_FILENO);
+    if (options.pipe_stdio) {
+      ::dup2(in_fds[0], STDIN_FILENO);
+      ::dup2(out_fds[1], STDOUT_FILENO);
+    } else {
+      const int log = ::open(options.stdout_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (log >= 0) ::dup2(log, STDOUT_FILENO);
+    }
     if (to_pipe) {
       ::dup2(pipe_fds[1], STDERR_FILENO);  // dup2 clears O_CLOEXEC on the copy
     } else {
@@ -156,7 +175,7 @@ Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& optio
           ::write(STDERR_FILENO, message.data(), message.size());
       ::_exit(127);
     };
-    if (options.null_stdin) {
+    if (options.null_stdin && !options.pipe_stdio) {
       const int null = ::open("/dev/null", O_RDONLY);
       if (null >= 0) ::dup2(null, STDIN_FILENO);
     }
@@ -179,11 +198,18 @@ Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& optio
   }
   ::close(exec_fds[0]);
   if (pid < 0) {
-    if (to_pipe) {
-      ::close(pipe_fds[0]);
-      ::close(pipe_fds[1]);
-    }
+    close_all({pipe_fds, in_fds, out_fds});
     throw std::runtime_error(std::string("fork failed: ") + std::strerror(fork_errno));
+  }
+  if (options.pipe_stdio) {
+    ::close(in_fds[0]);
+    ::close(out_fds[1]);
+    ::fcntl(in_fds[1], F_SETFL, O_NONBLOCK);
+    ::fcntl(out_fds[0], F_SETFL, O_NONBLOCK);
+    // A larger pipe means fewer wake-ups per scan; the default (64 KiB) works too.
+    ::fcntl(in_fds[1], F_SETPIPE_SZ, 1 << 20);
+    child.stdin_fd = in_fds[1];
+    child.stdout_fd = out_fds[0];
   }
   if (to_pipe) {
     ::close(pipe_fds[1]);

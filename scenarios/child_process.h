@@ -20,6 +20,8 @@ struct Child {
   std::chrono::steady_clock::time_point start;
   pid_t pid = -1;
   int stderr_fd = -1;  ///< read end of the child's stderr, non-blocking
+  int stdin_fd = -1;   ///< with SpawnOptions::pipe_stdio: write end of its stdin, non-blocking
+  int stdout_fd = -1;  ///< with SpawnOptions::pipe_stdio: read end of its stdout, non-blocking
   std::string log_path;
   std::string stderr_text;  ///< what it wrote there (the last 64 KiB)
   /// Past this, WaitAny kills it (SIGKILL) and sets timed_out. Never, by default.
@@ -68,6 +70,9 @@ struct SpawnOptions {
   std::string working_dir;   ///< empty: this process's
   bool search_path = false;  ///< args[0] without a slash is looked up on PATH (execvp)
   bool null_stdin = false;   ///< stdin from /dev/null, else this process's
+  /// Its stdin and stdout are pipes to this process (Child::stdin_fd, Child::stdout_fd; the
+  /// caller closes them); stdout_path and null_stdin are then unused.
+  bool pipe_stdio = false;
 };
 
 /// SpawnChild with the choices of `options`. A program that cannot be started exits with code
