@@ -76,49 +76,6 @@ std::string WriteInput(const slam::ExternalEstimator& estimator, const ExternalS
   return input.string();
 }
 
-// This process's resident memory now, KiB (0 when unknown).
-long ProcessResidentKb() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line)) {
-    if (line.rfind("VmRSS:", 0) == 0) return std::strtol(line.c_str() + 6, nullptr, 10);
-  }
-  return 0;
-}
-
-// The last `count` non-empty lines of a file, joined by " | ".
-std::string LastLines(const std::string& path, std::size_t count) {
-  std::ifstream in(path, std::ios::binary);
-  std::vector<std::string> lines;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    lines.push_back(line);
-    if (lines.size() > count) lines.erase(lines.begin());
-  }
-  std::string text;
-  for (const std::string& l : lines) text += (text.empty() ? "" : " | ") + l;
-  constexpr std::size_t kMaxChars = 600;
-  if (text.size() > kMaxChars) text = "..." + text.substr(text.size() - kMaxChars);
-  return text;
-}
-
-// How the program ended, when that is a failure; empty for exit code 0.
-std::string EndFailure(const Child& child, int status, double timeout_s) {
-  if (child.timed_out) {
-    std::ostringstream s;
-    s << "still running after timeout_s = " << timeout_s << " s; killed";
-    return s.str();
-  }
-  if (WIFSIGNALED(status)) {
-    return "killed by signal " + std::to_string(WTERMSIG(status)) + " (" +
-           ::strsignal(WTERMSIG(status)) + ")";
-  }
-  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return code == 0 ? "" : "exit code " + std::to_string(code);
-}
-
 // The program's output read back: the trajectory matched to the scans, and the map beside it.
 void ReadOutput(const fs::path& output, const slam::ExternalEstimator& estimator,
                 ExternalOutcome* outcome) {
@@ -157,6 +114,46 @@ void ReadOutput(const fs::path& output, const slam::ExternalEstimator& estimator
 }
 
 }  // namespace
+
+long ProcessResidentKb() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::strtol(line.c_str() + 6, nullptr, 10);
+  }
+  return 0;
+}
+
+std::string LastLines(const std::string& path, std::size_t count) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<std::string> lines;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    lines.push_back(line);
+    if (lines.size() > count) lines.erase(lines.begin());
+  }
+  std::string text;
+  for (const std::string& l : lines) text += (text.empty() ? "" : " | ") + l;
+  constexpr std::size_t kMaxChars = 600;
+  if (text.size() > kMaxChars) text = "..." + text.substr(text.size() - kMaxChars);
+  return text;
+}
+
+std::string ExternalEndFailure(bool timed_out, int status, double timeout_s) {
+  if (timed_out) {
+    std::ostringstream s;
+    s << "still running after timeout_s = " << timeout_s << " s; killed";
+    return s.str();
+  }
+  if (WIFSIGNALED(status)) {
+    return "killed by signal " + std::to_string(WTERMSIG(status)) + " (" +
+           ::strsignal(WTERMSIG(status)) + ")";
+  }
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return code == 0 ? "" : "exit code " + std::to_string(code);
+}
 
 std::optional<Trajectory> MatchPosesToScans(const Trajectory& poses,
                                             const std::vector<Time>& scan_times,
@@ -231,7 +228,7 @@ ExternalOutcome RunExternal(const std::string& name, const slam::ExternalEstimat
   // of a peak in its last 20 ms).
   outcome.peak_rss_kb = ended.peak_rss_kb > parent_kb ? ended.peak_rss_kb : ended.polled_peak_kb;
   outcome.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  outcome.failure = EndFailure(ended, status, options.timeout_s);
+  outcome.failure = ExternalEndFailure(ended.timed_out, status, options.timeout_s);
   if (outcome.failure.empty()) ReadOutput(output, estimator, &outcome);
   if (!outcome.failure.empty()) {
     const std::string tail = LastLines(spawn.stderr_path, 3);

@@ -51,6 +51,16 @@ inline constexpr double kExternalStampToleranceS = 1e-3;
 ExternalOutcome RunExternal(const std::string& name, const slam::ExternalEstimator& estimator,
                             const ExternalSource& source, const std::string& work_dir);
 
+/// This process's resident memory now, KiB (0 when unknown).
+long ProcessResidentKb();
+
+/// The last `count` non-empty lines of a file, joined by " | " (at most 600 characters, its end).
+std::string LastLines(const std::string& path, std::size_t count);
+
+/// How a program ended, when that is a failure ("exit code 2", "killed by signal 6 (Aborted)",
+/// "still running after timeout_s = 2 s; killed"); empty for exit code 0.
+std::string ExternalEndFailure(bool timed_out, int status, double timeout_s);
+
 /// Matches a program's poses to the scans' times, in order: one pose per scan, each within the
 /// tolerance of its scan's stamp. Returns the poses stamped with the scans' times, or nullopt
 /// and `*error` naming the counts or the first pose that does not match.

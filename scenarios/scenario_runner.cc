@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "scenarios/external_run.h"
+#include "scenarios/external_stream.h"
 #include "scenarios/live_view.h"
 #include "scenarios/recording.h"
 #include "scenarios/run_recorder.h"
@@ -36,7 +37,16 @@ constexpr double kRecoveredM = 0.5;
 
 using Runners = std::vector<std::unique_ptr<slam::EstimatorRunner>>;
 
-Runners MakeRunners(const ScenarioSpec& spec, const std::vector<Record>* log_records) {
+// A stream-mode external configuration's program, started and attached to its estimator.
+void AttachStream(slam::EstimatorRunner& runner, const std::string& work_dir) {
+  auto* external = dynamic_cast<slam::ExternalEstimator*>(&runner.estimator());
+  if (external == nullptr || !external->streams()) return;
+  external->Attach(
+      std::make_unique<ExternalStreamSession>(runner.config().name, *external, work_dir));
+}
+
+Runners MakeRunners(const ScenarioSpec& spec, const std::vector<Record>* log_records,
+                    const std::string& work_dir) {
   Runners runners;
   for (const slam::EstimatorConfig& config : spec.configs) {
     // A simulated robot always has wheel encoders; a log says what it has.
@@ -45,6 +55,7 @@ Runners MakeRunners(const ScenarioSpec& spec, const std::vector<Record>* log_rec
         : config.odometry.source == slam::OdometrySource::kAuto ? slam::OdometrySource::kWheelTicks
                                                                 : config.odometry.source;
     runners.push_back(std::make_unique<slam::EstimatorRunner>(config, source, spec.seed));
+    AttachStream(*runners.back(), work_dir);
   }
   return runners;
 }
@@ -297,6 +308,18 @@ ExternalSource ExternalSourceOf(const ScenarioSpec& spec) {
 // its output failed.
 bool TakeExternal(const slam::ExternalEstimator& external, const std::string& work_dir,
                   const Pose2& map_from_start, ConfigResult* c, ScenarioResult* result) {
+  if (external.streams()) {
+    // Its poses came in lockstep and are the run's; its map and statistics the estimator's.
+    const std::string failure = external.link()->failure();
+    if (!failure.empty()) {
+      result->failures.push_back({c->name, c->algorithm, failure});
+      return false;
+    }
+    c->has_map = external.link()->map().has_value();
+    if (!c->run.final.empty())
+      c->map_from_estimator = map_from_start * c->run.final.poses().front().pose.Inverse();
+    return true;
+  }
   ExternalOutcome outcome =
       RunExternal(c->name, external, ExternalSourceOf(*result->spec), work_dir);
   if (!outcome.failure.empty()) {
@@ -322,8 +345,9 @@ void Finish(Runners& runners, const Pose2& map_from_start, double data_time_s,
             const TextureRun* texture, const RunnerOptions& options, ScenarioResult* result) {
   if (texture) ScoreTruthTexture(*result->spec, *texture, result);
   const bool records_only = result->spec->log && result->scans == 0;
+  // Every stream ends (its program exits) before an offline program starts.
+  for (auto& r : runners) r->Finish();
   for (auto& r : runners) {
-    r->Finish();
     ConfigResult c;
     c.name = r->config().name;
     c.algorithm = r->config().algorithm;
@@ -378,7 +402,7 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
     layout.max_m = floor.max_m();
     texture.emplace(layout, floor.TruthColors(layout), floor.FloorMask(layout));
   }
-  Runners runners = MakeRunners(spec, nullptr);
+  Runners runners = MakeRunners(spec, nullptr, options.work_dir);
   std::optional<Pose2> map_from_start;  // true pose at the first scan SLAM sees
   std::unique_ptr<RunRecorder> recorder = MakeRecorder(options, runners, map_from_start);
   slam::OccupancyGrid truth_map{slam::OccupancyGridOptions{}};
@@ -503,7 +527,7 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
   result.log_format = data.format;
   result.times_synthesised = data.times_synthesised;
   if (!data.reference_kind.empty()) result.reference_kind = data.reference_kind;
-  Runners runners = MakeRunners(spec, &data.records);
+  Runners runners = MakeRunners(spec, &data.records, options.work_dir);
   std::optional<Pose2> map_from_start;
   std::unique_ptr<RunRecorder> recorder = MakeRecorder(options, runners, map_from_start);
   if (options.on_scan) {

@@ -65,6 +65,9 @@ class EstimatorRunner {
 
   const EstimatorConfig& config() const { return config_; }
   const Estimator& estimator() const { return *estimator_; }
+  /// The estimator, for what a caller attaches to it before the first record (an external
+  /// estimator's stream).
+  Estimator& estimator() { return *estimator_; }
   /// Scans the estimator has taken so far.
   std::size_t scans() const { return run_.online.size(); }
   /// The last online pose (identity before the first scan).

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "slam/types/check.h"
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
@@ -18,6 +19,20 @@ std::vector<std::string> ExternalEstimatorOptions::Validate() const {
   }
   if (!(std::isfinite(timeout_s) && timeout_s > 0.0))
     errors.push_back(RuleViolation("timeout_s", timeout_s, "must be > 0"));
+  if (!(std::isfinite(answer_timeout_s) && answer_timeout_s > 0.0))
+    errors.push_back(RuleViolation("answer_timeout_s", answer_timeout_s, "must be > 0"));
+  if (mode == ExternalMode::kStream) {
+    for (std::size_t i = 0; i < command.size(); ++i) {
+      for (const char* placeholder : {kExternalInputPlaceholder, kExternalOutputPlaceholder}) {
+        if (command[i].find(placeholder) != std::string::npos) {
+          errors.push_back("command[" + std::to_string(i) + "] = '" + command[i] + "'; " +
+                           placeholder +
+                           " has no meaning with mode stream (the records come on stdin, the "
+                           "poses go to stdout)");
+        }
+      }
+    }
+  }
   return errors;
 }
 
@@ -54,6 +69,37 @@ std::vector<std::string> SubstituteExternalArguments(const std::vector<std::stri
 ExternalEstimator::ExternalEstimator(const ExternalEstimatorOptions& options,
                                      const EstimatorContext& context)
     : options_(options), context_(context) {}
+
+void ExternalEstimator::AddRecord(const Record& record) {
+  if (!streams()) {
+    records_.push_back(record);
+    return;
+  }
+  SLAMRIG_CHECK(link_ != nullptr, "a stream-mode external estimator runs with a link attached");
+  // A scan goes when the estimators take it (AddScan): after the odometry it waits for.
+  if (!std::holds_alternative<LaserScan>(record)) link_->Record(record);
+}
+
+ScanEstimate ExternalEstimator::AddScan(const SyncedScan& scan) {
+  ScanEstimate estimate;
+  if (!streams()) return estimate;
+  SLAMRIG_CHECK(link_ != nullptr, "a stream-mode external estimator runs with a link attached");
+  if (const std::optional<Pose2> pose = link_->Scan(scan.scan)) estimate.pose = *pose;
+  return estimate;
+}
+
+void ExternalEstimator::Finish() {
+  if (link_) link_->Finish();
+}
+
+const OccupancyGrid& ExternalEstimator::map() const {
+  if (link_ && link_->map()) return *link_->map();
+  return map_;
+}
+
+std::map<std::string, double> ExternalEstimator::Statistics() const {
+  return link_ ? link_->Statistics() : std::map<std::string, double>{};
+}
 
 void ExternalAlgorithmOptions::Visit(FieldReader& reader) {
   namespace fs = std::filesystem;
