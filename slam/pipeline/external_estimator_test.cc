@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "slam/pipeline/estimator_config.h"
+#include "slam/pipeline/estimator_runner.h"
 #include "slam/types/error.h"
 
 namespace slamrig::slam {
@@ -81,6 +82,85 @@ TEST(ExternalEstimatorTest, BadOptionsAreOneLineNamingFileLineAndKey) {
   EXPECT_THAT(Error("algorithm: external\ncommand: [\"\", a]\n"),
               ::testing::HasSubstr("command[0]: the program is an empty text"));
   EXPECT_EQ(Error("algorithm: external\ncommand: [x]\n"), "no error");
+}
+
+TEST(ExternalEstimatorTest, StreamOptionsAreReadAndChecked) {
+  const YamlNode node = YamlNode::LoadString(
+      "algorithm: external\ncommand: [x, \"--seed={seed}\"]\nmode: stream\nanswer_timeout_s: 2\n",
+      "s.yaml");
+  const ExternalEstimatorOptions& o = OptionsOf(ParseEstimatorConfig("mine", node));
+  EXPECT_EQ(o.mode, ExternalMode::kStream);
+  EXPECT_EQ(o.answer_timeout_s, 2.0);
+  EXPECT_THAT(Error("algorithm: external\ncommand: [x]\nmode: online\n"),
+              ::testing::HasSubstr("s.yaml:3:7: mode: 'online' is not one of: offline, stream"));
+  EXPECT_THAT(Error("algorithm: external\ncommand: [x]\nmode: stream\nanswer_timeout_s: 0\n"),
+              ::testing::HasSubstr("answer_timeout_s = 0; must be > 0"));
+  EXPECT_THAT(Error("algorithm: external\ncommand: [x, \"{input}\"]\nmode: stream\n"),
+              ::testing::HasSubstr("command[1] = '{input}'; {input} has no meaning with mode "
+                                   "stream (the records come on stdin, the poses go to stdout)"));
+  EXPECT_EQ(Error("algorithm: external\ncommand: [x, \"{input}\"]\n"), "no error");
+}
+
+// Logs what a stream is given, in order, and answers each scan with (its time, 0, 0).
+class LoggingLink final : public ExternalStreamLink {
+ public:
+  explicit LoggingLink(std::vector<std::string>* log) : log_(log) {}
+  void Record(const slamrig::Record& record) override {
+    log_->push_back(std::string(std::holds_alternative<OdometryPose>(record) ? "odom " : "ticks ") +
+                    std::to_string(RecordTime(record).ns));
+  }
+  std::optional<Pose2> Scan(const LaserScan& scan) override {
+    log_->push_back("scan " + std::to_string(scan.time.ns));
+    return Pose2(scan.time.seconds(), 0.0, 0.0);
+  }
+  void Finish() override { log_->push_back("finish"); }
+  std::string failure() const override { return ""; }
+  const std::optional<OccupancyGrid>& map() const override { return map_; }
+  std::map<std::string, double> Statistics() const override { return {{"child_wall_s", 1.0}}; }
+
+ private:
+  std::vector<std::string>* log_;
+  std::optional<OccupancyGrid> map_;
+};
+
+// A scan reaches the program when the estimators take it: with odometry poses after the next
+// pose (its odometry is interpolated from both sides); with wheel ticks at once.
+TEST(ExternalEstimatorTest, StreamGetsEachScanAfterTheOdometryItWaitsFor) {
+  const YamlNode node =
+      YamlNode::LoadString("algorithm: external\ncommand: [x]\nmode: stream\n", "s.yaml");
+  const EstimatorConfig config = ParseEstimatorConfig("mine", node);
+  const auto scan = [](std::int64_t ns) {
+    LaserScan s;
+    s.time = Time{ns};
+    s.ranges_m = {1.0f};
+    return Record{s};
+  };
+  const auto odom = [](std::int64_t ns) { return Record{OdometryPose{Time{ns}, Pose2()}}; };
+  WheelTicks ticks;
+  ticks.right_ticks = ticks.left_ticks = {1};
+  const auto tick = [&](std::int64_t ns) {
+    ticks.time = Time{ns};
+    return Record{ticks};
+  };
+  const std::vector<std::pair<OdometrySource, std::vector<Record>>> cases = {
+      {OdometrySource::kOdometryPoses, {odom(0), scan(10), scan(20), odom(30), scan(40)}},
+      {OdometrySource::kWheelTicks, {tick(0), scan(10), scan(20), tick(30), scan(40)}}};
+  const std::vector<std::vector<std::string>> expected = {
+      {"odom 0", "odom 30", "scan 10", "scan 20", "scan 40", "finish"},
+      {"ticks 0", "scan 10", "scan 20", "ticks 30", "scan 40", "finish"}};
+  for (std::size_t c = 0; c < cases.size(); ++c) {
+    EstimatorRunner runner(config, cases[c].first, 1);
+    std::vector<std::string> log;
+    dynamic_cast<ExternalEstimator&>(runner.estimator())
+        .Attach(std::make_unique<LoggingLink>(&log));
+    for (const Record& r : cases[c].second) runner.Add(r);
+    runner.Finish();
+    EXPECT_EQ(log, expected[c]);
+    const EstimatorRun run = runner.TakeResult();
+    ASSERT_EQ(run.online.size(), 3u);
+    EXPECT_EQ(run.online.poses()[2].pose.x(), Time{40}.seconds());
+    EXPECT_EQ(run.statistics.at("child_wall_s"), 1.0);
+  }
 }
 
 TEST(ExternalEstimatorTest, SubstitutesEveryPlaceholderOnceAndNothingElse) {
