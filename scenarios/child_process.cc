@@ -62,6 +62,40 @@ void FinishChild(Child* child) {
   log << child->stderr_text;
 }
 
+// Closes both ends of each pipe that is open, and marks them closed.
+void ClosePairs(std::initializer_list<int*> pairs) {
+  for (int* pair : pairs) {
+    for (int i = 0; i < 2; ++i) {
+      if (pair[i] >= 0) ::close(pair[i]);
+      pair[i] = -1;
+    }
+  }
+}
+
+// In the child between fork and exec (async-signal-safe calls only): its stdin, stdout and
+// stderr as `options` say; the pipe ends given are the child's (dup2 clears O_CLOEXEC on the
+// copy).
+void RedirectStdio(const SpawnOptions& options, int stderr_write, int stdin_read,
+                   int stdout_write) {
+  if (options.pipe_stdio) {
+    ::dup2(stdin_read, STDIN_FILENO);
+    ::dup2(stdout_write, STDOUT_FILENO);
+  } else {
+    const int log = ::open(options.stdout_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (log >= 0) ::dup2(log, STDOUT_FILENO);
+    if (options.null_stdin) {
+      const int null = ::open("/dev/null", O_RDONLY);
+      if (null >= 0) ::dup2(null, STDIN_FILENO);
+    }
+  }
+  if (options.stderr_path.empty()) {
+    ::dup2(stderr_write, STDERR_FILENO);
+  } else {
+    const int err = ::open(options.stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (err >= 0) ::dup2(err, STDERR_FILENO);
+  }
+}
+
 }  // namespace
 
 ChildEnd ClassifyEnd(int status) {
@@ -119,24 +153,16 @@ Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& optio
   // stdin and stdout pipes: [0] read end, [1] write end, close-on-exec in this process (so no
   // other child holds them open), made the child's 0 and 1 by dup2.
   int in_fds[2] = {-1, -1}, out_fds[2] = {-1, -1};
-  const auto close_all = [](std::initializer_list<int*> fds) {
-    for (int* pair : fds) {
-      for (int i = 0; i < 2; ++i) {
-        if (pair[i] >= 0) ::close(pair[i]);
-        pair[i] = -1;
-      }
-    }
-  };
   if (options.pipe_stdio && (::pipe2(in_fds, O_CLOEXEC) != 0 || ::pipe2(out_fds, O_CLOEXEC) != 0)) {
     const int error = errno;
-    close_all({pipe_fds, in_fds, out_fds});
+    ClosePairs({pipe_fds, in_fds, out_fds});
     throw std::runtime_error(std::string("pipe failed: ") + std::strerror(error));
   }
   // Closed by the exec (or the child's exit): once it reads end of file, what runs in the child
   // is the program, not this process's copy (whose memory the child's /proc status would show).
   int exec_fds[2] = {-1, -1};
   if (::pipe2(exec_fds, O_CLOEXEC) != 0) {
-    close_all({pipe_fds, in_fds, out_fds});
+    ClosePairs({pipe_fds, in_fds, out_fds});
     throw std::runtime_error(std::string("pipe failed: ") + std::strerror(errno));
   }
   // SIGINT and SIGTERM blocked across fork: the child starts with this process's handlers, which
@@ -157,28 +183,12 @@ Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& optio
     // (not SIGKILL), so that it still removes its temporary files.
     ::prctl(PR_SET_PDEATHSIG, SIGTERM);
     if (::getppid() != parent) ::_exit(128 + SIGTERM);  // the sweep died before prctl
-    if (options.pipe_stdio) {
-      ::dup2(in_fds[0], STDIN_FILENO);
-      ::dup2(out_fds[1], STDOUT_FILENO);
-    } else {
-      const int log = ::open(options.stdout_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      if (log >= 0) ::dup2(log, STDOUT_FILENO);
-    }
-    if (to_pipe) {
-      ::dup2(pipe_fds[1], STDERR_FILENO);  // dup2 clears O_CLOEXEC on the copy
-    } else {
-      const int err = ::open(options.stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      if (err >= 0) ::dup2(err, STDERR_FILENO);
-    }
+    RedirectStdio(options, pipe_fds[1], in_fds[0], out_fds[1]);
     const auto fail = [](const std::string& message) {
       [[maybe_unused]] const ssize_t written =
           ::write(STDERR_FILENO, message.data(), message.size());
       ::_exit(127);
     };
-    if (options.null_stdin && !options.pipe_stdio) {
-      const int null = ::open("/dev/null", O_RDONLY);
-      if (null >= 0) ::dup2(null, STDIN_FILENO);
-    }
     if (!options.working_dir.empty() && ::chdir(options.working_dir.c_str()) != 0)
       fail(chdir_failed);
     if (options.search_path) {
@@ -198,7 +208,7 @@ Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& optio
   }
   ::close(exec_fds[0]);
   if (pid < 0) {
-    close_all({pipe_fds, in_fds, out_fds});
+    ClosePairs({pipe_fds, in_fds, out_fds});
     throw std::runtime_error(std::string("fork failed: ") + std::strerror(fork_errno));
   }
   if (options.pipe_stdio) {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "slam/types/check.h"
+#include "slam/types/error.h"
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
@@ -70,12 +70,20 @@ ExternalEstimator::ExternalEstimator(const ExternalEstimatorOptions& options,
                                      const EstimatorContext& context)
     : options_(options), context_(context) {}
 
+void ExternalEstimator::RequireLink() const {
+  if (link_ == nullptr) {
+    throw ConfigError(
+        "algorithm external with mode stream runs its program from the scenario runner (slamrig "
+        "run, slamrig slam --out); this caller started none");
+  }
+}
+
 void ExternalEstimator::AddRecord(const Record& record) {
   if (!streams()) {
     records_.push_back(record);
     return;
   }
-  SLAMRIG_CHECK(link_ != nullptr, "a stream-mode external estimator runs with a link attached");
+  RequireLink();
   // A scan goes when the estimators take it (AddScan): after the odometry it waits for.
   if (!std::holds_alternative<LaserScan>(record)) link_->Record(record);
 }
@@ -83,7 +91,7 @@ void ExternalEstimator::AddRecord(const Record& record) {
 ScanEstimate ExternalEstimator::AddScan(const SyncedScan& scan) {
   ScanEstimate estimate;
   if (!streams()) return estimate;
-  SLAMRIG_CHECK(link_ != nullptr, "a stream-mode external estimator runs with a link attached");
+  RequireLink();
   if (const std::optional<Pose2> pose = link_->Scan(scan.scan)) estimate.pose = *pose;
   return estimate;
 }

@@ -129,6 +129,9 @@ class ExternalEstimator final : public Estimator {
   }
 
  private:
+  // Throws ConfigError when a stream has no link (a caller that starts no program).
+  void RequireLink() const;
+
   ExternalEstimatorOptions options_;
   EstimatorContext context_;
   std::vector<Record> records_;

@@ -163,6 +163,22 @@ TEST(ExternalEstimatorTest, StreamGetsEachScanAfterTheOdometryItWaitsFor) {
   }
 }
 
+// A caller that starts no program (the Python module's run_estimator) gets an error, not a crash.
+TEST(ExternalEstimatorTest, StreamWithoutItsProgramIsAnError) {
+  const YamlNode node =
+      YamlNode::LoadString("algorithm: external\ncommand: [x]\nmode: stream\n", "s.yaml");
+  EstimatorRunner runner(ParseEstimatorConfig("mine", node), OdometrySource::kNone, 1);
+  LaserScan scan;
+  scan.ranges_m = {1.0f};
+  try {
+    runner.Add(scan);
+    ADD_FAILURE() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("mode stream runs its program from the scenario "
+                                               "runner"));
+  }
+}
+
 TEST(ExternalEstimatorTest, SubstitutesEveryPlaceholderOnceAndNothingElse) {
   const std::vector<std::string> command = {
       "prog",    "{input}", "--out={output}", "{seed}{seed}", "{inputs}",
