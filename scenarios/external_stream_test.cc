@@ -187,5 +187,43 @@ TEST(ExternalStreamTest, ClientsGiveTheBuiltInsBitsAndBrokenProgramsFailAlone) {
   fs::remove_all(dir);
 }
 
+// A log with odometry poses only (intel): each /scan comes after the /odom past it, and both
+// clients interpolate the poses to it; they agree with each other exactly and with the built-in
+// (which interpolates at constant twist, they linearly) to a few parts per million.
+TEST(ExternalStreamTest, OnALogTheClientsInterpolateItsOdometryPoses) {
+  const fs::path log =
+      fs::path(SLAMRIG_SOURCE_DIR) / "../shared/datasets/carmen_corrected/intel-corrected.log.gz";
+  if (!fs::exists(log)) GTEST_SKIP() << log << " is not there";
+  const fs::path dir = fs::temp_directory_path() / "slamrig_external_stream_log_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "s.yaml")
+      << "name: intel_stream\nsource: {log: " << log.lexically_normal().string()
+      << "}\nseed: 1\nslam:\n  dead_reckoning: {algorithm: dead-reckoning}\n"
+      << "  stream_py: {algorithm: external, mode: stream, command: [python3, "
+      << SLAMRIG_SOURCE_DIR << "/examples/external/stream_dead_reckoning.py]}\n"
+      << "  stream_cc: {algorithm: external, mode: stream, command: [" << SLAMRIG_STREAM_CLIENT
+      << "]}\n";
+  const ScenarioSpec spec = LoadScenario((dir / "s.yaml").string());
+  RunnerOptions options;
+  options.work_dir = (dir / "report").string();
+  const ScenarioResult r = RunScenario(spec, options);
+  const ConfigResult* builtin = Find(r, "dead_reckoning");
+  const ConfigResult* py = Find(r, "stream_py");
+  const ConfigResult* cc = Find(r, "stream_cc");
+  ASSERT_TRUE(builtin && py && cc) << Failure(r, "stream_py") << Failure(r, "stream_cc");
+  ASSERT_EQ(py->online.size(), 910u);
+  ASSERT_EQ(cc->online.size(), 910u);
+  for (std::size_t i = 0; i < py->online.size(); ++i) {
+    ASSERT_EQ(py->run.online.poses()[i].pose.x(), cc->run.online.poses()[i].pose.x()) << i;
+    ASSERT_EQ(py->run.online.poses()[i].pose.y(), cc->run.online.poses()[i].pose.y()) << i;
+  }
+  const double ate = builtin->metrics.at("ate_rmse_m");
+  EXPECT_GT(ate, 20.0);  // intel's raw odometry drifts
+  EXPECT_NEAR(py->metrics.at("ate_rmse_m"), ate, 1e-5 * ate);
+  EXPECT_EQ(cc->metrics.at("ate_rmse_m"), py->metrics.at("ate_rmse_m"));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace slamrig::scenario

@@ -8,7 +8,9 @@
 // The pose is the wheel odometry between scans as slamrig's built-in dead reckoning computes
 // it: encoder ticks (/joint_states) summed, gyro rates (/imu) averaged, one exact-arc step per
 // scan (the geometry from the stream's `slamrig.robot` metadata). Same arithmetic, same bits
-// (-ffp-contract=off, as slamrig is built). C++17 standard library only; no slamrig code.
+// (-ffp-contract=off, as slamrig is built). A log without encoders has its odometry poses on
+// /odom: they are interpolated to each scan. C++17 standard library only; no slamrig code.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -90,6 +92,27 @@ double Normalise(double a) {  // into (-pi, pi], as slamrig's Pose2
   return a <= -kPi ? a + 2.0 * kPi : a;
 }
 
+struct Pose {
+  double x = 0, y = 0, th = 0;
+};
+
+Pose Compose(const Pose& a, const Pose& b) {
+  const double c = std::cos(a.th), s = std::sin(a.th);
+  return {a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, Normalise(a.th + b.th)};
+}
+
+Pose Inverse(const Pose& a) {
+  const double c = std::cos(a.th), s = std::sin(a.th);
+  return {-c * a.x - s * a.y, s * a.x - c * a.y, Normalise(-a.th)};
+}
+
+// Between two stamped odometry poses: linear, shortest yaw; held at the ends.
+Pose Interpolate(std::int64_t t0, const Pose& p0, std::int64_t t1, const Pose& p1, std::int64_t t) {
+  const double f = t1 > t0 ? std::clamp(double(t - t0) / double(t1 - t0), 0.0, 1.0) : 1.0;
+  return {p0.x + f * (p1.x - p0.x), p0.y + f * (p1.y - p0.y),
+          Normalise(p0.th + f * Normalise(p1.th - p0.th))};
+}
+
 double Sinc(double x) { return std::abs(x) < 1e-4 ? 1.0 - x * x / 6.0 : std::sin(x) / x; }
 
 }  // namespace
@@ -117,9 +140,11 @@ int main() {
   std::map<std::string, std::string> robot;
   std::map<std::uint16_t, std::string> topics;
   std::vector<long long> total;
-  double right = 0, left = 0, gyro = 0, tpr = 0, held = 0, x = 0, y = 0, th = 0;
-  int count = 0;
+  double right = 0, left = 0, gyro = 0, tpr = 0, held = 0;
+  int count = 0, odoms = 0;
   bool has_held = false, started = false;
+  Pose pose, odom[2], last_odom;  // odom: the last two /odom poses, at odom_t
+  std::int64_t odom_t[2] = {0, 0};
   std::int64_t last = 0;
   std::uint32_t seq = 0;
   while (true) {
@@ -170,9 +195,22 @@ int main() {
         for (int i = 0; i < 15; ++i) cdr.Get<double>(true);
         gyro += cdr.Get<double>(true);
         ++count;
+      } else if (topic == "/odom" && total.empty()) {  // a log's odometry poses, no encoders
+        odom[0] = odom[1];
+        odom_t[0] = odom_t[1];
+        odom_t[1] = cdr.StampNs();
+        cdr.Str(true);  // child_frame_id
+        double v[7];
+        for (double& d : v) d = cdr.Get<double>(true);
+        odom[1] = {v[0], v[1], 2.0 * std::atan2(v[5], v[6])};
+        if (odoms++ == 0) odom[0] = odom[1], odom_t[0] = odom_t[1];
       } else if (topic == "/scan") {
         const std::int64_t t = cdr.StampNs();
-        if (started) {
+        if (total.empty() && odoms > 0) {  // the odometry poses interpolated to the scan
+          const Pose o = Interpolate(odom_t[0], odom[0], odom_t[1], odom[1], t);
+          if (started) pose = Compose(pose, Compose(Inverse(last_odom), o));
+          last_odom = o;
+        } else if (started) {
           const double dt = static_cast<double>(t - last) * 1e-9;
           const double mpt = 2.0 * kPi * std::stod(robot.at("wheel_radius_m")) / tpr;
           const double r_m = right * mpt, l_m = left * mpt;
@@ -183,17 +221,13 @@ int main() {
             if (has_held) yaw = held * dt;
           }
           const double half = 0.5 * yaw, chord = d * Sinc(half);
-          const double ix = chord * std::cos(half), iy = chord * std::sin(half);
-          const double c = std::cos(th), s = std::sin(th);
-          x = x + c * ix - s * iy;
-          y = y + s * ix + c * iy;
-          th = Normalise(th + Normalise(yaw));
+          pose = Compose(pose, {chord * std::cos(half), chord * std::sin(half), Normalise(yaw)});
         }
         started = true;
         last = t;
         right = left = gyro = 0;
         count = 0;
-        WritePose(seq++, t, x, y, th);
+        WritePose(seq++, t, pose.x, pose.y, pose.th);
       }
     }
   }

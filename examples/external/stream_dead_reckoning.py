@@ -7,6 +7,7 @@ geometry_msgs/PoseStamped on /estimate on stdout, stamped like the scan (docs/ex
 The pose is the wheel odometry between scans as slamrig's built-in dead reckoning computes it:
 encoder ticks (/joint_states) summed, gyro rates (/imu) averaged, one exact-arc step per scan
 (the robot's geometry from the stream's `slamrig.robot` metadata). Same arithmetic, same bits.
+A log without encoders has its odometry poses on /odom: they are interpolated to each scan.
 Python 3 standard library only (numpy is welcome in a real one: np.frombuffer reads the
 ranges of a /scan); no slamrig code.
 """
@@ -91,6 +92,18 @@ def compose(a, b):
     return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], normalise(a[2] + b[2]))
 
 
+def inverse(a):
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return (-c * a[0] - s * a[1], s * a[0] - c * a[1], normalise(-a[2]))
+
+
+def interpolate(odom, t):  # between the last two (time, pose), linear, shortest yaw; held at ends
+    (t0, p0), (t1, p1) = odom[0], odom[-1]
+    f = min(max((t - t0) / (t1 - t0), 0.0), 1.0) if t1 > t0 else 1.0
+    return (p0[0] + f * (p1[0] - p0[0]), p0[1] + f * (p1[1] - p0[1]),
+            normalise(p0[2] + f * normalise(p1[2] - p0[2])))
+
+
 def sinc(x):
     return 1.0 - x * x / 6.0 if abs(x) < 1e-4 else math.sin(x) / x
 
@@ -102,6 +115,7 @@ def main():
     robot, topics, total, tpr = {}, {}, None, None
     right = left = gyro = 0.0
     count, held, last_ns, pose = 0, None, None, (0.0, 0.0, 0.0)
+    odom, last_odom = [], None
     while True:
         head = inp.read(9)
         if len(head) < 9:
@@ -140,9 +154,18 @@ def main():
                 cdr.stamp_ns()
                 gyro += cdr.take("13d3d", 8)[15]  # orientation, its covariance; angular z
                 count += 1
+            elif topic == "/odom" and total is None:  # a log's odometry poses, no encoders
+                t = cdr.stamp_ns()
+                cdr.string()  # child_frame_id
+                x, y, _, _, _, qz, qw = cdr.take("7d", 8)
+                odom = odom[-1:] + [(t, (x, y, 2.0 * math.atan2(qz, qw)))]
             elif topic == "/scan":
                 t = cdr.stamp_ns()
-                if last_ns is not None:
+                if total is None and odom:  # the odometry poses interpolated to the scan
+                    o = interpolate(odom, t)
+                    pose = compose(pose, compose(inverse(last_odom), o)) if last_odom else pose
+                    last_odom = o
+                elif last_ns is not None:
                     dt = (t - last_ns) * 1e-9
                     mpt = 2.0 * math.pi * float(robot["wheel_radius_m"]) / tpr
                     r_m, l_m = right * mpt, left * mpt
