@@ -21,6 +21,11 @@ std::vector<std::string> ExternalEstimatorOptions::Validate() const {
     errors.push_back(RuleViolation("timeout_s", timeout_s, "must be > 0"));
   if (!(std::isfinite(answer_timeout_s) && answer_timeout_s > 0.0))
     errors.push_back(RuleViolation("answer_timeout_s", answer_timeout_s, "must be > 0"));
+  if (mode == ExternalMode::kStream && input != ExternalInput::kCarmen) {
+    errors.push_back(
+        "input: set with mode stream, which always streams MCAP on stdin (input is for mode "
+        "offline)");
+  }
   if (mode == ExternalMode::kStream) {
     for (std::size_t i = 0; i < command.size(); ++i) {
       for (const char* placeholder : {kExternalInputPlaceholder, kExternalOutputPlaceholder}) {

@@ -99,6 +99,8 @@ TEST(ExternalEstimatorTest, StreamOptionsAreReadAndChecked) {
               ::testing::HasSubstr("command[1] = '{input}'; {input} has no meaning with mode "
                                    "stream (the records come on stdin, the poses go to stdout)"));
   EXPECT_EQ(Error("algorithm: external\ncommand: [x, \"{input}\"]\n"), "no error");
+  EXPECT_THAT(Error("algorithm: external\ncommand: [x]\nmode: stream\ninput: mcap\n"),
+              ::testing::HasSubstr("input: set with mode stream, which always streams MCAP"));
 }
 
 // Logs what a stream is given, in order, and answers each scan with (its time, 0, 0).
