@@ -182,14 +182,24 @@ std::string ExternalStreamSession::Counts() const {
   return "wrote " + std::to_string(poses_) + " poses for " + std::to_string(scans_) + " scans";
 }
 
-std::string ExternalStreamSession::TimeoutText(Clock::time_point answer_deadline) const {
+ExternalStreamSession::Clock::time_point ExternalStreamSession::AnswerDeadline() const {
+  return std::min(run_deadline_,
+                  Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                     std::chrono::duration<double>(options_.answer_timeout_s)));
+}
+
+std::string ExternalStreamSession::TimeoutText(Clock::time_point deadline) const {
   char text[160];
-  if (answer_deadline >= run_deadline_) {
+  if (deadline >= run_deadline_) {
     std::snprintf(text, sizeof(text), "still running after timeout_s = %g s; killed",
                   options_.timeout_s);
     return std::string(text) + " (" + Counts() + ")";
   }
   std::snprintf(text, sizeof(text), "within answer_timeout_s = %g s", options_.answer_timeout_s);
+  if (written_ < stream_.size()) {  // the wait was for it to read
+    return "stopped reading its stdin (" + std::to_string(stream_.size() - written_) +
+           " bytes not taken " + text + "); killed (" + Counts() + ")";
+  }
   return "no pose for scan " + std::to_string(scans_) + " (" + Seconds(last_scan_time_) + ") " +
          text + "; killed (" + Counts() + ")";
 }
@@ -348,8 +358,10 @@ void ExternalStreamSession::Record(const slamrig::Record& record) {
   encode_s_ += std::chrono::duration<double>(Clock::now() - start).count();
   if (stream_.size() - written_ < kFlushBytes) return;
   try {
-    const Wait wait = WriteOut(run_deadline_);
-    if (wait == Wait::kTimeout) Fail(TimeoutText(run_deadline_));
+    // A program must keep taking its input: stalled this long, it has stopped.
+    const Clock::time_point deadline = AnswerDeadline();
+    const Wait wait = WriteOut(deadline);
+    if (wait == Wait::kTimeout) Fail(TimeoutText(deadline));
     if (wait == Wait::kEndOfFile) {
       const std::string end = Reap();
       Fail((end.empty() ? "exited" : end) + " before the end of the stream (" + Counts() + ")");
@@ -371,9 +383,7 @@ std::optional<Pose2> ExternalStreamSession::Scan(const LaserScan& scan) {
   encode_s_ += std::chrono::duration<double>(Clock::now() - start).count();
   ++scans_;
   last_scan_time_ = scan.time;
-  const Clock::time_point deadline = std::min(
-      run_deadline_, Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                        std::chrono::duration<double>(options_.answer_timeout_s)));
+  const Clock::time_point deadline = AnswerDeadline();
   try {
     Wait wait = WriteOut(deadline);
     std::optional<Pose2> pose;

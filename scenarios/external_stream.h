@@ -28,9 +28,10 @@ inline constexpr const char* kStreamMapTopic = "/map";            ///< Occupancy
 inline constexpr const char* kStreamRobotMetadata = "slamrig.robot";
 
 /// One running program fed in lockstep. Every pipe is non-blocking and every wait polls with a
-/// deadline (the scan's answer_timeout_s, and timeout_s from the start for the whole run), so
-/// a program that stops reading or writing costs at most its timeout; a write to a program that
-/// has gone fails with EPIPE (SIGPIPE is blocked around the write and a pending one taken back).
+/// deadline (answer_timeout_s for a scan's answer and for the program to take its input, and
+/// timeout_s from the start for the whole run), so a program that stops reading or writing costs
+/// at most its timeout; a write to a program that has gone fails with EPIPE (SIGPIPE is blocked
+/// around the write and a pending one taken back).
 /// The first failure kills the program and becomes `failure()`: "PROGRAM: what; stderr: <its
 /// last 3 lines>". SIGINT/SIGTERM throw Interrupted from any wait; the destructor kills and
 /// reaps a program still running.
@@ -69,6 +70,8 @@ class ExternalStreamSession final : public slam::ExternalStreamLink {
   void Take(const slam::McapStreamMessage& message, const LaserScan* scan,
             std::optional<Pose2>* pose);
   std::string Counts() const;
+  // answer_timeout_s from now, or the run's deadline when sooner.
+  Clock::time_point AnswerDeadline() const;
   std::string TimeoutText(Clock::time_point answer_deadline) const;
   // Waits for the program's exit (until the run's deadline); its end as a failure, or "".
   std::string Reap();
