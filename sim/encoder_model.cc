@@ -10,15 +10,10 @@
 namespace slamrig::sim {
 
 std::vector<std::string> EncoderOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (!(rate_hz > 0.0 && rate_hz <= 10000.0)) {
-    errors.push_back("rate_hz = " + FormatNumber(rate_hz) + "; must be in (0, 10000]");
-  }
-  if (ticks_per_revolution <= 0) {
-    errors.push_back("ticks_per_revolution = " + std::to_string(ticks_per_revolution) +
-                     "; must be > 0");
-  }
-  return errors;
+  Rules rules;
+  rules.InRange("rate_hz", rate_hz, 0.0, 10000.0, Ends::kOpenLow)
+      .Positive("ticks_per_revolution", ticks_per_revolution);
+  return rules.errors();
 }
 
 EncoderModel::EncoderModel(const EncoderOptions& options, int num_right, int num_left,

@@ -19,19 +19,6 @@ bool IsOdometry(const Record& r) {
   return std::holds_alternative<OdometryPose>(r) || std::holds_alternative<WheelTicks>(r);
 }
 
-void CheckFraction(std::vector<std::string>* errors, const char* field, double value) {
-  if (!(value >= 0.0 && value <= 1.0))
-    errors->push_back(RuleViolation(field, FormatNumber(value), "must be in [0, 1]"));
-}
-
-void CheckNonNegative(std::vector<std::string>* errors, const char* field, double value,
-                      double upper) {
-  if (!(value >= 0.0 && value <= upper)) {
-    errors->push_back(
-        RuleViolation(field, FormatNumber(value), "must be in [0, " + FormatNumber(upper) + "]"));
-  }
-}
-
 // The standard normal draws of the odometry noise. One set serves every odometry record between
 // two scans (the records' noise is fully correlated within a scan interval), so an increment
 // between scans, the motion SLAM sees, gets sigma = noise_per_m * |t| whatever the odometry
@@ -268,33 +255,25 @@ bool LogPerturbation::Active() const {
 }
 
 std::vector<std::string> LogPerturbation::Validate() const {
-  std::vector<std::string> e;
-  CheckNonNegative(&e, "odometry.noise_per_m", odometry.noise_per_m, 10.0);
-  CheckNonNegative(&e, "odometry.noise_per_rad", odometry.noise_per_rad, 10.0);
-  if (!(odometry.scale > 0.0 && odometry.scale <= 10.0))
-    e.push_back(
-        RuleViolation("odometry.scale", FormatNumber(odometry.scale), "must be in (0, 10]"));
-  if (!(std::abs(odometry.bias_rad_per_m) <= 10.0)) {
-    e.push_back(RuleViolation("odometry.bias_rad_per_m", FormatNumber(odometry.bias_rad_per_m),
-                              "must be in [-10, 10]"));
-  }
+  Rules rules;
+  rules.InRange("odometry.noise_per_m", odometry.noise_per_m, 0.0, 10.0)
+      .InRange("odometry.noise_per_rad", odometry.noise_per_rad, 0.0, 10.0)
+      .InRange("odometry.scale", odometry.scale, 0.0, 10.0, Ends::kOpenLow)
+      .InRange("odometry.bias_rad_per_m", odometry.bias_rad_per_m, -10.0, 10.0);
   for (std::size_t i = 0; i < odometry.lost.size(); ++i) {
     const Eigen::Vector2d& l = odometry.lost[i];
-    if (!(l.x() >= 0.0 && l.y() >= l.x() && std::isfinite(l.y()))) {
-      e.push_back(RuleViolation("odometry.lost[" + std::to_string(i) + "]",
-                                "[" + FormatNumber(l.x()) + ", " + FormatNumber(l.y()) + "]",
-                                "must be [t0, t1] seconds with 0 <= t0 <= t1"));
-    }
+    rules.Require(l.x() >= 0.0 && l.y() >= l.x() && std::isfinite(l.y()),
+                  "odometry.lost[" + std::to_string(i) + "]",
+                  "[" + FormatNumber(l.x()) + ", " + FormatNumber(l.y()) + "]",
+                  "must be [t0, t1] seconds with 0 <= t0 <= t1");
   }
-  CheckFraction(&e, "scans.drop_fraction", scans.drop_fraction);
-  CheckNonNegative(&e, "range.noise_m", range.noise_m, 100.0);
-  CheckNonNegative(&e, "range.max_m", range.max_m, 1e4);
-  if (beams.drop_every < 0 || beams.drop_every == 1) {
-    e.push_back(RuleViolation("beams.drop_every", beams.drop_every,
-                              "must be 0 (none) or >= 2 (1 would drop every beam)"));
-  }
-  CheckFraction(&e, "beams.drop_fraction", beams.drop_fraction);
-  return e;
+  rules.Fraction("scans.drop_fraction", scans.drop_fraction)
+      .InRange("range.noise_m", range.noise_m, 0.0, 100.0)
+      .InRange("range.max_m", range.max_m, 0.0, 1e4)
+      .Require(beams.drop_every == 0 || beams.drop_every >= 2, "beams.drop_every", beams.drop_every,
+               "must be 0 (none) or >= 2 (1 would drop every beam)")
+      .Fraction("beams.drop_fraction", beams.drop_fraction);
+  return rules.errors();
 }
 
 LogPerturbation ParseLogPerturbation(const YamlNode& node) {

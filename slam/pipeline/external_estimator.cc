@@ -8,17 +8,15 @@
 namespace slamrig::slam {
 
 std::vector<std::string> ExternalEstimatorOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (command.empty()) {
-    errors.push_back(
-        "command: required, a non-empty list (the program, then its arguments, e.g. [python3, "
-        "./my_slam.py, \"{input}\", \"{output}\"])");
-  } else if (command.front().empty()) {
-    errors.push_back("command[0]: the program is an empty text");
+  Rules rules;
+  rules.Required(!command.empty(), "command",
+                 "a non-empty list: the program, then its arguments, e.g. [python3, "
+                 "./my_slam.py, \"{input}\", \"{output}\"]");
+  if (!command.empty() && command.front().empty()) {
+    rules.Add("command[0]: the program is an empty text");
   }
-  if (!(std::isfinite(timeout_s) && timeout_s > 0.0))
-    errors.push_back(RuleViolation("timeout_s", timeout_s, "must be > 0"));
-  return errors;
+  rules.Require(std::isfinite(timeout_s) && timeout_s > 0.0, "timeout_s", timeout_s, "must be > 0");
+  return rules.errors();
 }
 
 std::vector<std::string> SubstituteExternalArguments(const std::vector<std::string>& command,
