@@ -69,6 +69,8 @@ std::vector<std::string> RobotSpec::Validate() const {
 
 RobotSpec WithoutNoise(RobotSpec spec) {
   spec.calibration = CalibrationErrors{0.0, 0.0, 0.0};
+  spec.encoders.slip_stddev = 0.0;
+  spec.encoders.slip_common_stddev = 0.0;
   spec.imu.gyro = ImuNoise{};
   spec.imu.accel = ImuNoise{};
   spec.lidar.range_noise_stddev_m = 0.0;

@@ -335,7 +335,41 @@ void ApplyLogPerturbation(Dataset* data, const LogPerturbation& p, std::uint64_t
                         std::to_string(lost) + " odometry records removed in lost intervals");
 }
 
-OdometryNoiseMeasurement MeasureOdometryNoise(const Dataset& data, const ScanSyncOptions& sync) {
+namespace {
+
+// Least squares of y = a x1 + b x2 with a, b >= 0 (no intercept): the normal equations, and
+// the one-variable fit when the pair has a negative coefficient.
+class RotationErrorFit {
+ public:
+  void Add(double x1, double x2, double y) {
+    s11_ += x1 * x1;
+    s12_ += x1 * x2;
+    s22_ += x2 * x2;
+    s1y_ += x1 * y;
+    s2y_ += x2 * y;
+  }
+  std::pair<double, double> Solve() const {
+    const double det = s11_ * s22_ - s12_ * s12_;
+    if (det > 1e-12 * s11_ * s22_) {
+      const double a = (s22_ * s1y_ - s12_ * s2y_) / det;
+      const double b = (s11_ * s2y_ - s12_ * s1y_) / det;
+      if (a >= 0.0 && b >= 0.0) return {a, b};
+    }
+    const double a = s11_ > 0.0 ? std::max(0.0, s1y_ / s11_) : 0.0;
+    const double b = s22_ > 0.0 ? std::max(0.0, s2y_ / s22_) : 0.0;
+    // The single term that explains more of sum y^2 (residual s_yy - coefficient * s_xy).
+    if (a * s1y_ >= b * s2y_) return {a, 0.0};
+    return {0.0, b};
+  }
+
+ private:
+  double s11_ = 0.0, s12_ = 0.0, s22_ = 0.0, s1y_ = 0.0, s2y_ = 0.0;
+};
+
+}  // namespace
+
+OdometryNoiseMeasurement MeasureOdometryNoise(const Dataset& data, const ScanSyncOptions& sync,
+                                              const OdometryNoiseSpacing& spacing) {
   const ScanSyncResult synced = SyncToScans(data.records, sync);
   if (data.reference.size() != synced.scans.size()) {
     throw ParseError(data.source + ": " + std::to_string(data.reference.size()) +
@@ -344,9 +378,18 @@ OdometryNoiseMeasurement MeasureOdometryNoise(const Dataset& data, const ScanSyn
   }
   OdometryNoiseMeasurement m;
   double sum_e_t2 = 0.0, sum_e_r2 = 0.0, sum_t2 = 0.0, sum_r2 = 0.0, sum_dot = 0.0;
+  double sum_r_dot = 0.0;
+  RotationErrorFit fit;
+  const bool every_scan = !(spacing.travel_m > 0.0 || spacing.turn_rad > 0.0);
+  std::size_t last = 0;  // the last kept scan
+  Pose2 u;               // the odometry from it
   for (std::size_t k = 1; k < synced.scans.size(); ++k) {
-    const Pose2& u = synced.scans[k].increment;
-    const Pose2 g = data.reference[k - 1].map_from_base.Between(data.reference[k].map_from_base);
+    u = every_scan ? synced.scans[k].increment : u * synced.scans[k].increment;
+    const Pose2 g = data.reference[last].map_from_base.Between(data.reference[k].map_from_base);
+    if (!every_scan && g.translation().norm() < spacing.travel_m &&
+        std::abs(g.theta()) < spacing.turn_rad) {
+      continue;
+    }
     const Eigen::Vector2d e = u.translation() - g.translation();
     const double e_theta = NormalizeAngle(u.theta() - g.theta());
     sum_e_t2 += e.squaredNorm();
@@ -354,16 +397,25 @@ OdometryNoiseMeasurement MeasureOdometryNoise(const Dataset& data, const ScanSyn
     sum_t2 += g.translation().squaredNorm();
     sum_r2 += g.theta() * g.theta();
     sum_dot += u.translation().dot(g.translation());
+    sum_r_dot += u.theta() * g.theta();
+    fit.Add(g.translation().squaredNorm(), g.theta() * g.theta(), e_theta * e_theta);
     m.path_m += g.translation().norm();
+    m.turn_rad += std::abs(g.theta());
     ++m.increments;
+    last = k;
+    u = Pose2();
   }
-  if (m.increments == 0) throw ParseError(data.source + ": fewer than two scans");
+  if (m.increments == 0) throw ParseError(data.source + ": fewer than two scans to compare");
   const double n = m.increments;
   m.rms_translation_m = std::sqrt(sum_e_t2 / n);
   m.rms_rotation_rad = std::sqrt(sum_e_r2 / n);
   m.noise_per_m = sum_t2 > 0.0 ? std::sqrt(0.5 * sum_e_t2 / sum_t2) : 0.0;
   m.noise_per_rad = sum_r2 > 0.0 ? std::sqrt(sum_e_r2 / sum_r2) : 0.0;
   m.scale = sum_t2 > 0.0 ? sum_dot / sum_t2 : 1.0;
+  m.rotation_scale = sum_r2 > 0.0 ? sum_r_dot / sum_r2 : 1.0;
+  const auto [per_m2, per_rad2] = fit.Solve();
+  m.rotation_per_m = std::sqrt(per_m2);
+  m.rotation_per_rad = std::sqrt(per_rad2);
   return m;
 }
 
