@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <utility>
 
 #include "slam/config/fields.h"
 #include "slam/config/yaml_node.h"
