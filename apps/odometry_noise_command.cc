@@ -1,7 +1,10 @@
 // `slamrig odometry-noise LOG`: a log's own odometry error per scan against its reference, as the
 // figures `--perturb odometry.noise_per_m=...` takes.
 
+#include <cmath>
 #include <cstdio>
+#include <string>
+#include <utility>
 
 #include "apps/cli_args.h"
 #include "apps/commands.h"
@@ -9,6 +12,7 @@
 #include "slam/io/log_perturbation.h"
 #include "slam/io/log_reader.h"
 #include "slam/types/error.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::app {
 
@@ -60,8 +64,12 @@ int RunOdometryNoiseCommand(const std::vector<std::string>& args) {
   slam::Dataset data = slam::ReadLog(slam::ResolveLogPath(log_path), read);
   slam::ApplyLogPerturbation(&data, perturbation, seed, sync.robot);
   sync.source = slam::ResolveOdometrySource(data.records, sync.source);
-  if (!(spacing.travel_m >= 0.0) || !(spacing.turn_rad >= 0.0)) {
-    throw ConfigError("slamrig odometry-noise: --every-m and --every-rad must be >= 0");
+  for (const auto& [flag, value] :
+       {std::pair{"--every-m", spacing.travel_m}, std::pair{"--every-rad", spacing.turn_rad}}) {
+    if (!(value >= 0.0 && std::isfinite(value))) {
+      throw ConfigError(std::string("slamrig odometry-noise: ") + flag + " " + FormatNumber(value) +
+                        ": must be a finite number >= 0");
+    }
   }
   const slam::OdometryNoiseMeasurement m = slam::MeasureOdometryNoise(data, sync, spacing);
   std::printf(
