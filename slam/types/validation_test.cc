@@ -52,9 +52,9 @@ TEST(RulesTest, NumbersPrintShortestRoundTrip) {
   // Values and bounds alike: no "0.100000" and no digits lost (0.123456789 is not "0.123457").
   Rules rules;
   rules.AtLeast("a_m", 0.1, 0.15).InRange("b", 0.123456789, 0.2, 1.0);
-  rules.Positive("c", 0.1f).Above("d", -1.0, -1.0).Require(false, "e", 1e-9, "must hold");
+  rules.Positive("c", -0.1f).Above("d", -1.0, -1.0).Require(false, "e", 1e-9, "must hold");
   const std::vector<std::string> expected = {
-      "a_m = 0.1; must be >= 0.15", "b = 0.123456789; must be in [0.2, 1]", "c = 0.1; must be > 0",
+      "a_m = 0.1; must be >= 0.15", "b = 0.123456789; must be in [0.2, 1]", "c = -0.1; must be > 0",
       "d = -1; must be > -1", "e = 1e-09; must hold"};
   EXPECT_EQ(rules.errors(), expected);
   EXPECT_EQ(FormatValue(2.5), "2.5");
