@@ -45,13 +45,9 @@ std::string SimSettingsYaml(const sim::SimulatorOptions& options, const RunSumma
 }  // namespace
 
 std::vector<std::string> RunOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (!(duration_s >= 0.0))
-    errors.push_back("duration_s = " + FormatNumber(duration_s) + "; must be >= 0");
-  if (!(max_duration_s > 0.0)) {
-    errors.push_back("max_duration_s = " + FormatNumber(max_duration_s) + "; must be > 0");
-  }
-  return errors;
+  Rules rules;
+  rules.NonNegative("duration_s", duration_s).Positive("max_duration_s", max_duration_s);
+  return rules.errors();
 }
 
 std::vector<std::pair<std::string, std::string>> CarmenLogParams(
@@ -134,14 +130,13 @@ void CountRecords(const RecordSinks& sinks, RunSummary* summary) {
 }  // namespace
 
 std::vector<std::string> RecordingOptions::Validate() const {
+  Rules rules;
   if (format == RecordingFormat::kEce276a) {
-    if (ece276a_dataset < 0) {
-      return {RuleViolation("ece276a_dataset", ece276a_dataset, "must be >= 0")};
-    }
-    return {};
+    rules.NonNegative("ece276a_dataset", ece276a_dataset);
+  } else if (format != RecordingFormat::kCarmen) {
+    rules.Nested("", topics.Validate());
   }
-  if (format == RecordingFormat::kCarmen) return {};
-  return topics.Validate();
+  return rules.errors();
 }
 
 RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptions& run,

@@ -23,48 +23,35 @@ const char* DriveModeName(DriveMode mode) {
 }
 
 std::vector<std::string> DriveOptions::Validate() const {
-  std::vector<std::string> errors;
-  auto positive = [&errors](const char* name, double value) {
-    if (!(value > 0.0))
-      errors.push_back(std::string(name) + " = " + FormatNumber(value) + "; must be > 0");
-  };
-  if (laps < 1) errors.push_back("laps = " + std::to_string(laps) + "; must be >= 1");
+  Rules rules;
+  rules.AtLeast("laps", laps, 1);
   if (mode == DriveMode::kWaypoints) {
-    positive("speed_m_s", speed_m_s);
-    positive("lookahead_m", lookahead_m);
-    positive("max_yaw_rate_rad_s", max_yaw_rate_rad_s);
-    positive("max_decel_m_s2", max_decel_m_s2);
-    positive("goal_tolerance_m", goal_tolerance_m);
-    if (!(dead_end_reach_m >= 0.0)) {
-      errors.push_back("dead_end_reach_m = " + FormatNumber(dead_end_reach_m) + "; must be >= 0");
-    }
-    if (!(turn_in_place_rad > 0.0 && turn_in_place_rad <= std::numbers::pi)) {
-      errors.push_back("turn_in_place_rad = " + FormatNumber(turn_in_place_rad) +
-                       "; must be in (0, pi]");
-    }
+    rules.Positive("speed_m_s", speed_m_s)
+        .Positive("lookahead_m", lookahead_m)
+        .Positive("max_yaw_rate_rad_s", max_yaw_rate_rad_s)
+        .Positive("max_decel_m_s2", max_decel_m_s2)
+        .Positive("goal_tolerance_m", goal_tolerance_m)
+        .NonNegative("dead_end_reach_m", dead_end_reach_m)
+        .Require(turn_in_place_rad > 0.0 && turn_in_place_rad <= std::numbers::pi,
+                 "turn_in_place_rad", turn_in_place_rad, "must be in (0, pi]");
     if (waypoints_m.size() < 2) {
-      errors.push_back("waypoints_m has " + std::to_string(waypoints_m.size()) +
-                       " points; pure pursuit needs at least 2");
+      rules.Add("waypoints_m has " + std::to_string(waypoints_m.size()) +
+                " points; pure pursuit needs at least 2");
     }
     for (std::size_t i = 0; i + 1 < waypoints_m.size(); ++i) {
       if ((waypoints_m[i + 1] - waypoints_m[i]).norm() < 1e-3) {
-        errors.push_back("waypoints_m[" + std::to_string(i + 1) + "] repeats the point before it");
+        rules.Add("waypoints_m[" + std::to_string(i + 1) + "] repeats the point before it");
       }
     }
-    if (!closed && laps != 1) {
-      errors.push_back("laps = " + std::to_string(laps) + "; an open path (closed: false) has 1");
-    }
+    rules.Require(closed || laps == 1, "laps", laps, "an open path (closed: false) has 1");
   }
   if (mode == DriveMode::kSchedule) {
-    if (schedule.empty()) errors.push_back("schedule is empty; schedule mode needs segments");
+    if (schedule.empty()) rules.Add("schedule is empty; schedule mode needs segments");
     for (std::size_t i = 0; i < schedule.size(); ++i) {
-      if (!(schedule[i].duration_s > 0.0)) {
-        errors.push_back("schedule[" + std::to_string(i) + "].duration_s = " +
-                         FormatNumber(schedule[i].duration_s) + "; must be > 0");
-      }
+      rules.Positive("schedule[" + std::to_string(i) + "].duration_s", schedule[i].duration_s);
     }
   }
-  return errors;
+  return rules.errors();
 }
 
 Driver::Driver(const DriveOptions& options) : options_(options) {

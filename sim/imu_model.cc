@@ -9,34 +9,24 @@
 namespace slamrig::sim {
 
 std::vector<std::string> ImuNoise::Validate() const {
-  std::vector<std::string> errors;
-  for (const auto& [name, value] :
-       {std::pair{"noise_density", noise_density}, std::pair{"random_walk", random_walk},
-        std::pair{"turn_on_bias_stddev", turn_on_bias_stddev},
-        std::pair{"saturation", saturation}}) {
-    if (!(value >= 0.0))
-      errors.push_back(std::string(name) + " = " + FormatNumber(value) + "; must be >= 0");
-  }
-  if (!(scale_error > -1.0)) {
-    errors.push_back("scale_error = " + FormatNumber(scale_error) + "; must be > -1");
-  }
-  return errors;
+  Rules rules;
+  rules.NonNegative("noise_density", noise_density)
+      .NonNegative("random_walk", random_walk)
+      .NonNegative("turn_on_bias_stddev", turn_on_bias_stddev)
+      .NonNegative("saturation", saturation)
+      .Above("scale_error", scale_error, -1.0);
+  return rules.errors();
 }
 
 std::vector<std::string> ImuOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (!(rate_hz > 0.0 && rate_hz <= 10000.0)) {
-    errors.push_back("rate_hz = " + FormatNumber(rate_hz) + "; must be in (0, 10000]");
-  }
-  if (mount.yaw_rad != 0.0) {
-    errors.push_back("mount.yaw_rad = " + FormatNumber(mount.yaw_rad) +
-                     "; the IMU axes must be base_link's (0)");
-  }
-  if (!(gravity_m_s2 >= 0.0))
-    errors.push_back("gravity_m_s2 = " + FormatNumber(gravity_m_s2) + "; must be >= 0");
-  AppendErrors(&errors, PrefixErrors("gyro", gyro.Validate()));
-  AppendErrors(&errors, PrefixErrors("accel", accel.Validate()));
-  return errors;
+  Rules rules;
+  rules.InRange("rate_hz", rate_hz, 0.0, 10000.0, Ends::kOpenLow)
+      .Require(mount.yaw_rad == 0.0, "mount.yaw_rad", mount.yaw_rad,
+               "the IMU axes must be base_link's (0)")
+      .NonNegative("gravity_m_s2", gravity_m_s2)
+      .Nested("gyro", gyro.Validate())
+      .Nested("accel", accel.Validate());
+  return rules.errors();
 }
 
 ImuModel::ImuModel(const ImuOptions& options, std::uint64_t seed)

@@ -24,44 +24,31 @@ double LidarOptions::time_increment_s() const {
 }
 
 std::vector<std::string> LidarOptions::Validate() const {
-  std::vector<std::string> errors;
-  auto require = [&errors](bool ok, const std::string& what) {
-    if (!ok) errors.push_back(what);
-  };
-  require(rate_hz > 0.0 && rate_hz <= 1000.0,
-          "rate_hz = " + FormatNumber(rate_hz) + "; must be in (0, 1000]");
-  require(num_beams > 1, "num_beams = " + std::to_string(num_beams) + "; must be > 1");
-  require(fov_deg > 0.0 && fov_deg < 360.0,
-          "fov_deg = " + FormatNumber(fov_deg) + "; must be in (0, 360)");
+  Rules rules;
+  rules.InRange("rate_hz", rate_hz, 0.0, 1000.0, Ends::kOpenLow)
+      .Above("num_beams", num_beams, 1)
+      .InRange("fov_deg", fov_deg, 0.0, 360.0, Ends::kOpen);
   if (num_beams > 1 && fov_deg > 0.0) {
     // The beams of one scan must fit into one turn of the mirror.
     const double beams_in_fov = fov_deg / 360.0 * beams_per_revolution;
-    require(beams_in_fov + 1e-9 >= num_beams - 1,
-            "beams_per_revolution = " + std::to_string(beams_per_revolution) +
-                "; must be >= (num_beams - 1) * 360 / fov_deg = " +
-                FormatNumber((num_beams - 1) * 360.0 / fov_deg));
+    rules.Require(beams_in_fov + 1e-9 >= num_beams - 1, "beams_per_revolution",
+                  beams_per_revolution,
+                  "must be >= (num_beams - 1) * 360 / fov_deg = " +
+                      FormatNumber((num_beams - 1) * 360.0 / fov_deg));
   }
-  require(range_min_m >= 0.0, "range_min_m = " + FormatNumber(range_min_m) + "; must be >= 0");
-  require(range_max_m > range_min_m, "range_max_m = " + FormatNumber(range_max_m) +
-                                         "; must be > range_min_m (" + FormatNumber(range_min_m) +
-                                         ")");
-  require(range_noise_stddev_m >= 0.0,
-          "range_noise_stddev_m = " + FormatNumber(range_noise_stddev_m) + "; must be >= 0");
-  require(range_noise_fraction >= 0.0 && range_noise_fraction <= 1.0,
-          "range_noise_fraction = " + FormatNumber(range_noise_fraction) + "; must be in [0, 1]");
-  require(range_resolution_m >= 0.0,
-          "range_resolution_m = " + FormatNumber(range_resolution_m) + "; must be >= 0");
-  require(short_decay_per_m > 0.0,
-          "short_decay_per_m = " + FormatNumber(short_decay_per_m) + "; must be > 0");
-  for (const auto& [name, p] : {std::pair{"p_short", p_short}, std::pair{"p_max", p_max},
-                                std::pair{"p_random", p_random}}) {
-    require(p >= 0.0 && p <= 1.0,
-            std::string(name) + " = " + FormatNumber(p) + "; must be in [0, 1]");
-  }
-  require(p_short + p_max + p_random <= 1.0,
-          "p_short + p_max + p_random = " + FormatNumber(p_short + p_max + p_random) +
-              "; must be <= 1");
-  return errors;
+  rules.NonNegative("range_min_m", range_min_m)
+      .Require(range_max_m > range_min_m, "range_max_m", range_max_m,
+               "must be > range_min_m (" + FormatNumber(range_min_m) + ")")
+      .NonNegative("range_noise_stddev_m", range_noise_stddev_m)
+      .Fraction("range_noise_fraction", range_noise_fraction)
+      .NonNegative("range_resolution_m", range_resolution_m)
+      .Positive("short_decay_per_m", short_decay_per_m)
+      .Fraction("p_short", p_short)
+      .Fraction("p_max", p_max)
+      .Fraction("p_random", p_random);
+  const double p_sum = p_short + p_max + p_random;
+  rules.Require(p_sum <= 1.0, "p_short + p_max + p_random", p_sum, "must be <= 1");
+  return rules.errors();
 }
 
 LidarModel::LidarModel(const LidarOptions& options, std::uint64_t seed)

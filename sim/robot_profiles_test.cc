@@ -25,7 +25,8 @@ constexpr Profile kProfiles[] = {
     {"sick_lms200_1deg", 181, 180.0, 81.91, 5.0},   {"sick_lms200_05deg", 361, 180.0, 81.91, 5.0},
     {"hokuyo_urg04lx", 683, 239.765625, 5.6, 10.0}, {"rplidar_a1", 360, 359.0, 12.0, 5.5},
     {"ece276a", 1081, 270.0, 30.0, 40.0},           {"odom_calibrated", 181, 180.0, 81.91, 5.0},
-    {"odom_poor", 181, 180.0, 81.91, 5.0},
+    {"odom_poor", 181, 180.0, 81.91, 5.0},          {"odom_intel", 181, 180.0, 81.91, 5.0},
+    {"odom_2x_intel", 181, 180.0, 81.91, 5.0},
 };
 
 class RobotProfileTest : public ::testing::TestWithParam<Profile> {};

@@ -103,7 +103,8 @@ struct RobotSpec {
 slam::DiffDriveParams NominalOdometry(const RobotSpec& spec);
 
 /// `spec` with every noise source and calibration error switched off: no IMU noise, bias or
-/// scale error, no lidar noise or mixture outliers, no range rounding, nominal = physical geometry.
+/// scale error, no lidar noise or mixture outliers, no range rounding, no random encoder slip,
+/// nominal = physical geometry.
 /// Tick quantization and the physics (slip, skid) remain.
 RobotSpec WithoutNoise(RobotSpec spec);
 

@@ -83,6 +83,9 @@ void VisitFields(V& v, EncoderOptions& e) {
   v("enabled", e.enabled);
   v("rate_hz", e.rate_hz);
   v("ticks_per_revolution", e.ticks_per_revolution);
+  v("slip_stddev", e.slip_stddev);
+  v("slip_common_stddev", e.slip_common_stddev);
+  v("slip_length_m", e.slip_length_m);
 }
 
 template <typename V>

@@ -73,25 +73,24 @@ double TwiceSignedArea(const std::vector<Eigen::Vector2d>& points) {
 }
 
 std::vector<std::string> ShapeSpec::Validate() const {
-  std::vector<std::string> errors;
+  Rules rules;
+  const std::vector<std::string>& errors = rules.errors();
   switch (type) {
     case ShapeType::kBox:
-      if (!(size_m.x() > 0.0 && size_m.y() > 0.0)) {
-        errors.push_back("size_m = [" + FormatNumber(size_m.x()) + ", " + FormatNumber(size_m.y()) +
-                         "]; both must be > 0");
-      }
+      rules.Require(size_m.x() > 0.0 && size_m.y() > 0.0, "size_m",
+                    "[" + FormatNumber(size_m.x()) + ", " + FormatNumber(size_m.y()) + "]",
+                    "both must be > 0");
       break;
     case ShapeType::kCircle:
-      if (!(radius_m > 0.0))
-        errors.push_back("radius_m = " + FormatNumber(radius_m) + "; must be > 0");
+      rules.Positive("radius_m", radius_m);
       break;
     case ShapeType::kPolygon:
     case ShapeType::kPolyline: {
       const bool polygon = type == ShapeType::kPolygon;
       const std::size_t min_points = polygon ? 3 : 2;
       if (points_m.size() < min_points) {
-        errors.push_back("points_m has " + std::to_string(points_m.size()) + " points; a " +
-                         ShapeTypeName(type) + " needs at least " + std::to_string(min_points));
+        rules.Add("points_m has " + std::to_string(points_m.size()) + " points; a " +
+                  ShapeTypeName(type) + " needs at least " + std::to_string(min_points));
         break;
       }
       const bool loop = polygon || closed;
@@ -99,8 +98,8 @@ std::vector<std::string> ShapeSpec::Validate() const {
       for (std::size_t i = 0; i < num_edges; ++i) {
         const double length = (points_m[(i + 1) % points_m.size()] - points_m[i]).norm();
         if (length < kMinEdgeLengthM) {
-          errors.push_back("points_m: edge " + std::to_string(i) + " is " + FormatNumber(length) +
-                           " m long; must be >= " + FormatNumber(kMinEdgeLengthM) + " m");
+          rules.Add("points_m: edge " + std::to_string(i) + " is " + FormatNumber(length) +
+                    " m long; must be >= " + FormatNumber(kMinEdgeLengthM) + " m");
         }
       }
       if (!errors.empty() || !polygon) break;
@@ -111,24 +110,24 @@ std::vector<std::string> ShapeSpec::Validate() const {
           if (i == 0 && j == n - 1) continue;  // adjacent through the closing edge
           if (SegmentsIntersect(points_m[i], points_m[(i + 1) % n], points_m[j],
                                 points_m[(j + 1) % n])) {
-            errors.push_back("points_m: edges " + std::to_string(i) + " and " + std::to_string(j) +
-                             " cross; the polygon must not self-intersect");
+            rules.Add("points_m: edges " + std::to_string(i) + " and " + std::to_string(j) +
+                      " cross; the polygon must not self-intersect");
             break;
           }
         }
       }
       if (errors.empty() && std::abs(TwiceSignedArea(points_m)) < 1e-6) {
-        errors.push_back("points_m: the polygon has no area");
+        rules.Add("points_m: the polygon has no area");
       }
       break;
     }
   }
   if (type == ShapeType::kCircle || type == ShapeType::kBox) {
     if (!points_m.empty()) {
-      errors.push_back(std::string("points_m is not used by a ") + ShapeTypeName(type));
+      rules.Add(std::string("points_m is not used by a ") + ShapeTypeName(type));
     }
   }
-  return errors;
+  return rules.errors();
 }
 
 std::vector<Eigen::Vector2d> ShapeSpec::Outline() const {

@@ -16,34 +16,27 @@ std::int64_t PeriodNs(double rate_hz) { return std::llround(1e9 / rate_hz); }
 }  // namespace
 
 std::vector<std::string> SimulatorOptions::Validate() const {
-  std::vector<std::string> errors;
-  AppendErrors(&errors, PrefixErrors("world", world.Validate()));
-  AppendErrors(&errors, PrefixErrors("robot", robot.Validate()));
-  if (!(physics_rate_hz >= 50.0 && physics_rate_hz <= 10000.0)) {
-    errors.push_back("physics_rate_hz = " + FormatNumber(physics_rate_hz) +
-                     "; must be in [50, 10000]");
-  }
-  for (const auto& [name, value] : {std::pair{"traction_iterations", traction_iterations},
-                                    std::pair{"velocity_iterations", velocity_iterations},
-                                    std::pair{"position_iterations", position_iterations}}) {
-    if (value < 1)
-      errors.push_back(std::string(name) + " = " + std::to_string(value) + "; must be >= 1");
-  }
+  Rules rules;
+  rules.Nested("world", world.Validate())
+      .Nested("robot", robot.Validate())
+      .InRange("physics_rate_hz", physics_rate_hz, 50.0, 10000.0)
+      .AtLeast("traction_iterations", traction_iterations, 1)
+      .AtLeast("velocity_iterations", velocity_iterations, 1)
+      .AtLeast("position_iterations", position_iterations, 1);
   // The speed loop is integrated explicitly: its gain must not overshoot within one step.
   const double dt = 1.0 / physics_rate_hz;
   const double loop_gain = robot.motor.kp_n_m_s_rad * dt / robot.wheels.spin_inertia_kg_m2;
-  if (errors.empty() && loop_gain >= 1.0) {
-    errors.push_back("robot.motor.kp_n_m_s_rad = " + FormatNumber(robot.motor.kp_n_m_s_rad) +
-                     "; kp / physics_rate_hz / wheels.spin_inertia_kg_m2 = " +
-                     FormatNumber(loop_gain) + " must be < 1 for a stable speed loop");
+  if (rules.errors().empty()) {
+    rules.Require(loop_gain < 1.0, "robot.motor.kp_n_m_s_rad", robot.motor.kp_n_m_s_rad,
+                  "kp / physics_rate_hz / wheels.spin_inertia_kg_m2 = " + FormatNumber(loop_gain) +
+                      " must be < 1 for a stable speed loop");
   }
-  return errors;
+  return rules.errors();
 }
 
 Simulator::Simulator(const SimulatorOptions& options)
     : options_(options), driver_(options.world.drive) {
-  const auto errors = options_.Validate();
-  SLAMRIG_CHECK(errors.empty(), errors.empty() ? "" : errors.front().c_str());
+  SLAMRIG_CHECK_VALID(options_, "SimulatorOptions");
   world_ = std::make_unique<World>(options_.world);
   robot_ = std::make_unique<Robot>(options_.robot, world_.get(), options_.world.spawn);
   caster_ = std::make_unique<RayCaster>(world_->b2world(), robot_->body(), &world_->materials());
@@ -53,7 +46,7 @@ Simulator::Simulator(const SimulatorOptions& options)
   const RobotSpec& robot = options_.robot;
   if (robot.encoders.enabled) {
     encoders_.emplace(robot.encoders, robot_->num_right_wheels(), robot_->num_left_wheels(),
-                      options_.seed);
+                      options_.seed, robot.wheels.radius_m);
     encoder_period_ns_ = PeriodNs(robot.encoders.rate_hz);
   }
   if (robot.imu.enabled) {

@@ -12,6 +12,7 @@
 #include "sim/world.h"
 #include "sim/world_yaml.h"
 #include "slam/types/error.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::sim::worldgen {
 namespace {
@@ -209,6 +210,20 @@ TEST(WorldgenTest, ParsesWhatItWrites) {
     node.CheckAllKeysUsed();
     EXPECT_EQ(GenerateSpecToYaml(back), yaml);
   }
+}
+
+// Each broken rule names its key, value and bound, numbers as written.
+TEST(WorldKindsTest, BrokenRulesNameKeyValueAndBound) {
+  GenerateSpec spec;
+  spec.kind = WorldKind::kMaze;
+  spec.route.speed_m_s = 0.01;
+  spec.maze.cell_m = 0.1;
+  spec.maze.black_fraction = 1.5;
+  EXPECT_THAT(spec.Validate(),
+              ::testing::ElementsAre(
+                  "speed_m_s = 0.01; must be in [0.05, 5]", "cell_m = 0.1; must be in [0.5, 10]",
+                  "wall_m = " + FormatNumber(spec.maze.wall_m) + "; must be < cell_m / 2",
+                  "black_fraction = 1.5; must be in [0, 1]"));
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <utility>
 
 #include "slam/config/fields.h"
 #include "slam/config/yaml_node.h"
@@ -17,19 +18,6 @@ namespace {
 
 bool IsOdometry(const Record& r) {
   return std::holds_alternative<OdometryPose>(r) || std::holds_alternative<WheelTicks>(r);
-}
-
-void CheckFraction(std::vector<std::string>* errors, const char* field, double value) {
-  if (!(value >= 0.0 && value <= 1.0))
-    errors->push_back(RuleViolation(field, FormatNumber(value), "must be in [0, 1]"));
-}
-
-void CheckNonNegative(std::vector<std::string>* errors, const char* field, double value,
-                      double upper) {
-  if (!(value >= 0.0 && value <= upper)) {
-    errors->push_back(
-        RuleViolation(field, FormatNumber(value), "must be in [0, " + FormatNumber(upper) + "]"));
-  }
 }
 
 // The standard normal draws of the odometry noise. One set serves every odometry record between
@@ -268,33 +256,25 @@ bool LogPerturbation::Active() const {
 }
 
 std::vector<std::string> LogPerturbation::Validate() const {
-  std::vector<std::string> e;
-  CheckNonNegative(&e, "odometry.noise_per_m", odometry.noise_per_m, 10.0);
-  CheckNonNegative(&e, "odometry.noise_per_rad", odometry.noise_per_rad, 10.0);
-  if (!(odometry.scale > 0.0 && odometry.scale <= 10.0))
-    e.push_back(
-        RuleViolation("odometry.scale", FormatNumber(odometry.scale), "must be in (0, 10]"));
-  if (!(std::abs(odometry.bias_rad_per_m) <= 10.0)) {
-    e.push_back(RuleViolation("odometry.bias_rad_per_m", FormatNumber(odometry.bias_rad_per_m),
-                              "must be in [-10, 10]"));
-  }
+  Rules rules;
+  rules.InRange("odometry.noise_per_m", odometry.noise_per_m, 0.0, 10.0)
+      .InRange("odometry.noise_per_rad", odometry.noise_per_rad, 0.0, 10.0)
+      .InRange("odometry.scale", odometry.scale, 0.0, 10.0, Ends::kOpenLow)
+      .InRange("odometry.bias_rad_per_m", odometry.bias_rad_per_m, -10.0, 10.0);
   for (std::size_t i = 0; i < odometry.lost.size(); ++i) {
     const Eigen::Vector2d& l = odometry.lost[i];
-    if (!(l.x() >= 0.0 && l.y() >= l.x() && std::isfinite(l.y()))) {
-      e.push_back(RuleViolation("odometry.lost[" + std::to_string(i) + "]",
-                                "[" + FormatNumber(l.x()) + ", " + FormatNumber(l.y()) + "]",
-                                "must be [t0, t1] seconds with 0 <= t0 <= t1"));
-    }
+    rules.Require(l.x() >= 0.0 && l.y() >= l.x() && std::isfinite(l.y()),
+                  "odometry.lost[" + std::to_string(i) + "]",
+                  "[" + FormatNumber(l.x()) + ", " + FormatNumber(l.y()) + "]",
+                  "must be [t0, t1] seconds with 0 <= t0 <= t1");
   }
-  CheckFraction(&e, "scans.drop_fraction", scans.drop_fraction);
-  CheckNonNegative(&e, "range.noise_m", range.noise_m, 100.0);
-  CheckNonNegative(&e, "range.max_m", range.max_m, 1e4);
-  if (beams.drop_every < 0 || beams.drop_every == 1) {
-    e.push_back(RuleViolation("beams.drop_every", beams.drop_every,
-                              "must be 0 (none) or >= 2 (1 would drop every beam)"));
-  }
-  CheckFraction(&e, "beams.drop_fraction", beams.drop_fraction);
-  return e;
+  rules.Fraction("scans.drop_fraction", scans.drop_fraction)
+      .InRange("range.noise_m", range.noise_m, 0.0, 100.0)
+      .InRange("range.max_m", range.max_m, 0.0, 1e4)
+      .Require(beams.drop_every == 0 || beams.drop_every >= 2, "beams.drop_every", beams.drop_every,
+               "must be 0 (none) or >= 2 (1 would drop every beam)")
+      .Fraction("beams.drop_fraction", beams.drop_fraction);
+  return rules.errors();
 }
 
 LogPerturbation ParseLogPerturbation(const YamlNode& node) {
@@ -356,7 +336,41 @@ void ApplyLogPerturbation(Dataset* data, const LogPerturbation& p, std::uint64_t
                         std::to_string(lost) + " odometry records removed in lost intervals");
 }
 
-OdometryNoiseMeasurement MeasureOdometryNoise(const Dataset& data, const ScanSyncOptions& sync) {
+namespace {
+
+// Least squares of y = a x1 + b x2 with a, b >= 0 (no intercept): the normal equations, and
+// the one-variable fit when the pair has a negative coefficient.
+class RotationErrorFit {
+ public:
+  void Add(double x1, double x2, double y) {
+    s11_ += x1 * x1;
+    s12_ += x1 * x2;
+    s22_ += x2 * x2;
+    s1y_ += x1 * y;
+    s2y_ += x2 * y;
+  }
+  std::pair<double, double> Solve() const {
+    const double det = s11_ * s22_ - s12_ * s12_;
+    if (det > 1e-12 * s11_ * s22_) {
+      const double a = (s22_ * s1y_ - s12_ * s2y_) / det;
+      const double b = (s11_ * s2y_ - s12_ * s1y_) / det;
+      if (a >= 0.0 && b >= 0.0) return {a, b};
+    }
+    const double a = s11_ > 0.0 ? std::max(0.0, s1y_ / s11_) : 0.0;
+    const double b = s22_ > 0.0 ? std::max(0.0, s2y_ / s22_) : 0.0;
+    // The single term that explains more of sum y^2 (residual s_yy - coefficient * s_xy).
+    if (a * s1y_ >= b * s2y_) return {a, 0.0};
+    return {0.0, b};
+  }
+
+ private:
+  double s11_ = 0.0, s12_ = 0.0, s22_ = 0.0, s1y_ = 0.0, s2y_ = 0.0;
+};
+
+}  // namespace
+
+OdometryNoiseMeasurement MeasureOdometryNoise(const Dataset& data, const ScanSyncOptions& sync,
+                                              const OdometryNoiseSpacing& spacing) {
   const ScanSyncResult synced = SyncToScans(data.records, sync);
   if (data.reference.size() != synced.scans.size()) {
     throw ParseError(data.source + ": " + std::to_string(data.reference.size()) +
@@ -365,9 +379,18 @@ OdometryNoiseMeasurement MeasureOdometryNoise(const Dataset& data, const ScanSyn
   }
   OdometryNoiseMeasurement m;
   double sum_e_t2 = 0.0, sum_e_r2 = 0.0, sum_t2 = 0.0, sum_r2 = 0.0, sum_dot = 0.0;
+  double sum_r_dot = 0.0;
+  RotationErrorFit fit;
+  const bool every_scan = !(spacing.travel_m > 0.0 || spacing.turn_rad > 0.0);
+  std::size_t last = 0;  // the last kept scan
+  Pose2 u;               // the odometry from it
   for (std::size_t k = 1; k < synced.scans.size(); ++k) {
-    const Pose2& u = synced.scans[k].increment;
-    const Pose2 g = data.reference[k - 1].map_from_base.Between(data.reference[k].map_from_base);
+    u = every_scan ? synced.scans[k].increment : u * synced.scans[k].increment;
+    const Pose2 g = data.reference[last].map_from_base.Between(data.reference[k].map_from_base);
+    if (!every_scan && g.translation().norm() < spacing.travel_m &&
+        std::abs(g.theta()) < spacing.turn_rad) {
+      continue;
+    }
     const Eigen::Vector2d e = u.translation() - g.translation();
     const double e_theta = NormalizeAngle(u.theta() - g.theta());
     sum_e_t2 += e.squaredNorm();
@@ -375,16 +398,25 @@ OdometryNoiseMeasurement MeasureOdometryNoise(const Dataset& data, const ScanSyn
     sum_t2 += g.translation().squaredNorm();
     sum_r2 += g.theta() * g.theta();
     sum_dot += u.translation().dot(g.translation());
+    sum_r_dot += u.theta() * g.theta();
+    fit.Add(g.translation().squaredNorm(), g.theta() * g.theta(), e_theta * e_theta);
     m.path_m += g.translation().norm();
+    m.turn_rad += std::abs(g.theta());
     ++m.increments;
+    last = k;
+    u = Pose2();
   }
-  if (m.increments == 0) throw ParseError(data.source + ": fewer than two scans");
+  if (m.increments == 0) throw ParseError(data.source + ": fewer than two scans to compare");
   const double n = m.increments;
   m.rms_translation_m = std::sqrt(sum_e_t2 / n);
   m.rms_rotation_rad = std::sqrt(sum_e_r2 / n);
   m.noise_per_m = sum_t2 > 0.0 ? std::sqrt(0.5 * sum_e_t2 / sum_t2) : 0.0;
   m.noise_per_rad = sum_r2 > 0.0 ? std::sqrt(sum_e_r2 / sum_r2) : 0.0;
   m.scale = sum_t2 > 0.0 ? sum_dot / sum_t2 : 1.0;
+  m.rotation_scale = sum_r2 > 0.0 ? sum_r_dot / sum_r2 : 1.0;
+  const auto [per_m2, per_rad2] = fit.Solve();
+  m.rotation_per_m = std::sqrt(per_m2);
+  m.rotation_per_rad = std::sqrt(per_rad2);
   return m;
 }
 

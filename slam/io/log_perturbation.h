@@ -136,6 +136,7 @@ void ApplyLogPerturbation(Dataset* data, const LogPerturbation& perturbation, st
 /// g_k the reference's: the error model ApplyLogPerturbation draws from, fitted.
 struct OdometryNoiseMeasurement {
   int increments = 0;              ///< scan pairs used
+  double turn_rad = 0.0;           ///< sum of |theta(g_k)|
   double path_m = 0.0;             ///< sum of |g_k translation|
   double rms_translation_m = 0.0;  ///< RMS of |t(u_k) - t(g_k)| per scan
   double rms_rotation_rad = 0.0;   ///< RMS of the wrapped theta(u_k) - theta(g_k) per scan
@@ -147,10 +148,29 @@ struct OdometryNoiseMeasurement {
   double noise_per_rad = 0.0;
   /// sum t(u).t(g) / sum |t(g)|^2: the systematic translation scale.
   double scale = 1.0;
+  /// sum theta(u) theta(g) / sum theta(g)^2: the systematic rotation scale.
+  double rotation_scale = 1.0;
+  /// The rotation error split by its causes, from the least-squares fit (coefficients >= 0)
+  /// e_theta^2 = a |t(g)|^2 + b theta(g)^2 over the scan pairs: heading error per metre
+  /// travelled, sqrt(a), and per radian turned, sqrt(b). Unlike noise_per_rad it does not
+  /// depend on how much of the route is straight.
+  double rotation_per_m = 0.0;
+  double rotation_per_rad = 0.0;
+};
+
+/// Which scan pairs MeasureOdometryNoise compares. With both 0, every consecutive pair; else
+/// only the scans at which the reference has moved `travel_m` or turned `turn_rad` since the
+/// last kept scan (the first is kept), each compared with the last kept one, so a finely
+/// sampled log (a simulation at the lidar's rate) is measured at a coarser log's spacing (the
+/// corrected CARMEN logs keep GMapping's scans, about one per metre or half radian).
+struct OdometryNoiseSpacing {
+  double travel_m = 0.0;
+  double turn_rad = 0.0;
 };
 
 /// Measures `data`'s odometry (synchronised to its scans by `sync`) against its reference.
 /// Throws ParseError naming the source when it has no reference of one pose per scan.
-OdometryNoiseMeasurement MeasureOdometryNoise(const Dataset& data, const ScanSyncOptions& sync);
+OdometryNoiseMeasurement MeasureOdometryNoise(const Dataset& data, const ScanSyncOptions& sync,
+                                              const OdometryNoiseSpacing& spacing = {});
 
 }  // namespace slamrig::slam

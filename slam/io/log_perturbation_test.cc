@@ -481,5 +481,38 @@ TEST(LogPerturbationTest, MeasurementRecoversAddedNoise) {
   EXPECT_NEAR(m.noise_per_m, std::sqrt(0.04 * 0.04 + 0.05 * 0.05 / 2), 0.002);
 }
 
+// A log whose odometry turns 10 % too far and drifts 0.02 rad per metre: the fit splits the
+// rotation error into its causes, and thinned scans compose the odometry between kept ones.
+TEST(LogPerturbationTest, RotationErrorPerMetreAndPerRadianAndSpacing) {
+  Dataset d;
+  Pose2 truth, odometry;
+  for (int k = 0; k < 4000; ++k) {
+    const double t = 0.1 * k;
+    // Alternately 20 steps straight (0.1 m) and 20 turning on the spot (0.05 rad).
+    const bool turning = (k / 20) % 2 == 1;
+    const Pose2 g = turning ? Pose2(0.0, 0.0, 0.05) : Pose2(0.1, 0.0, 0.0);
+    truth = truth * g;
+    odometry = odometry * Pose2(g.x(), g.y(), 1.1 * g.theta() + 0.02 * g.x());
+    d.records.push_back(OdometryPose{Time::FromSeconds(t), odometry});
+    d.records.push_back(MakeScan(t, 1));
+    d.reference.push_back({Time::FromSeconds(t), truth});
+  }
+  ScanSyncOptions sync;
+  sync.source = OdometrySource::kOdometryPoses;
+  const OdometryNoiseMeasurement every = MeasureOdometryNoise(d, sync);
+  EXPECT_EQ(every.increments, 3999);
+  EXPECT_NEAR(every.rotation_scale, 1.1, 1e-9);
+  EXPECT_NEAR(every.rotation_per_rad, 0.1, 1e-6);
+  EXPECT_NEAR(every.rotation_per_m, 0.02, 1e-6);
+  // One comparison per metre straight (10 steps) or per 0.5 rad turned (10 steps); the pair
+  // that spans the first step mixes the two.
+  const OdometryNoiseMeasurement spaced = MeasureOdometryNoise(d, sync, {0.95, 0.475});
+  EXPECT_NEAR(spaced.increments, 400, 2);
+  EXPECT_NEAR(spaced.path_m, every.path_m, 1e-6);
+  EXPECT_NEAR(spaced.rotation_scale, 1.1, 1e-3);
+  EXPECT_NEAR(spaced.rotation_per_rad, 0.1, 1e-3);
+  EXPECT_NEAR(spaced.rotation_per_m, 0.02, 1e-3);
+}
+
 }  // namespace
 }  // namespace slamrig::slam

@@ -9,20 +9,18 @@
 namespace slamrig::slam {
 
 std::vector<std::string> ExternalEstimatorOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (command.empty()) {
-    errors.push_back(
-        "command: required, a non-empty list (the program, then its arguments, e.g. [python3, "
-        "./my_slam.py, \"{input}\", \"{output}\"])");
-  } else if (command.front().empty()) {
-    errors.push_back("command[0]: the program is an empty text");
+  Rules rules;
+  rules.Required(!command.empty(), "command",
+                 "a non-empty list: the program, then its arguments, e.g. [python3, "
+                 "./my_slam.py, \"{input}\", \"{output}\"]");
+  if (!command.empty() && command.front().empty()) {
+    rules.Add("command[0]: the program is an empty text");
   }
-  if (!(std::isfinite(timeout_s) && timeout_s > 0.0))
-    errors.push_back(RuleViolation("timeout_s", timeout_s, "must be > 0"));
-  if (!(std::isfinite(answer_timeout_s) && answer_timeout_s > 0.0))
-    errors.push_back(RuleViolation("answer_timeout_s", answer_timeout_s, "must be > 0"));
+  rules.Require(std::isfinite(timeout_s) && timeout_s > 0.0, "timeout_s", timeout_s, "must be > 0")
+      .Require(std::isfinite(answer_timeout_s) && answer_timeout_s > 0.0, "answer_timeout_s",
+               answer_timeout_s, "must be > 0");
   if (mode == ExternalMode::kStream && input != ExternalInput::kCarmen) {
-    errors.push_back(
+    rules.Add(
         "input: set with mode stream, which always streams MCAP on stdin (input is for mode "
         "offline)");
   }
@@ -30,15 +28,14 @@ std::vector<std::string> ExternalEstimatorOptions::Validate() const {
     for (std::size_t i = 0; i < command.size(); ++i) {
       for (const char* placeholder : {kExternalInputPlaceholder, kExternalOutputPlaceholder}) {
         if (command[i].find(placeholder) != std::string::npos) {
-          errors.push_back("command[" + std::to_string(i) + "] = '" + command[i] + "'; " +
-                           placeholder +
-                           " has no meaning with mode stream (the records come on stdin, the "
-                           "poses go to stdout)");
+          rules.Add("command[" + std::to_string(i) + "] = '" + command[i] + "'; " + placeholder +
+                    " has no meaning with mode stream (the records come on stdin, the poses go to "
+                    "stdout)");
         }
       }
     }
   }
-  return errors;
+  return rules.errors();
 }
 
 std::vector<std::string> SubstituteExternalArguments(const std::vector<std::string>& command,

@@ -8,13 +8,13 @@ namespace slamrig::slam {
 
 std::vector<std::string> IcpOdometryEstimatorOptions::Validate() const {
   // The odometry's keys sit at the top level of this table: drop its own "icp_odometry." prefix.
-  std::vector<std::string> errors;
+  Rules rules;
   const std::string prefix = "icp_odometry.";
   for (std::string e : icp_odometry.Validate()) {
-    errors.push_back(e.rfind(prefix, 0) == 0 ? e.substr(prefix.size()) : e);
+    rules.Add(e.rfind(prefix, 0) == 0 ? e.substr(prefix.size()) : e);
   }
-  AppendErrors(&errors, PrefixErrors("map", map.Validate()));
-  return errors;
+  rules.Nested("map", map.Validate());
+  return rules.errors();
 }
 
 IcpOdometryEstimator::IcpOdometryEstimator(const IcpOdometryEstimatorOptions& options,

@@ -6,6 +6,7 @@
 #include <mutex>
 
 #include "slam/types/error.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::slam {
 namespace {
@@ -43,11 +44,11 @@ PythonOptionValue TypedScalar(const YamlNode& node) {
 }  // namespace
 
 std::vector<std::string> PythonEstimatorOptions::Validate() const {
-  std::vector<std::string> errors;
-  if (object) return errors;
-  if (module.empty()) errors.push_back("module: required (the Python module to import)");
-  if (class_name.empty()) errors.push_back("class: required (the estimator class of the module)");
-  return errors;
+  Rules rules;
+  if (object) return rules.errors();
+  rules.Required(!module.empty(), "module", "the Python module to import")
+      .Required(!class_name.empty(), "class", "the estimator class of the module");
+  return rules.errors();
 }
 
 void SetPythonEstimatorFactory(PythonEstimatorFactory factory) {

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <limits>
+#include <string>
 
 #include "slam/types/check.h"
 
@@ -44,6 +46,42 @@ TEST(RulesTest, NestedUnderTheRootKeepsKeys) {
   Rules rules;
   rules.Nested("", {"seed = -1; must be >= 0"});
   EXPECT_EQ(rules.errors(), std::vector<std::string>{"seed = -1; must be >= 0"});
+}
+
+TEST(RulesTest, NumbersPrintShortestRoundTrip) {
+  // Values and bounds alike: no "0.100000" and no digits lost (0.123456789 is not "0.123457").
+  Rules rules;
+  rules.AtLeast("a_m", 0.1, 0.15).InRange("b", 0.123456789, 0.2, 1.0);
+  rules.Positive("c", -0.1f).Above("d", -1.0, -1.0).Require(false, "e", 1e-9, "must hold");
+  const std::vector<std::string> expected = {
+      "a_m = 0.1; must be >= 0.15", "b = 0.123456789; must be in [0.2, 1]", "c = -0.1; must be > 0",
+      "d = -1; must be > -1", "e = 1e-09; must hold"};
+  EXPECT_EQ(rules.errors(), expected);
+  EXPECT_EQ(FormatValue(2.5), "2.5");
+  EXPECT_EQ(FormatValue(0.1f), "0.1");
+  EXPECT_EQ(FormatValue(std::int64_t{-12345678901}), "-12345678901");
+  EXPECT_EQ(FormatValue(std::string("'x'")), "'x'");
+}
+
+TEST(RulesTest, IntervalEndsAreSaidAndKept) {
+  Rules rules;
+  rules.InRange("closed", 1.0, 0.0, 1.0).InRange("open_high", 0.0, 0.0, 1.0, Ends::kOpenHigh);
+  rules.InRange("open_low", 1.0, 0.0, 1.0, Ends::kOpenLow)
+      .InRange("open", 0.5, 0.0, 1.0, Ends::kOpen);
+  EXPECT_TRUE(rules.errors().empty());
+  rules.InRange("a", 1.0, 0.0, 1.0, Ends::kOpenHigh).InRange("b", 0.0, 0.0, 1.0, Ends::kOpenLow);
+  rules.InRange("c", 0.0, 0.0, 1.0, Ends::kOpen).InRange("d", kNan, 0.0, 1.0, Ends::kOpen);
+  rules.Above("e", kNan, 0.0);
+  const std::vector<std::string> expected = {"a = 1; must be in [0, 1)", "b = 0; must be in (0, 1]",
+                                             "c = 0; must be in (0, 1)",
+                                             "d = nan; must be in (0, 1)", "e = nan; must be > 0"};
+  EXPECT_EQ(rules.errors(), expected);
+}
+
+TEST(RulesTest, RequiredNamesTheMissingKey) {
+  Rules rules;
+  rules.Required(true, "module", "the module").Required(false, "class", "the estimator class");
+  EXPECT_EQ(rules.errors(), std::vector<std::string>{"class: required (the estimator class)"});
 }
 
 struct BrokenOptions {

@@ -50,12 +50,11 @@ std::string Quote(std::string_view s) {
   return q + "\"";
 }
 
-void CheckTopicName(const std::string& field, const std::string& name,
-                    std::vector<std::string>* errors) {
-  if (name.size() < 2 || name[0] != '/' || name.back() == '/' ||
-      name.find_first_of(" \t\n\"'") != std::string::npos) {
-    errors->push_back(RuleViolation(field, "'" + name + "'", "must be an absolute ROS topic name"));
-  }
+// An absolute ROS topic name: "/" and at least one more character, no trailing "/", no
+// blanks or quotes.
+bool IsTopicName(const std::string& name) {
+  return name.size() >= 2 && name[0] == '/' && name.back() != '/' &&
+         name.find_first_of(" \t\n\"'") == std::string::npos;
 }
 
 }  // namespace
@@ -71,7 +70,7 @@ std::string_view BagStorageName(BagStorage storage) {
 }
 
 std::vector<std::string> BagTopicNames::Validate() const {
-  std::vector<std::string> errors;
+  Rules rules;
   const std::vector<std::pair<const char*, const std::string*>> names = {
       {"topics.scan", &scan},
       {"topics.imu", &imu},
@@ -85,15 +84,15 @@ std::vector<std::string> BagTopicNames::Validate() const {
       {"topics.depth", &depth},
       {"topics.camera_info", &camera_info}};
   for (std::size_t i = 0; i < names.size(); ++i) {
-    CheckTopicName(names[i].first, *names[i].second, &errors);
+    const auto& [field, name] = names[i];
+    rules.Require(IsTopicName(*name), field, "'" + *name + "'",
+                  "must be an absolute ROS topic name");
     for (std::size_t j = 0; j < i; ++j) {
-      if (*names[i].second == *names[j].second) {
-        errors.push_back(RuleViolation(names[i].first, "'" + *names[i].second + "'",
-                                       std::string("must differ from ") + names[j].first));
-      }
+      rules.Require(*name != *names[j].second, field, "'" + *name + "'",
+                    std::string("must differ from ") + names[j].first);
     }
   }
-  return errors;
+  return rules.errors();
 }
 
 std::string* BagTopicNames::Find(std::string_view key) {
