@@ -175,21 +175,26 @@ slam::RosOccupancyGrid ToRosGrid(const slam::OccupancyGrid& grid, Time time,
 }
 
 RunRecorder::RunRecorder(std::string path, std::vector<std::string> config_names,
-                         RecorderOptions options)
+                         RecorderOptions options, slam::MessageSink* live)
     : path_(std::move(path)), options_(options) {
-  const std::string partial = path_ + ".partial";
-  std::error_code ec;
-  std::filesystem::remove(partial, ec);
-  const std::filesystem::path parent = std::filesystem::path(partial).parent_path();
-  if (!parent.empty() && !std::filesystem::exists(parent)) {
-    std::filesystem::create_directories(parent, ec);
-    if (!ec) created_dir_ = parent.string();
-  }
   slam::BagWriterOptions bag;
   bag.single_file = true;
   // base_link hangs under truth/base_link; the robot's own odom -> base_link stays in /odom.
   bag.write_tf = false;
-  writer_ = std::make_unique<slam::BagWriter>(partial, bag);
+  if (path_.empty()) {
+    writer_ = std::make_unique<slam::BagWriter>(bag);
+  } else {
+    const std::string partial = path_ + ".partial";
+    std::error_code ec;
+    std::filesystem::remove(partial, ec);
+    const std::filesystem::path parent = std::filesystem::path(partial).parent_path();
+    if (!parent.empty() && !std::filesystem::exists(parent)) {
+      std::filesystem::create_directories(parent, ec);
+      if (!ec) created_dir_ = parent.string();
+    }
+    writer_ = std::make_unique<slam::BagWriter>(partial, bag);
+  }
+  if (live) writer_->AddSink(live);
   if (options_.odometry && options_.odometry->Validate().empty())
     odometry_.emplace(*options_.odometry);
   for (std::string& name : config_names) {

@@ -51,11 +51,15 @@ struct RecorderOptions {
 /// The file is written as `path` + ".partial" and stays there after Finish(); Commit() renames
 /// it to `path`. A run killed before leaves only the .partial file (a chunked MCAP without a
 /// summary that readers recover up to the last whole chunk); one that throws removes it.
+/// The same messages, in the same order, also go to `live` (the run's live view over the
+/// Foxglove WebSocket protocol), with or without a file: this class is the one source of a run's
+/// messages for both.
 class RunRecorder {
  public:
-  /// `config_names`: the configurations in runner order. Throws OutputError if the file cannot
-  /// be written.
-  RunRecorder(std::string path, std::vector<std::string> config_names, RecorderOptions options);
+  /// `config_names`: the configurations in runner order. An empty `path` writes no file (then
+  /// `live` should be given). Throws OutputError if the file cannot be written.
+  RunRecorder(std::string path, std::vector<std::string> config_names, RecorderOptions options,
+              slam::MessageSink* live = nullptr);
   ~RunRecorder();
   RunRecorder(const RunRecorder&) = delete;
   RunRecorder& operator=(const RunRecorder&) = delete;

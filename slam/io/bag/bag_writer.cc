@@ -203,8 +203,16 @@ BagWriter::BagWriter(std::string folder, BagWriterOptions options)
   }
 }
 
+BagWriter::BagWriter(BagWriterOptions options) : options_(std::move(options)) {
+  const std::vector<std::string> errors = options_.Validate();
+  if (!errors.empty()) throw ConfigError("bag writer: " + errors.front());
+  if (options_.clock_rate_hz > 0.0) {
+    clock_period_ns_ = std::max<std::int64_t>(1, std::llround(1e9 / options_.clock_rate_hz));
+  }
+}
+
 BagWriter::~BagWriter() {
-  if (!committed_) {
+  if (!committed_ && (mcap_ || sqlite_)) {
     mcap_.reset();
     sqlite_.reset();
     std::error_code ec;
@@ -221,6 +229,8 @@ BagWriter::Topic& BagWriter::GetTopic(const std::string& name, int type, bool la
   topic.name = name;
   topic.type = std::string(RosTypeName(ros_type));
   topic.qos = QosProfile(latched);
+  topic.ros_type = ros_type;
+  topic.latched = latched;
   if (mcap_) {
     auto it = mcap_schemas_.find(type);
     if (it == mcap_schemas_.end()) {
@@ -232,7 +242,7 @@ BagWriter::Topic& BagWriter::GetTopic(const std::string& name, int type, bool la
     std::map<std::string, std::string> metadata = {{"offered_qos_profiles", topic.qos}};
     if (ros_type == RosType::kJointState) metadata[kTicksKey] = TicksText();
     topic.mcap_channel = mcap_->AddChannel(it->second, name, "cdr", metadata);
-  } else {
+  } else if (sqlite_) {
     topic.sqlite_id =
         sqlite_->AddTopic(name, topic.type, topic.qos, RosMessageDefinition(ros_type));
   }
@@ -244,9 +254,11 @@ void BagWriter::Emit(Topic& topic, Time time, std::string_view payload) {
   const auto t = static_cast<std::uint64_t>(time.ns);
   if (mcap_) {
     mcap_->WriteMessage(topic.mcap_channel, topic.sequence, t, t, payload);
-  } else {
+  } else if (sqlite_) {
     sqlite_->WriteMessage(topic.sqlite_id, time.ns, payload);
   }
+  for (MessageSink* sink : sinks_)
+    sink->Message(topic.name, topic.ros_type, topic.latched, time, payload);
   ++topic.sequence;
   ++topic.count;
   if (message_count_ == 0 || time.ns < start_ns_) start_ns_ = time.ns;
@@ -420,6 +432,10 @@ std::string BagWriter::MetadataYaml() const {
 
 void BagWriter::Commit() {
   if (committed_) return;
+  if (!mcap_ && !sqlite_) {  // no storage: nothing to close
+    committed_ = true;
+    return;
+  }
   if (options_.single_file) {
     mcap_->Close();
     mcap_.reset();
