@@ -74,7 +74,8 @@ bool Offers(std::string_view list, std::string_view protocol) {
 struct Frame {
   std::shared_ptr<const std::string> data;
   bool binary = true;
-  bool message = false;  // a message frame (counted as sent)
+  bool message = false;            // a message frame (counted as sent)
+  std::uint32_t subscription = 0;  // a message frame's
 };
 
 struct Channel {
@@ -354,7 +355,7 @@ void LiveServer::Impl::Subscribe(Session& s, const Json& request) {
     s.subscription_of[channel] = id;
     // A latched topic's last message, as a late subscriber of a transient-local topic gets it.
     const Channel& c = channels[channel - 1];
-    if (c.last) Enqueue(s, {DataFrame(id, c.last_time, *c.last), true, true});
+    if (c.last) Enqueue(s, {DataFrame(id, c.last_time, *c.last), true, true, id});
   }
   CountWatchers();
 }
@@ -369,6 +370,12 @@ void LiveServer::Impl::Unsubscribe(Session& s, const Json& request) {
     }
     s.subscription_of.erase(it->second);
     s.channel_of.erase(it);
+    // What is queued for it is not sent any more.
+    std::erase_if(s.queue, [&](const Frame& f) {
+      const bool gone = f.message && f.subscription == id;
+      if (gone) s.queued_bytes -= f.data->size();
+      return gone;
+    });
   }
   CountWatchers();
 }
@@ -481,7 +488,7 @@ void LiveServer::Message(const std::string& topic, slam::RosType type, bool latc
   for (const auto& s : m.sessions) {
     const auto sub = s->subscription_of.find(channel.id);
     if (sub != s->subscription_of.end()) {
-      m.Enqueue(*s, {Impl::DataFrame(sub->second, time, cdr), true, true});
+      m.Enqueue(*s, {Impl::DataFrame(sub->second, time, cdr), true, true, sub->second});
     }
   }
 }
@@ -529,13 +536,22 @@ void LiveServer::Close(double drain_s) {
   // What is queued goes out, for at most drain_s.
   const auto deadline = SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
                                                  std::chrono::duration<double>(drain_s));
+  // Nor longer than while a frame was written to some client in the last kStuck.
+  constexpr auto kStuck = std::chrono::milliseconds(500);
+  std::uint64_t last_sent = m.sent.load();
+  auto last_progress = SteadyClock::now();
   for (;;) {
     bool idle = true;
     {
       std::lock_guard lock(m.mu);
       for (const auto& s : m.sessions) idle &= !s->writing && s->queue.empty();
     }
-    if (idle || SteadyClock::now() >= deadline || InterruptSignal() != 0) break;
+    const auto now = SteadyClock::now();
+    if (m.sent.load() != last_sent) {
+      last_sent = m.sent.load();
+      last_progress = now;
+    }
+    if (idle || now >= deadline || now - last_progress > kStuck || InterruptSignal() != 0) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   // Every connection ends with a close frame (one still writing is cut), then the thread ends.

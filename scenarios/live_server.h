@@ -63,7 +63,8 @@ class LiveServer final : public slam::MessageSink {
   /// it at the current pace while a client is subscribed; returns at once otherwise.
   void Pace(Time time);
   /// Lets the clients receive what is queued for them, for at most `drain_s` seconds of wall
-  /// time, then closes their connections and stops listening.
+  /// time (less when none of them takes anything for half a second), then closes their
+  /// connections and stops listening.
   void Close(double drain_s);
 
   LiveStats stats() const;
