@@ -195,6 +195,7 @@ RunRecorder::RunRecorder(std::string path, std::vector<std::string> config_names
     writer_ = std::make_unique<slam::BagWriter>(partial, bag);
   }
   if (live) writer_->AddSink(live);
+  live_ = live;
   if (options_.odometry && options_.odometry->Validate().empty())
     odometry_.emplace(*options_.odometry);
   for (std::string& name : config_names) {
@@ -246,6 +247,15 @@ void RunRecorder::Scan(std::size_t index, Time time, const slam::ScanEstimate& e
   Config& c = configs_.at(index);
   c.last_time = time;
   const std::string frame = c.name + "/map";
+  if (live_ && !c.announced) {
+    c.announced = true;
+    std::vector<slam::RosTransform> identities;
+    for (const Config& other : configs_) {
+      if (other.announced) identities.push_back({time, kMap, other.name + "/map", Pose2()});
+    }
+    slam::EncodeTfMessage(identities, &buffer_);
+    live_->Message("/live/alignments", RosType::kTfMessage, true, time, buffer_);
+  }
   const Pose2 pose = map_from_estimator * estimate.pose;
   slam::EncodeTfMessage({{time, frame, c.name + "/base_link", pose}}, &buffer_);
   Write("/tf", RosType::kTfMessage, time);

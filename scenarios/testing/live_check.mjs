@@ -6,8 +6,8 @@
 //        node live_check.mjs NODE_MODULES_PARENT stall URL
 // watch: connects while the run goes, checks serverInfo (capabilities parameters and time),
 //   subscribes to /scan, /tf, /pf/pose, /dead_reckoning/pose, /pf/particles, /pf/map and /clock
-//   as they are advertised and, a second later, to /tf_static (sent once at the start: it
-//   arrives only as the latched topic's last message); decodes every message with the schema of
+//   as they are advertised and, a second later, to /tf_static and /live/alignments (sent once
+//   at the start: they arrive only as the latched topics' last messages); decodes every message with the schema of
 //   its advertisement and checks types and fields (stamps equal to the frame's log time,
 //   increasing on each topic; finite poses; the laser and the base's static transforms); asks
 //   for `slamrig.pace` 2 and checks that the run's clock then advances at most ~2x the wall
@@ -58,12 +58,16 @@ const expectedTypes = {
   "/scan": ["sensor_msgs/msg/LaserScan"],
   "/tf": ["tf2_msgs/msg/TFMessage"],
   "/tf_static": ["tf2_msgs/msg/TFMessage"],
+  "/live/alignments": ["tf2_msgs/msg/TFMessage"],
   "/pf/pose": ["geometry_msgs/msg/PoseWithCovarianceStamped", "geometry_msgs/msg/PoseStamped"],
   "/dead_reckoning/pose": ["geometry_msgs/msg/PoseWithCovarianceStamped", "geometry_msgs/msg/PoseStamped"],
   "/pf/particles": ["geometry_msgs/msg/PoseArray"],
   "/pf/map": ["nav_msgs/msg/OccupancyGrid"],
   "/clock": ["rosgraph_msgs/msg/Clock"],
 };
+
+// Sent once early in the run: a subscriber a second later gets them only as the latched copy.
+const latched = ["/tf_static", "/live/alignments"];
 
 const stampNs = (s) => BigInt(s.sec) * 1000000000n + BigInt(s.nanosec ?? s.nsec);
 const finite = (...v) => v.every((x) => Number.isFinite(x));
@@ -99,6 +103,13 @@ function checkMessage(topic, m, t, state) {
     const pairs = m.transforms.map((x) => `${x.header.frame_id}->${x.child_frame_id}`);
     for (const want of ["truth/base_link->base_link", "base_link->laser"]) {
       if (!pairs.includes(want)) fail(`/tf_static: no ${want} in ${pairs.join(", ")}`);
+    }
+  } else if (topic === "/live/alignments") {
+    const pairs = m.transforms.map((x) => `${x.header.frame_id}->${x.child_frame_id}`).sort();
+    if (pairs.join(",") !== "map->dead_reckoning/map,map->pf/map") fail(`/live/alignments: ${pairs}`);
+    for (const x of m.transforms) {
+      const { translation: p, rotation: q } = x.transform;
+      if (p.x !== 0 || p.y !== 0 || q.w !== 1) fail(`/live/alignments: not the identity`);
     }
   } else if (topic === "/tf") {
     if (!m.transforms.every((x) => finite(x.transform.translation.x, x.transform.rotation.w))) {
@@ -138,7 +149,7 @@ async function watch() {
   client.on("advertise", (list) => {
     for (const c of list) {
       channels.set(c.id, c);
-      if (c.topic in expectedTypes && c.topic !== "/tf_static") subscribe(c);
+      if (c.topic in expectedTypes && !latched.includes(c.topic)) subscribe(c);
     }
   });
   client.on("time", ({ timestamp }) => {
@@ -176,9 +187,11 @@ async function watch() {
     }
   }
   await sleep(1000);
-  const tfStatic = [...channels.values()].find((c) => c.topic === "/tf_static");
-  if (!tfStatic) fail("/tf_static not advertised");
-  else subscribe(tfStatic);
+  for (const topic of latched) {
+    const c = [...channels.values()].find((x) => x.topic === topic);
+    if (!c) fail(`${topic} not advertised`);
+    else subscribe(c);
+  }
 
   // The run at twice real time while we watch.
   client.setParameters([{ name: "slamrig.pace", value: 2 }], "pace");
@@ -208,7 +221,9 @@ async function watch() {
   for (const topic of Object.keys(expectedTypes)) {
     if (!(counts.get(topic) > 0)) fail(`no ${topic} message received`);
   }
-  if ((counts.get("/tf_static") ?? 0) !== 1) fail(`${counts.get("/tf_static")} /tf_static messages, expected its latched one`);
+  for (const topic of latched) {
+    if ((counts.get(topic) ?? 0) !== 1) fail(`${counts.get(topic)} ${topic} messages, expected its latched one`);
+  }
   if (closed) fail("the server closed the connection mid-run");
   const summary = [...counts].map(([t, n]) => `${t} ${n}`).join(", ");
   client.close();  // mid-run: the run must go on
