@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "slam/types/error.h"
 
@@ -45,13 +46,16 @@ void AddLiveFlags(ArgParser* parser, LiveFlags* flags) {
   parser->AddOption("live-pace", "F",
                     "with --live, the run's speed while a client is subscribed: 1 real time, 2 "
                     "twice as fast, 0 as fast as it goes; a client changes it with the "
-                    "slamrig.pace parameter",
+                    "slamrig.pace parameter [default: 1]",
                     &flags->pace);
 }
 
 std::unique_ptr<scenario::LiveServer> StartLive(const std::string& command, const LiveFlags& flags,
                                                 scenario::RunnerOptions* options) {
-  if (!flags.live) return nullptr;
+  if (!flags.live) {
+    if (!flags.pace.empty()) throw ConfigError(command + ": --live-pace needs --live");
+    return nullptr;
+  }
   scenario::LiveOptions live;
   if (!flags.port.empty()) {
     const long port = AllDigits(flags.port) ? std::stol(flags.port) : -1;
@@ -63,11 +67,15 @@ std::unique_ptr<scenario::LiveServer> StartLive(const std::string& command, cons
     }
     live.port = static_cast<std::uint16_t>(port);
   }
-  if (!std::isfinite(flags.pace) || flags.pace < 0.0) {
-    throw ConfigError(command + ": --live-pace: expected a number >= 0 (0 as fast as it goes, 1 " +
-                      "real time), got " + std::to_string(flags.pace));
+  if (!flags.pace.empty()) {
+    char* end = nullptr;
+    const double pace = std::strtod(flags.pace.c_str(), &end);
+    if (end != flags.pace.c_str() + flags.pace.size() || !std::isfinite(pace) || pace < 0.0) {
+      throw ConfigError(command + ": --live-pace: expected a number >= 0 (0 as fast as it goes, " +
+                        "1 real time), got '" + flags.pace + "'");
+    }
+    live.pace = pace;
   }
-  live.pace = flags.pace;
   auto server = std::make_unique<scenario::LiveServer>(live);
   scenario::LiveServer* s = server.get();
   options->live = s;

@@ -14,7 +14,7 @@ namespace slamrig::app {
 struct LiveFlags {
   bool live = false;
   std::string port;  ///< as typed after --live; empty: the default port
-  double pace = 1.0;
+  std::string pace;  ///< as typed after --live-pace; empty: real time
 };
 
 /// Takes the optional PORT of `--live PORT` (a number right after --live) or `--live=PORT` out of
@@ -26,7 +26,8 @@ void AddLiveFlags(ArgParser* parser, LiveFlags* flags);
 
 /// The live view the flags ask for, listening before the run starts, or nullptr; sets
 /// `options->live` and `options->pace` to it and says its address on stderr. Throws ConfigError
-/// for a bad PORT or pace, OutputError when it cannot listen (the port in use).
+/// for a bad PORT or pace (or --live-pace without --live), OutputError when it cannot listen
+/// (the port in use).
 std::unique_ptr<scenario::LiveServer> StartLive(const std::string& command, const LiveFlags& flags,
                                                 scenario::RunnerOptions* options);
 

@@ -76,6 +76,7 @@ struct Frame {
   bool binary = true;
   bool message = false;            // a message frame (counted as sent)
   std::uint32_t subscription = 0;  // a message frame's
+  bool essential = false;          // serverInfo and advertisements: never dropped
 };
 
 struct Channel {
@@ -117,6 +118,8 @@ struct LiveServer::Impl {
   double anchor_factor = 0.0;
 
   void Accept();
+  // With `mu` held: the channel of `topic`, made and advertised to every client if new.
+  Channel& Declare(const std::string& topic, slam::RosType type, bool latched);
   void Open(const std::shared_ptr<Session>& s);
   void Drop(const std::shared_ptr<Session>& s);
   // With `mu` held: queues `frame` for `s`; a message frame that does not fit is dropped.
@@ -233,6 +236,23 @@ void LiveServer::Impl::Accept() {
   });
 }
 
+Channel& LiveServer::Impl::Declare(const std::string& topic, slam::RosType type, bool latched) {
+  const auto [it, added] = channel_index.try_emplace(topic, channels.size());
+  if (added) {
+    Channel c;
+    c.id = static_cast<std::uint32_t>(channels.size() + 1);
+    c.topic = topic;
+    c.type = type;
+    c.latched = latched;
+    channels.push_back(std::move(c));
+    if (!sessions.empty()) {
+      auto advertise = std::make_shared<const std::string>(Advertise({&channels.back()}));
+      for (const auto& s : sessions) Enqueue(*s, {advertise, false, false, 0, true});
+    }
+  }
+  return channels[it->second];
+}
+
 void LiveServer::Impl::Open(const std::shared_ptr<Session>& s) {
   ++clients;
   std::lock_guard lock(mu);
@@ -243,10 +263,10 @@ void LiveServer::Impl::Open(const std::shared_ptr<Session>& s) {
                {"capabilities", Json::array({"parameters", "time"})},
                {"metadata", Json::object()},
                {"sessionId", std::to_string(::getpid())}};
-  Enqueue(*s, {std::make_shared<const std::string>(Dump(info)), false, false});
+  Enqueue(*s, {std::make_shared<const std::string>(Dump(info)), false, false, 0, true});
   std::vector<const Channel*> all;
   for (const Channel& c : channels) all.push_back(&c);
-  Enqueue(*s, {std::make_shared<const std::string>(Advertise(all)), false, false});
+  Enqueue(*s, {std::make_shared<const std::string>(Advertise(all)), false, false, 0, true});
 }
 
 void LiveServer::Impl::Drop(const std::shared_ptr<Session>& s) {
@@ -265,8 +285,10 @@ void LiveServer::Impl::Drop(const std::shared_ptr<Session>& s) {
 
 void LiveServer::Impl::Enqueue(Session& s, Frame frame) {
   if (!s.open) return;
-  if (frame.message && s.queued_bytes + frame.data->size() > options.queue_bytes) {
-    ++dropped;
+  // Only the frames that tell a client what exists bypass the bound: whatever else a client
+  // causes (messages, time, status and parameter replies to its requests) waits in it.
+  if (!frame.essential && s.queued_bytes + frame.data->size() > options.queue_bytes) {
+    if (frame.message) ++dropped;
     return;
   }
   s.queued_bytes += frame.data->size();
@@ -457,20 +479,7 @@ void LiveServer::Message(const std::string& topic, slam::RosType type, bool latc
   Impl& m = *impl_;
   std::lock_guard lock(m.mu);
   if (m.closed) return;
-  auto [it, added] = m.channel_index.try_emplace(topic, m.channels.size());
-  if (added) {
-    Channel c;
-    c.id = static_cast<std::uint32_t>(m.channels.size() + 1);
-    c.topic = topic;
-    c.type = type;
-    c.latched = latched;
-    m.channels.push_back(std::move(c));
-    if (!m.sessions.empty()) {
-      auto advertise = std::make_shared<const std::string>(Impl::Advertise({&m.channels.back()}));
-      for (const auto& s : m.sessions) m.Enqueue(*s, {advertise, false, false});
-    }
-  }
-  Channel& channel = m.channels[it->second];
+  Channel& channel = m.Declare(topic, type, latched);
   if (channel.latched) {
     channel.last = std::make_shared<const std::string>(cdr);
     channel.last_time = time;
@@ -482,7 +491,7 @@ void LiveServer::Message(const std::string& topic, slam::RosType type, bool latc
     PutLe(frame.get(), static_cast<std::uint64_t>(std::max<std::int64_t>(time.ns, 0)), 8);
     // A time frame is small and may be dropped like a message (it is not counted as one).
     for (const auto& s : m.sessions) {
-      if (s->queued_bytes + frame->size() <= m.options.queue_bytes) m.Enqueue(*s, {frame, true});
+      m.Enqueue(*s, {frame, true});
     }
   }
   for (const auto& s : m.sessions) {
@@ -491,6 +500,18 @@ void LiveServer::Message(const std::string& topic, slam::RosType type, bool latc
       m.Enqueue(*s, {Impl::DataFrame(sub->second, time, cdr), true, true, sub->second});
     }
   }
+}
+
+bool LiveServer::Wants(const std::string& topic, slam::RosType type, bool latched) {
+  Impl& m = *impl_;
+  std::lock_guard lock(m.mu);
+  if (m.closed) return false;
+  const Channel& channel = m.Declare(topic, type, latched);
+  if (channel.latched) return true;
+  for (const auto& s : m.sessions) {
+    if (s->subscription_of.contains(channel.id)) return true;
+  }
+  return false;
 }
 
 void LiveServer::Pace(Time time) {

@@ -59,6 +59,8 @@ class LiveServer final : public slam::MessageSink {
 
   void Message(const std::string& topic, slam::RosType type, bool latched, Time time,
                std::string_view cdr) override;
+  /// True for a latched topic and for one a client is subscribed to; declares the topic.
+  bool Wants(const std::string& topic, slam::RosType type, bool latched) override;
   /// The run has reached `time` on its own clock: sleeps until the wall clock catches up with
   /// it at the current pace while a client is subscribed; returns at once otherwise.
   void Pace(Time time);

@@ -56,6 +56,9 @@ TEST(LiveServerTest, WithoutAClientNothingWaits) {
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_LT(wall_s, 0.5);  // 1000 s of run time at real time would take 1000 s
+  // No one wants a message of a topic that is not latched; a latched one is kept for later.
+  EXPECT_FALSE(server.Wants("/topic1", slam::RosType::kString, false));
+  EXPECT_TRUE(server.Wants("/topic0", slam::RosType::kString, true));
   const LiveStats stats = server.stats();
   EXPECT_EQ(stats.clients, 0u);
   EXPECT_EQ(stats.sent, 0u);
@@ -75,6 +78,8 @@ struct Capture : slam::MessageSink {
     bool operator==(const Entry&) const = default;
   };
   std::vector<Entry> entries;
+  bool wants = true;
+  bool Wants(const std::string&, slam::RosType, bool latched) override { return wants || latched; }
   void Message(const std::string& topic, slam::RosType type, bool latched, Time time,
                std::string_view cdr) override {
     entries.push_back({topic, type, latched, time.ns, std::string(cdr)});
@@ -124,6 +129,35 @@ TEST(MessageSinkTest, AWriterWithoutStorageFeedsTheSameMessagesAsAFileWriter) {
   }
   EXPECT_EQ(scans, 30);
   EXPECT_EQ(statics, 1);
+  std::filesystem::remove(path);
+}
+
+// Messages no sink wants are not made when there is no file; latched ones always are; with a
+// file every message is made and given to the sinks whatever they want.
+TEST(MessageSinkTest, OnlyWantedMessagesAreMadeWithoutAFile) {
+  slam::BagWriterOptions options;
+  options.single_file = true;
+  const std::string path = testing::TempDir() + "/sink_want_test.mcap";
+  std::filesystem::remove(path);
+  Capture bare_sink, file_sink;
+  bare_sink.wants = file_sink.wants = false;
+  slam::BagWriter bare(options);
+  slam::BagWriter file(path, options);
+  bare.AddSink(&bare_sink);
+  file.AddSink(&file_sink);
+  for (slam::BagWriter* w : {&bare, &file}) {
+    for (int i = 0; i < 10; ++i) {
+      LaserScan scan;
+      scan.time = Time::FromSeconds(0.1 * i);
+      scan.ranges_m = {1.0f, 2.0f};
+      w->Write(Record{scan});
+    }
+    w->Commit();
+  }
+  ASSERT_EQ(bare_sink.entries.size(), 1u);
+  EXPECT_EQ(bare_sink.entries[0].topic, "/tf_static");
+  EXPECT_EQ(file_sink.entries.size(), file.message_count());
+  EXPECT_GT(file.message_count(), 10u);  // the scans, /clock and /tf_static
   std::filesystem::remove(path);
 }
 

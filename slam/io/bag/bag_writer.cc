@@ -266,6 +266,13 @@ void BagWriter::Emit(Topic& topic, Time time, std::string_view payload) {
   ++message_count_;
 }
 
+bool BagWriter::Wants(const std::string& topic, RosType type, bool latched) {
+  if (mcap_ || sqlite_) return true;
+  bool wanted = false;
+  for (MessageSink* sink : sinks_) wanted = sink->Wants(topic, type, latched) || wanted;
+  return wanted;
+}
+
 void BagWriter::MaybeClock(Time time) {
   if (time.ns < 0) {
     throw std::invalid_argument("bag writer: record time " + std::to_string(time.ns) +
@@ -274,6 +281,7 @@ void BagWriter::MaybeClock(Time time) {
   if (clock_period_ns_ == 0) return;
   if (last_clock_ && time.ns < last_clock_->ns + clock_period_ns_) return;
   last_clock_ = time;
+  if (!Wants(options_.topics.clock, RosType::kClock, false)) return;
   EncodeClock(time, &buffer_);
   Emit(GetTopic(options_.topics.clock, static_cast<int>(RosType::kClock), false), time);
 }
@@ -287,9 +295,11 @@ void BagWriter::Write(const Record& record) {
       static_laser_ = scan->base_from_laser;
       EmitStaticTransforms(time);
     }
+    if (!Wants(options_.topics.scan, RosType::kLaserScan, false)) return;
     EncodeLaserScan(*scan, f.laser, &buffer_);
     Emit(GetTopic(options_.topics.scan, static_cast<int>(RosType::kLaserScan), false), time);
   } else if (const auto* imu = std::get_if<ImuSample>(&record)) {
+    if (!Wants(options_.topics.imu, RosType::kImu, false)) return;
     EncodeImu(*imu, f.imu, &buffer_);
     Emit(GetTopic(options_.topics.imu, static_cast<int>(RosType::kImu), false), time);
   } else if (const auto* ticks = std::get_if<WheelTicks>(&record)) {
@@ -309,6 +319,7 @@ void BagWriter::Write(const Record& record) {
           i < right_wheels_ ? ticks->right_ticks[i] : ticks->left_ticks[i - right_wheels_];
       positions_[i] = static_cast<double>(tick_totals_[i]) * rad_per_tick;
     }
+    if (!Wants(options_.topics.joint_states, RosType::kJointState, false)) return;
     EncodeJointState(time, joint_names_, positions_, &buffer_);
     Emit(GetTopic(options_.topics.joint_states, static_cast<int>(RosType::kJointState), false),
          time);
@@ -321,17 +332,25 @@ void BagWriter::Write(const Record& record) {
       static_depth_ = depth;
       EmitStaticTransforms(time);
     }
-    EncodeRgbImage(*frame, f.camera, &buffer_);
-    Emit(GetTopic(options_.topics.rgb, static_cast<int>(RosType::kImage), false), time);
-    EncodeDepthImage(*frame, f.depth, &buffer_);
-    Emit(GetTopic(options_.topics.depth, static_cast<int>(RosType::kImage), false), time);
-    EncodeCameraInfo(*frame, f.camera, &buffer_);
-    Emit(GetTopic(options_.topics.camera_info, static_cast<int>(RosType::kCameraInfo), false),
-         time);
+    if (Wants(options_.topics.rgb, RosType::kImage, false)) {
+      EncodeRgbImage(*frame, f.camera, &buffer_);
+      Emit(GetTopic(options_.topics.rgb, static_cast<int>(RosType::kImage), false), time);
+    }
+    if (Wants(options_.topics.depth, RosType::kImage, false)) {
+      EncodeDepthImage(*frame, f.depth, &buffer_);
+      Emit(GetTopic(options_.topics.depth, static_cast<int>(RosType::kImage), false), time);
+    }
+    if (Wants(options_.topics.camera_info, RosType::kCameraInfo, false)) {
+      EncodeCameraInfo(*frame, f.camera, &buffer_);
+      Emit(GetTopic(options_.topics.camera_info, static_cast<int>(RosType::kCameraInfo), false),
+           time);
+    }
   } else if (const auto* odom = std::get_if<OdometryPose>(&record)) {
-    EncodeOdometry({time, f.odom, f.base, odom->odom_from_base}, &buffer_);
-    Emit(GetTopic(options_.topics.odom, static_cast<int>(RosType::kOdometry), false), time);
-    if (options_.write_tf) {
+    if (Wants(options_.topics.odom, RosType::kOdometry, false)) {
+      EncodeOdometry({time, f.odom, f.base, odom->odom_from_base}, &buffer_);
+      Emit(GetTopic(options_.topics.odom, static_cast<int>(RosType::kOdometry), false), time);
+    }
+    if (options_.write_tf && Wants(options_.topics.tf, RosType::kTfMessage, false)) {
       EncodeTfMessage({{time, f.odom, f.base, odom->odom_from_base}}, &buffer_);
       Emit(GetTopic(options_.topics.tf, static_cast<int>(RosType::kTfMessage), false), time);
     }
@@ -390,6 +409,7 @@ void BagWriter::EmitStaticTransforms(Time time) {
 
 void BagWriter::Write(const GroundTruthPose& truth) {
   MaybeClock(truth.time);
+  if (!Wants(options_.topics.ground_truth, RosType::kOdometry, false)) return;
   EncodeOdometry({truth.time, options_.frames.map, options_.frames.base, truth.map_from_base},
                  &buffer_);
   Emit(GetTopic(options_.topics.ground_truth, static_cast<int>(RosType::kOdometry), false),

@@ -146,6 +146,9 @@ class BagWriter {
   void AddStaticTransform(const RosTransform& transform, Time time);
   /// Gives every message from now on also to `sink`, which must outlive the writer.
   void AddSink(MessageSink* sink) { sinks_.push_back(sink); }
+  /// Whether a message on `topic` would be used: always with storage, else when a sink wants it
+  /// (MessageSink::Wants, asked of every sink). Messages no one wants are not even encoded.
+  bool Wants(const std::string& topic, RosType type, bool latched);
   /// MCAP only: closes the open chunk, so that what follows is in chunks of its own.
   void FlushChunk();
   /// Closes the storage file, writes metadata.yaml and renames the folder into place.

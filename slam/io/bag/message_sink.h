@@ -19,6 +19,13 @@ class MessageSink {
   virtual ~MessageSink() = default;
   virtual void Message(const std::string& topic, RosType type, bool latched, Time time,
                        std::string_view cdr) = 0;
+  /// Whether a message on `topic` would be used now; it also makes the topic known (so that a
+  /// client can ask for it). A producer may skip making a message no one wants; a latched
+  /// topic's messages are always wanted.
+  virtual bool Wants(const std::string& topic, RosType type, bool latched) {
+    (void)topic, (void)type, (void)latched;
+    return true;
+  }
 };
 
 }  // namespace slamrig::slam
