@@ -171,7 +171,13 @@ void LiveServer::Impl::Session::Start() {
           return;
         }
         beast::get_lowest_layer(self->ws).expires_never();
-        self->ws.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+        // A client that answers no ping for a minute is gone; one that only listens (Foxglove
+        // sends nothing while it watches) answers the pings and stays.
+        websocket::stream_base::timeout timeout{};
+        timeout.handshake_timeout = std::chrono::seconds(30);
+        timeout.idle_timeout = std::chrono::seconds(60);
+        timeout.keep_alive_pings = true;
+        self->ws.set_option(timeout);
         self->ws.set_option(websocket::stream_base::decorator([](websocket::response_type& r) {
           r.set(http::field::sec_websocket_protocol, kSubprotocol);
           r.set(http::field::server, "slamrig");

@@ -4,7 +4,8 @@
 #   2. the same run with --live on a free port, watched by @foxglove/ws-protocol's client
 #      (subscriptions, every message decoded, the latched /tf_static, pacing at 2x real time
 #      asked through the slamrig.pace parameter, an unsubscription), which disconnects
-#      mid-run; meanwhile a second `--live` on the same port must fail at once, before its run;
+#      mid-run, beside a client that subscribes to everything, stops reading and is killed
+#      (SIGKILL) mid-run; a second `--live` on the same port must fail at once, before its run;
 #   3. the same run with a client that subscribes to everything and never reads: the run
 #      still ends (the server drops what does not fit the client's queue);
 #   4. a bad port is one line and a non-zero exit;
@@ -143,7 +144,21 @@ if [[ $(wc -l <"$work/busy.err") -ne 1 ]] || ! grep -q "cannot listen on 127.0.0
 fi
 if [[ -e "$work/busy" ]]; then failed "a port in use left a report folder"; fi
 echo "live_foxglove_test: a port in use: $(cat "$work/busy.err")"
-node "$here/live_check.mjs" "$modules" watch "ws://127.0.0.1:$port"
+# Beside the watcher, a client that subscribes to everything, stops reading and vanishes
+# (SIGKILL) mid-run.
+node "$here/live_check.mjs" "$modules" stall "ws://127.0.0.1:$port" >"$work/vanish.out" 2>&1 &
+vanish_pid=$!
+pids+=("$vanish_pid")
+node "$here/live_check.mjs" "$modules" watch "ws://127.0.0.1:$port" &
+watch_pid=$!
+pids+=("$watch_pid")
+sleep 3
+kill -KILL "$vanish_pid" 2>/dev/null || failed "the vanishing client ended before it was killed"
+wait "$vanish_pid" 2>/dev/null || true
+grep -q "not reading any more" "$work/vanish.out" || failed "the vanishing client never subscribed"
+rc=0
+wait "$watch_pid" || rc=$?
+if [[ $rc -ne 0 ]]; then failed "the watching client failed"; fi
 wait_run watched 60
 same_results watched
 
