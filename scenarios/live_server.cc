@@ -130,6 +130,8 @@ struct LiveServer::Impl {
   void Parameters(Session& s, const Json& request, bool set);
   void Status(Session& s, int level, const std::string& message);
   void CountWatchers();
+  // With `mu` held: a time frame to every client when the run's clock has advanced enough.
+  void Clock(Time time);
   static std::string Advertise(const std::vector<const Channel*>& channels);
   static std::shared_ptr<const std::string> DataFrame(std::uint32_t subscription, Time time,
                                                       std::string_view payload);
@@ -303,6 +305,15 @@ void LiveServer::Impl::Enqueue(Session& s, Frame frame) {
     s.writing = true;
     net::post(ioc, [self = s.shared_from_this()] { self->WriteNext(); });
   }
+}
+
+void LiveServer::Impl::Clock(Time time) {
+  if (sessions.empty() || time.ns < last_time_ns + kTimePeriodNs) return;
+  last_time_ns = time.ns;
+  auto frame = std::make_shared<std::string>(1, static_cast<char>(kTimeData));
+  PutLe(frame.get(), static_cast<std::uint64_t>(std::max<std::int64_t>(time.ns, 0)), 8);
+  // A time frame is small and may be dropped like a message (it is not counted as one).
+  for (const auto& s : sessions) Enqueue(*s, {frame, true});
 }
 
 void LiveServer::Impl::CountWatchers() {
@@ -491,15 +502,7 @@ void LiveServer::Message(const std::string& topic, slam::RosType type, bool latc
     channel.last_time = time;
   }
   if (m.sessions.empty()) return;
-  if (time.ns >= m.last_time_ns + kTimePeriodNs) {
-    m.last_time_ns = time.ns;
-    auto frame = std::make_shared<std::string>(1, static_cast<char>(kTimeData));
-    PutLe(frame.get(), static_cast<std::uint64_t>(std::max<std::int64_t>(time.ns, 0)), 8);
-    // A time frame is small and may be dropped like a message (it is not counted as one).
-    for (const auto& s : m.sessions) {
-      m.Enqueue(*s, {frame, true});
-    }
-  }
+  m.Clock(time);
   for (const auto& s : m.sessions) {
     const auto sub = s->subscription_of.find(channel.id);
     if (sub != s->subscription_of.end()) {
@@ -522,6 +525,11 @@ bool LiveServer::Wants(const std::string& topic, slam::RosType type, bool latche
 
 void LiveServer::Pace(Time time) {
   Impl& m = *impl_;
+  // The clients' clock follows the run's even when no message they take is made.
+  if (m.watchers.load() > 0) {
+    std::lock_guard lock(m.mu);
+    if (!m.closed) m.Clock(time);
+  }
   for (;;) {
     const double factor = m.pace.load();
     if (m.watchers.load() == 0 || !(factor > 0.0) || InterruptSignal() != 0) {

@@ -152,7 +152,9 @@ async function watch() {
       if (c.topic in expectedTypes && !latched.includes(c.topic)) subscribe(c);
     }
   });
+  let timeFrames = 0;
   client.on("time", ({ timestamp }) => {
+    ++timeFrames;
     if (timestamp < lastClockTime) fail(`time ${timestamp} after ${lastClockTime}`);
     lastClockTime = timestamp;
   });
@@ -224,6 +226,7 @@ async function watch() {
   for (const topic of latched) {
     if ((counts.get(topic) ?? 0) !== 1) fail(`${counts.get(topic)} ${topic} messages, expected its latched one`);
   }
+  if (timeFrames < 100) fail(`only ${timeFrames} time frames`);
   if (closed) fail("the server closed the connection mid-run");
   const summary = [...counts].map(([t, n]) => `${t} ${n}`).join(", ");
   client.close();  // mid-run: the run must go on
@@ -233,7 +236,7 @@ async function watch() {
     console.error(`live_check: ${errors.length} failures`);
     process.exit(1);
   }
-  console.log(`live_check: decoded ${summary}`);
+  console.log(`live_check: decoded ${summary}; ${timeFrames} time frames`);
   process.exit(0);
 }
 
