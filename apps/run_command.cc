@@ -8,6 +8,7 @@
 
 #include "apps/cli_args.h"
 #include "apps/commands.h"
+#include "apps/live_flags.h"
 #include "scenarios/scenario_runner.h"
 #include "scenarios/scenario_spec.h"
 #include "slam/io/atomic_file.h"
@@ -18,7 +19,10 @@ namespace slamrig::app {
 /// Exit code of a run whose expectations failed.
 constexpr int kExitExpectationsFailed = 3;
 
-int RunRunCommand(const std::vector<std::string>& args) {
+int RunRunCommand(const std::vector<std::string>& command_line) {
+  std::vector<std::string> args = command_line;
+  LiveFlags live_flags;
+  TakeLivePort(&args, &live_flags);
   std::string scenario_path = "office_loop";
   std::string out_dir;
   std::vector<std::string> overrides;
@@ -48,6 +52,7 @@ int RunRunCommand(const std::vector<std::string>& args) {
                  "also write run.mcap in the report folder, the whole run for Foxglove "
                  "(docs/foxglove.md); `record: true` in the scenario does the same",
                  &record);
+  AddLiveFlags(&parser, &live_flags);
   parser.AddFlag("quiet", "print only errors and the verdict line", &quiet);
   if (!parser.Parse(args)) return 0;
   if (!seed_text.empty()) {
@@ -71,6 +76,7 @@ int RunRunCommand(const std::vector<std::string>& args) {
   scenario::RunnerOptions options;
   options.view = view;
   if (record || spec.record) options.record_path = out_dir + "/run.mcap";
+  const std::unique_ptr<scenario::LiveServer> live = StartLive("slamrig run", live_flags, &options);
   const bool tty = ::isatty(STDERR_FILENO) != 0;
   if (!quiet) {
     options.progress = [tty](double t, double duration) {
@@ -85,6 +91,7 @@ int RunRunCommand(const std::vector<std::string>& args) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!quiet && tty) std::fputc('\n', stderr);
   scenario::WriteReport(result, out_dir);
+  FinishLive(live.get(), quiet);
 
   if (!quiet) {
     if (result.times_synthesised) {

@@ -15,6 +15,7 @@
 
 #include "apps/cli_args.h"
 #include "apps/commands.h"
+#include "apps/live_flags.h"
 #include "apps/topic_flags.h"
 #include "scenarios/plot.h"
 #include "scenarios/scenario_result.h"
@@ -118,10 +119,12 @@ struct SlamFlags {
   std::uint64_t seed = 1;
   std::vector<std::string> perturb;
   bool no_gyro = false, lenient = false, quiet = false, strict = false, record = false;
+  LiveFlags live;
 };
 
 // Reads the flags and checks the output folder; false when help was asked for.
-bool ParseSlamFlags(const std::vector<std::string>& args, SlamFlags* f) {
+bool ParseSlamFlags(std::vector<std::string> args, SlamFlags* f) {
+  TakeLivePort(&args, &f->live);
   ArgParser parser(
       "slamrig slam", "LOG --out DIR [options]",
       "Runs one estimator on a log, with dead reckoning beside it, and writes DIR as\n"
@@ -177,6 +180,7 @@ bool ParseSlamFlags(const std::vector<std::string>& args, SlamFlags* f) {
   parser.AddFlag("record", "also write DIR/run.mcap, the run for Foxglove (docs/foxglove.md)",
                  &f->record);
   parser.AddFlag("quiet", "no progress output", &f->quiet);
+  AddLiveFlags(&parser, &f->live);
   if (!parser.Parse(args)) return false;
   if (f->out_dir.empty()) throw ConfigError("slamrig slam: --out DIR is required");
   slam::CheckOutputFolder(f->out_dir);
@@ -295,6 +299,8 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   if (flags.clouds > 0) clouds = "# time_s,particle,x_m,y_m,yaw_rad,weight\n";
   scenario::RunnerOptions options;
   if (flags.record) options.record_path = flags.out_dir + "/run.mcap";
+  const std::unique_ptr<scenario::LiveServer> live =
+      StartLive("slamrig slam", flags.live, &options);
   options.on_scan = [&](std::size_t done, std::size_t total, const slam::SyncedScan& scan,
                         const slam::EstimatorRunner& runner) {
     progress(done, total);
@@ -313,6 +319,7 @@ int RunSlamCommand(const std::vector<std::string>& args) {
   }
   WriteSlamFiles(result, flags.out_dir, clouds);
   scenario::WriteReport(result, flags.out_dir);
+  FinishLive(live.get(), flags.quiet);
 
   std::puts(SummaryLine(result, flags.out_dir).c_str());
   for (const std::string& note : result.notes) std::printf("  note: %s\n", note.c_str());

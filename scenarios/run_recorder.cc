@@ -175,21 +175,27 @@ slam::RosOccupancyGrid ToRosGrid(const slam::OccupancyGrid& grid, Time time,
 }
 
 RunRecorder::RunRecorder(std::string path, std::vector<std::string> config_names,
-                         RecorderOptions options)
+                         RecorderOptions options, slam::MessageSink* live)
     : path_(std::move(path)), options_(options) {
-  const std::string partial = path_ + ".partial";
-  std::error_code ec;
-  std::filesystem::remove(partial, ec);
-  const std::filesystem::path parent = std::filesystem::path(partial).parent_path();
-  if (!parent.empty() && !std::filesystem::exists(parent)) {
-    std::filesystem::create_directories(parent, ec);
-    if (!ec) created_dir_ = parent.string();
-  }
   slam::BagWriterOptions bag;
   bag.single_file = true;
   // base_link hangs under truth/base_link; the robot's own odom -> base_link stays in /odom.
   bag.write_tf = false;
-  writer_ = std::make_unique<slam::BagWriter>(partial, bag);
+  if (path_.empty()) {
+    writer_ = std::make_unique<slam::BagWriter>(bag);
+  } else {
+    const std::string partial = path_ + ".partial";
+    std::error_code ec;
+    std::filesystem::remove(partial, ec);
+    const std::filesystem::path parent = std::filesystem::path(partial).parent_path();
+    if (!parent.empty() && !std::filesystem::exists(parent)) {
+      std::filesystem::create_directories(parent, ec);
+      if (!ec) created_dir_ = parent.string();
+    }
+    writer_ = std::make_unique<slam::BagWriter>(partial, bag);
+  }
+  if (live) writer_->AddSink(live);
+  live_ = live;
   if (options_.odometry && options_.odometry->Validate().empty())
     odometry_.emplace(*options_.odometry);
   for (std::string& name : config_names) {
@@ -232,6 +238,7 @@ void RunRecorder::Truth(Time time, const Pose2& map_from_base) {
     writer_->AddStaticTransform({time, kTruthBase, "base_link", Pose2()}, time);
   }
   writer_->Write(GroundTruthPose{time, map_from_base});
+  if (!writer_->Wants("/tf", RosType::kTfMessage, false)) return;
   slam::EncodeTfMessage({{time, kMap, kTruthBase, map_from_base}}, &buffer_);
   Write("/tf", RosType::kTfMessage, time);
 }
@@ -241,22 +248,38 @@ void RunRecorder::Scan(std::size_t index, Time time, const slam::ScanEstimate& e
   Config& c = configs_.at(index);
   c.last_time = time;
   const std::string frame = c.name + "/map";
+  if (live_ && !c.announced) {
+    c.announced = true;
+    std::vector<slam::RosTransform> identities;
+    for (const Config& other : configs_) {
+      if (other.announced) identities.push_back({time, kMap, other.name + "/map", Pose2()});
+    }
+    slam::EncodeTfMessage(identities, &buffer_);
+    live_->Message("/live/alignments", RosType::kTfMessage, true, time, buffer_);
+  }
   const Pose2 pose = map_from_estimator * estimate.pose;
-  slam::EncodeTfMessage({{time, frame, c.name + "/base_link", pose}}, &buffer_);
-  Write("/tf", RosType::kTfMessage, time);
+  if (writer_->Wants("/tf", RosType::kTfMessage, false)) {
+    slam::EncodeTfMessage({{time, frame, c.name + "/base_link", pose}}, &buffer_);
+    Write("/tf", RosType::kTfMessage, time);
+  }
   if (!c.has_covariance) c.has_covariance = estimate.covariance.has_value();
-  if (*c.has_covariance) {
-    const Eigen::Matrix3d cov =
-        estimate.covariance ? RotateCovariance(*estimate.covariance, map_from_estimator.theta())
-                            : Eigen::Matrix3d::Zero();
-    slam::EncodePoseWithCovarianceStamped(time, frame, pose, cov, &buffer_);
-    Write("/" + c.name + "/pose", RosType::kPoseWithCovarianceStamped, time);
-  } else {
-    slam::EncodePoseStamped(time, frame, pose, &buffer_);
-    Write("/" + c.name + "/pose", RosType::kPoseStamped, time);
+  const RosType pose_type =
+      *c.has_covariance ? RosType::kPoseWithCovarianceStamped : RosType::kPoseStamped;
+  const std::string pose_topic = "/" + c.name + "/pose";
+  if (writer_->Wants(pose_topic, pose_type, false)) {
+    if (*c.has_covariance) {
+      const Eigen::Matrix3d cov =
+          estimate.covariance ? RotateCovariance(*estimate.covariance, map_from_estimator.theta())
+                              : Eigen::Matrix3d::Zero();
+      slam::EncodePoseWithCovarianceStamped(time, frame, pose, cov, &buffer_);
+    } else {
+      slam::EncodePoseStamped(time, frame, pose, &buffer_);
+    }
+    Write(pose_topic, pose_type, time);
   }
   const slam::EstimatorView view = estimator.View();
-  if (!view.particles.empty() && time.seconds() >= c.next_particles_s) {
+  if (!view.particles.empty() && time.seconds() >= c.next_particles_s &&
+      writer_->Wants("/" + c.name + "/particles", RosType::kPoseArray, false)) {
     c.next_particles_s = time.seconds() + options_.particles_period_s;
     std::vector<Pose2> particles;
     particles.reserve(view.particles.size());
@@ -266,8 +289,10 @@ void RunRecorder::Scan(std::size_t index, Time time, const slam::ScanEstimate& e
     Write("/" + c.name + "/particles", RosType::kPoseArray, time);
   }
   for (const slam::TraceValue& v : estimate.trace) {
+    const std::string topic = "/" + c.name + "/health/" + v.name;
+    if (!writer_->Wants(topic, RosType::kFloat64, false)) continue;
     slam::EncodeFloat64(v.value, &buffer_);
-    Write("/" + c.name + "/health/" + v.name, RosType::kFloat64, time);
+    Write(topic, RosType::kFloat64, time);
   }
   if (time.seconds() >= c.next_map_s) {
     c.next_map_s = time.seconds() + options_.map_period_s;
@@ -279,15 +304,18 @@ void RunRecorder::WriteSnapshot(Config& c, Time time, const slam::Estimator& est
                                 const slam::EstimatorView& view, const Pose2& map_from_estimator) {
   const std::string frame = c.name + "/map";
   const slam::OccupancyGrid& grid = estimator.map();
-  if (grid.width() > 0 && grid.height() > 0) {
+  if (grid.width() > 0 && grid.height() > 0 &&
+      writer_->Wants("/" + c.name + "/map", RosType::kOccupancyGrid, false)) {
     slam::EncodeOccupancyGrid(ToRosGrid(grid, time, frame, map_from_estimator), &buffer_);
     Write("/" + c.name + "/map", RosType::kOccupancyGrid, time);
   }
-  if (!view.edges.empty()) {
+  if (!view.edges.empty() &&
+      writer_->Wants("/" + c.name + "/graph", RosType::kMarkerArray, false)) {
     slam::EncodeMarkerArray(GraphMarkers(view.edges, time, frame, map_from_estimator), &buffer_);
     Write("/" + c.name + "/graph", RosType::kMarkerArray, time);
   }
-  if (!view.landmarks.empty()) {
+  if (!view.landmarks.empty() &&
+      writer_->Wants("/" + c.name + "/landmarks", RosType::kMarkerArray, false)) {
     slam::EncodeMarkerArray(LandmarkMarkers(view.landmarks, time, frame, map_from_estimator),
                             &buffer_);
     Write("/" + c.name + "/landmarks", RosType::kMarkerArray, time);

@@ -51,11 +51,19 @@ struct RecorderOptions {
 /// The file is written as `path` + ".partial" and stays there after Finish(); Commit() renames
 /// it to `path`. A run killed before leaves only the .partial file (a chunked MCAP without a
 /// summary that readers recover up to the last whole chunk); one that throws removes it.
+/// The same messages, in the same order, also go to `live` (the run's live view over the
+/// Foxglove WebSocket protocol), with or without a file: this class is the one source of a run's
+/// messages for both. The live view alone also gets `/live/alignments` (tf2_msgs/TFMessage,
+/// latched): `map -> <config>/map` as the identity for each configuration from its first scan, so
+/// that its estimate shows in the map frame while the run goes (each is placed at the reference
+/// pose of its first scan; the ATE alignment that the file's /tf_static carries is known only at
+/// the end, and then comes on /tf_static to the live view too).
 class RunRecorder {
  public:
-  /// `config_names`: the configurations in runner order. Throws OutputError if the file cannot
-  /// be written.
-  RunRecorder(std::string path, std::vector<std::string> config_names, RecorderOptions options);
+  /// `config_names`: the configurations in runner order. An empty `path` writes no file (then
+  /// `live` should be given). Throws OutputError if the file cannot be written.
+  RunRecorder(std::string path, std::vector<std::string> config_names, RecorderOptions options,
+              slam::MessageSink* live = nullptr);
   ~RunRecorder();
   RunRecorder(const RunRecorder&) = delete;
   RunRecorder& operator=(const RunRecorder&) = delete;
@@ -81,6 +89,7 @@ class RunRecorder {
     double next_map_s = 0.0;
     double next_particles_s = 0.0;
     Time last_time;
+    bool announced = false;  // to the live view, in /live/alignments
   };
   struct Late {  // a message written at the end, with its own time
     Time time;
@@ -102,6 +111,7 @@ class RunRecorder {
   bool finished_ = false;
   RecorderOptions options_;
   std::unique_ptr<slam::BagWriter> writer_;
+  slam::MessageSink* live_ = nullptr;
   std::optional<slam::RobotOdometry> odometry_;
   std::vector<Config> configs_;
   std::optional<Time> first_time_;

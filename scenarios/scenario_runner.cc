@@ -60,17 +60,19 @@ Runners MakeRunners(const ScenarioSpec& spec, const std::vector<Record>* log_rec
   return runners;
 }
 
-// The recording of a run, when asked for: every configuration's scans go to it as they are
-// taken, placed by the reference pose of the run's first scan (`map_from_start`, filled later).
+// The recording of a run (a file, a live view or both), when asked for: every configuration's scans
+// go to it as they are taken, placed by the reference pose of the run's first scan
+// (`map_from_start`, filled later).
 std::unique_ptr<RunRecorder> MakeRecorder(const RunnerOptions& options, Runners& runners,
                                           const std::optional<Pose2>& map_from_start) {
-  if (options.record_path.empty()) return nullptr;
+  if (options.record_path.empty() && !options.live) return nullptr;
   std::vector<std::string> names;
   for (const auto& r : runners) names.push_back(r->config().name);
   RecorderOptions recording;
   const slam::EstimatorConfig& first = runners.front()->config();
   recording.odometry = slam::WheelOdometryOptions{first.odometry.robot, first.odometry.use_gyro};
-  auto recorder = std::make_unique<RunRecorder>(options.record_path, names, recording);
+  auto recorder =
+      std::make_unique<RunRecorder>(options.record_path, names, recording, options.live);
   for (std::size_t i = 0; i < runners.size(); ++i) {
     slam::EstimatorRunner* runner = runners[i].get();
     RunRecorder* rec = recorder.get();
@@ -466,6 +468,7 @@ ScenarioResult RunSimulated(const ScenarioSpec& spec, const RunnerOptions& optio
       result.kidnap_times.push_back(simulator.time());
     }
     consume(step(false));
+    if (options.pace) options.pace(simulator.time());
     const double now_s = simulator.time().seconds();
     if (now_s >= next_progress_s) {
       next_progress_s = now_s + 1.0;
@@ -572,6 +575,7 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
     last_time = last_time ? std::max(*last_time, t) : t;
     if (recorder) recorder->Record(record);
     for (auto& r : runners) r->Add(record);
+    if (options.pace) options.pace(t);
     if (view && is_scan) {
       ShowLive(*view, SecondsBetween(t, *first_time), runners, map_from_start.value_or(Pose2()),
                true, map_from_start.value_or(Pose2()));

@@ -5,6 +5,7 @@
 
 #include "scenarios/scenario_result.h"
 #include "scenarios/scenario_spec.h"
+#include "slam/io/bag/message_sink.h"
 
 namespace slamrig::scenario {
 
@@ -14,6 +15,12 @@ struct RunnerOptions {
   /// Record the run as MCAP for Foxglove (RunRecorder) to this path (.partial until WriteReport
   /// renames it); empty: no recording.
   std::string record_path;
+  /// The run's live view (LiveServer): every message the recording has, as it is made, with or
+  /// without record_path; nullptr: none.
+  slam::MessageSink* live = nullptr;
+  /// Called with the run's clock after each simulation step (a log: each record), to pace a
+  /// live view to the wall clock. It may sleep; it never changes what the run computes.
+  std::function<void(Time)> pace;
   /// Called about once per simulated second with (sim time, duration); for progress output.
   std::function<void(double, double)> progress;
   /// A log source: called after each scan the first configuration takes, with the scans taken,

@@ -13,6 +13,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libsqlite3-dev zlib1g-dev libnanoflann-dev
   libspectra-dev
   libzstd-dev liblz4-dev
+  libboost-dev nlohmann-json3-dev # `slamrig run --live`: Boost.Beast/Asio, the protocol's JSON
   libegl-dev libegl-mesa0 libgl1-mesa-dri
   pybind11-dev python3-dev python3-numpy
 )

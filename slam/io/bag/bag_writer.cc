@@ -213,7 +213,16 @@ BagWriter::BagWriter(McapWriter::Output output, BagWriterOptions options)
   }
 }
 
+BagWriter::BagWriter(BagWriterOptions options) : options_(std::move(options)) {
+  const std::vector<std::string> errors = options_.Validate();
+  if (!errors.empty()) throw ConfigError("bag writer: " + errors.front());
+  if (options_.clock_rate_hz > 0.0) {
+    clock_period_ns_ = std::max<std::int64_t>(1, std::llround(1e9 / options_.clock_rate_hz));
+  }
+}
+
 BagWriter::~BagWriter() {
+  // A folder only when there is storage in one (not for a stream or a writer for sinks alone).
   if (!committed_ && !folder_.empty()) {
     mcap_.reset();
     sqlite_.reset();
@@ -231,6 +240,8 @@ BagWriter::Topic& BagWriter::GetTopic(const std::string& name, int type, bool la
   topic.name = name;
   topic.type = std::string(RosTypeName(ros_type));
   topic.qos = QosProfile(latched);
+  topic.ros_type = ros_type;
+  topic.latched = latched;
   if (mcap_) {
     auto it = mcap_schemas_.find(type);
     if (it == mcap_schemas_.end()) {
@@ -242,7 +253,7 @@ BagWriter::Topic& BagWriter::GetTopic(const std::string& name, int type, bool la
     std::map<std::string, std::string> metadata = {{"offered_qos_profiles", topic.qos}};
     if (ros_type == RosType::kJointState) metadata[kTicksKey] = TicksText();
     topic.mcap_channel = mcap_->AddChannel(it->second, name, "cdr", metadata);
-  } else {
+  } else if (sqlite_) {
     topic.sqlite_id =
         sqlite_->AddTopic(name, topic.type, topic.qos, RosMessageDefinition(ros_type));
   }
@@ -254,14 +265,23 @@ void BagWriter::Emit(Topic& topic, Time time, std::string_view payload) {
   const auto t = static_cast<std::uint64_t>(time.ns);
   if (mcap_) {
     mcap_->WriteMessage(topic.mcap_channel, topic.sequence, t, t, payload);
-  } else {
+  } else if (sqlite_) {
     sqlite_->WriteMessage(topic.sqlite_id, time.ns, payload);
   }
+  for (MessageSink* sink : sinks_)
+    sink->Message(topic.name, topic.ros_type, topic.latched, time, payload);
   ++topic.sequence;
   ++topic.count;
   if (message_count_ == 0 || time.ns < start_ns_) start_ns_ = time.ns;
   if (message_count_ == 0 || time.ns > end_ns_) end_ns_ = time.ns;
   ++message_count_;
+}
+
+bool BagWriter::Wants(const std::string& topic, RosType type, bool latched) {
+  if (mcap_ || sqlite_) return true;
+  bool wanted = false;
+  for (MessageSink* sink : sinks_) wanted = sink->Wants(topic, type, latched) || wanted;
+  return wanted;
 }
 
 void BagWriter::MaybeClock(Time time) {
@@ -272,6 +292,7 @@ void BagWriter::MaybeClock(Time time) {
   if (clock_period_ns_ == 0) return;
   if (last_clock_ && time.ns < last_clock_->ns + clock_period_ns_) return;
   last_clock_ = time;
+  if (!Wants(options_.topics.clock, RosType::kClock, false)) return;
   EncodeClock(time, &buffer_);
   Emit(GetTopic(options_.topics.clock, static_cast<int>(RosType::kClock), false), time);
 }
@@ -285,9 +306,11 @@ void BagWriter::Write(const Record& record) {
       static_laser_ = scan->base_from_laser;
       EmitStaticTransforms(time);
     }
+    if (!Wants(options_.topics.scan, RosType::kLaserScan, false)) return;
     EncodeLaserScan(*scan, f.laser, &buffer_);
     Emit(GetTopic(options_.topics.scan, static_cast<int>(RosType::kLaserScan), false), time);
   } else if (const auto* imu = std::get_if<ImuSample>(&record)) {
+    if (!Wants(options_.topics.imu, RosType::kImu, false)) return;
     EncodeImu(*imu, f.imu, &buffer_);
     Emit(GetTopic(options_.topics.imu, static_cast<int>(RosType::kImu), false), time);
   } else if (const auto* ticks = std::get_if<WheelTicks>(&record)) {
@@ -307,6 +330,7 @@ void BagWriter::Write(const Record& record) {
           i < right_wheels_ ? ticks->right_ticks[i] : ticks->left_ticks[i - right_wheels_];
       positions_[i] = static_cast<double>(tick_totals_[i]) * rad_per_tick;
     }
+    if (!Wants(options_.topics.joint_states, RosType::kJointState, false)) return;
     EncodeJointState(time, joint_names_, positions_, &buffer_);
     Emit(GetTopic(options_.topics.joint_states, static_cast<int>(RosType::kJointState), false),
          time);
@@ -319,17 +343,25 @@ void BagWriter::Write(const Record& record) {
       static_depth_ = depth;
       EmitStaticTransforms(time);
     }
-    EncodeRgbImage(*frame, f.camera, &buffer_);
-    Emit(GetTopic(options_.topics.rgb, static_cast<int>(RosType::kImage), false), time);
-    EncodeDepthImage(*frame, f.depth, &buffer_);
-    Emit(GetTopic(options_.topics.depth, static_cast<int>(RosType::kImage), false), time);
-    EncodeCameraInfo(*frame, f.camera, &buffer_);
-    Emit(GetTopic(options_.topics.camera_info, static_cast<int>(RosType::kCameraInfo), false),
-         time);
+    if (Wants(options_.topics.rgb, RosType::kImage, false)) {
+      EncodeRgbImage(*frame, f.camera, &buffer_);
+      Emit(GetTopic(options_.topics.rgb, static_cast<int>(RosType::kImage), false), time);
+    }
+    if (Wants(options_.topics.depth, RosType::kImage, false)) {
+      EncodeDepthImage(*frame, f.depth, &buffer_);
+      Emit(GetTopic(options_.topics.depth, static_cast<int>(RosType::kImage), false), time);
+    }
+    if (Wants(options_.topics.camera_info, RosType::kCameraInfo, false)) {
+      EncodeCameraInfo(*frame, f.camera, &buffer_);
+      Emit(GetTopic(options_.topics.camera_info, static_cast<int>(RosType::kCameraInfo), false),
+           time);
+    }
   } else if (const auto* odom = std::get_if<OdometryPose>(&record)) {
-    EncodeOdometry({time, f.odom, f.base, odom->odom_from_base}, &buffer_);
-    Emit(GetTopic(options_.topics.odom, static_cast<int>(RosType::kOdometry), false), time);
-    if (options_.write_tf) {
+    if (Wants(options_.topics.odom, RosType::kOdometry, false)) {
+      EncodeOdometry({time, f.odom, f.base, odom->odom_from_base}, &buffer_);
+      Emit(GetTopic(options_.topics.odom, static_cast<int>(RosType::kOdometry), false), time);
+    }
+    if (options_.write_tf && Wants(options_.topics.tf, RosType::kTfMessage, false)) {
       EncodeTfMessage({{time, f.odom, f.base, odom->odom_from_base}}, &buffer_);
       Emit(GetTopic(options_.topics.tf, static_cast<int>(RosType::kTfMessage), false), time);
     }
@@ -394,6 +426,7 @@ void BagWriter::EmitStaticTransforms(Time time) {
 
 void BagWriter::Write(const GroundTruthPose& truth) {
   MaybeClock(truth.time);
+  if (!Wants(options_.topics.ground_truth, RosType::kOdometry, false)) return;
   EncodeOdometry({truth.time, options_.frames.map, options_.frames.base, truth.map_from_base},
                  &buffer_);
   Emit(GetTopic(options_.topics.ground_truth, static_cast<int>(RosType::kOdometry), false),
@@ -436,7 +469,11 @@ std::string BagWriter::MetadataYaml() const {
 
 void BagWriter::Commit() {
   if (committed_) return;
-  if (options_.single_file || folder_.empty()) {
+  if (!mcap_ && !sqlite_) {  // no storage: nothing to close
+    committed_ = true;
+    return;
+  }
+  if (options_.single_file || folder_.empty()) {  // one file, or a stream
     mcap_->Close();
     mcap_.reset();
     committed_ = true;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "slam/io/bag/mcap_writer.h"
+#include "slam/io/bag/message_sink.h"
 #include "slam/io/bag/ros_messages.h"
 #include "slam/io/dataset.h"
 #include "slam/types/records.h"
@@ -117,6 +118,8 @@ std::optional<bool> WheelJointIsRight(std::string_view name);
 /// Each message's log time, publish time and header stamp are the record's time. Nothing
 /// appears at `folder` until Commit(): the bag is written in a sibling temporary folder and
 /// renamed into place; destroying an uncommitted writer removes it.
+/// Every message written also goes to the sinks added with AddSink(), in the same order; a
+/// writer made without a folder writes no file and only feeds its sinks.
 class BagWriter {
  public:
   /// Throws ConfigError if the options are invalid, std::runtime_error if `folder` exists or
@@ -126,6 +129,9 @@ class BagWriter {
   /// no summary, no folder and no metadata.yaml); storage must be mcap. Commit() ends the
   /// stream (DataEnd, Footer, magic).
   BagWriter(McapWriter::Output output, BagWriterOptions options);
+  /// A writer without storage: the messages go only to the sinks (options.storage and
+  /// single_file do not matter). Throws ConfigError if the options are invalid.
+  explicit BagWriter(BagWriterOptions options);
   ~BagWriter();
   BagWriter(const BagWriter&) = delete;
   BagWriter& operator=(const BagWriter&) = delete;
@@ -142,6 +148,11 @@ class BagWriter {
                     std::string_view cdr);
   /// Adds a planar transform to the ones /tf_static carries, and writes /tf_static at `time`.
   void AddStaticTransform(const RosTransform& transform, Time time);
+  /// Gives every message from now on also to `sink`, which must outlive the writer.
+  void AddSink(MessageSink* sink) { sinks_.push_back(sink); }
+  /// Whether a message on `topic` would be used: always with storage, else when a sink wants it
+  /// (MessageSink::Wants, asked of every sink). Messages no one wants are not even encoded.
+  bool Wants(const std::string& topic, RosType type, bool latched);
   /// MCAP only: closes the open chunk, so that what follows is in chunks of its own.
   void FlushChunk();
   /// MCAP only: one Metadata record `name` with the text pairs of `metadata`.
@@ -159,6 +170,8 @@ class BagWriter {
     std::string name;
     std::string type;
     std::string qos;
+    RosType ros_type = RosType::kLaserScan;
+    bool latched = false;
     std::uint16_t mcap_channel = 0;
     std::int64_t sqlite_id = 0;
     std::uint32_t sequence = 0;
@@ -180,6 +193,7 @@ class BagWriter {
   std::unique_ptr<class SqliteBagWriter> sqlite_;
   std::vector<Topic> topics_;
   std::map<int, std::uint16_t> mcap_schemas_;
+  std::vector<MessageSink*> sinks_;
   std::string buffer_;
   void EmitStaticTransforms(Time time);
   std::optional<Pose2> static_laser_;
