@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <tuple>
 
 #include "slam/matching/map_frame_drift.h"
@@ -10,6 +11,22 @@
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
+std::vector<std::string> IcpOdometrySearchOptions::Validate() const {
+  Rules rules;
+  rules.NonNegative("sigmas", sigmas)
+      .NonNegative("trigger_window_m", trigger_window_m)
+      .NonNegative("trigger_window_rad", trigger_window_rad)
+      .Positive("max_window_m", max_window_m)
+      .Require(max_window_rad > 0.0 && max_window_rad <= std::numbers::pi, "max_window_rad",
+               max_window_rad, "must be in (0, pi]")
+      .Positive("resolution_m", resolution_m)
+      .Positive("blur_m", blur_m)
+      .NonNegative("min_gain", min_gain)
+      .NonNegative("prior_weight", prior_weight)
+      .Fraction("adapt_rate", adapt_rate);
+  return PrefixErrors("search", rules.errors());
+}
+
 std::vector<std::string> IcpOdometryOptions::Validate() const {
   Rules rules;
   rules.AtLeast("local_map_keyframes", local_map_keyframes, 1)
@@ -27,7 +44,8 @@ std::vector<std::string> IcpOdometryOptions::Validate() const {
       .NonNegative("sigma_xy_floor_m", sigma_xy_floor_m)
       .NonNegative("sigma_yaw_per_rad", sigma_yaw_per_rad)
       .NonNegative("sigma_yaw_per_m", sigma_yaw_per_m)
-      .NonNegative("sigma_yaw_floor_rad", sigma_yaw_floor_rad);
+      .NonNegative("sigma_yaw_floor_rad", sigma_yaw_floor_rad)
+      .Nested("", search.Validate());
   std::vector<std::string> errors = icp.Validate();
   AppendErrors(&errors, points.Validate());
   AppendErrors(&errors, PrefixErrors("icp_odometry", rules.errors()));
@@ -44,11 +62,81 @@ const std::vector<Eigen::Vector2d>& IcpOdometry::local_map() const {
 }
 
 Eigen::Matrix3d IcpOdometry::IncrementCovariance(const Pose2& increment) const {
+  const Eigen::Vector2d sigma = ModelSigmas(increment).cwiseProduct(noise_scale_);
+  return Eigen::Vector3d(sigma.x() * sigma.x(), sigma.x() * sigma.x(), sigma.y() * sigma.y())
+      .asDiagonal();
+}
+
+Eigen::Vector2d IcpOdometry::ModelSigmas(const Pose2& increment) const {
   const double d = increment.translation().norm();
-  const double sxy = options_.sigma_xy_per_m * d + options_.sigma_xy_floor_m;
-  const double syaw = options_.sigma_yaw_per_rad * std::abs(increment.theta()) +
-                      options_.sigma_yaw_per_m * d + options_.sigma_yaw_floor_rad;
-  return Eigen::Vector3d(sxy * sxy, sxy * sxy, syaw * syaw).asDiagonal();
+  return {options_.sigma_xy_per_m * d + options_.sigma_xy_floor_m,
+          options_.sigma_yaw_per_rad * std::abs(increment.theta()) + options_.sigma_yaw_per_m * d +
+              options_.sigma_yaw_floor_rad};
+}
+
+void IcpOdometry::MeasureNoise(const Pose2& prior, const Pose2& matched, const Pose2& increment) {
+  const double rate = options_.search.adapt_rate;
+  if (rate <= 0.0) return;
+  const Pose2 correction = prior.Between(matched);
+  const Eigen::Vector2d sigma = ModelSigmas(increment);
+  // The corrections' sizes in units of the model's sigma (per axis in x and y: a 2D Gaussian's
+  // distance has mean sigma sqrt(pi / 2)), averaged: a mean of sizes, not of squares, so that a
+  // rare wrong match moves it little; each clipped to the current search window for the same
+  // reason. For Gaussian noise the mean size is sigma sqrt(2 / pi).
+  const double window = std::max(options_.search.sigmas, 1.0);
+  const Eigen::Vector2d size(
+      correction.translation().norm() / (sigma.x() * std::sqrt(std::numbers::pi / 2.0)),
+      std::abs(correction.theta()) / (sigma.y() * std::sqrt(2.0 / std::numbers::pi)));
+  for (int i = 0; i < 2; ++i) {
+    noise_mean_size_[i] =
+        (1.0 - rate) * noise_mean_size_[i] + rate * std::min(size[i], window * noise_scale_[i]);
+    noise_scale_[i] = std::max(1.0, noise_mean_size_[i]);
+  }
+}
+
+Eigen::Vector2d IcpOdometry::SearchWindow(const Pose2& increment) const {
+  const IcpOdometrySearchOptions& o = options_.search;
+  const Eigen::Vector2d sigma = ModelSigmas(increment).cwiseProduct(noise_scale_);
+  return {std::min(o.max_window_m, o.sigmas * sigma.x()),
+          std::min(o.max_window_rad, o.sigmas * sigma.y())};
+}
+
+std::optional<MatchResult> IcpOdometry::SearchedMatch(const std::vector<Eigen::Vector2d>& points,
+                                                      const Pose2& prior,
+                                                      const Eigen::Vector2d& window,
+                                                      std::optional<MatchResult> from_prior) {
+  const IcpOdometrySearchOptions& o = options_.search;
+  if (o.sigmas <= 0.0) return from_prior;
+  if (from_prior && window.x() <= o.trigger_window_m && window.y() <= o.trigger_window_rad) {
+    return from_prior;
+  }
+  ++counts_.searched;
+  if (!raster_) raster_ = RasterOf(matcher_->reference(), o.resolution_m, o.blur_m);
+  const std::vector<Eigen::Vector2d> query = Thinned(points, o.resolution_m);
+  // The yaw step: a point 10 m out moves one raster cell; ICP takes the rest.
+  const CorrelativeMatcherOptions search{.linear_window_m = window.x(),
+                                         .angular_window_rad = window.y(),
+                                         .angular_step_rad = o.resolution_m / 10.0,
+                                         .branch_and_bound_depth = 5,
+                                         .min_score = 0.05};
+  const std::optional<MatchResult> coarse =
+      CorrelativeMatcher(search, raster_->view).Match(query, prior);
+  if (!coarse) return from_prior;
+  std::optional<MatchResult> refined = GatedMatch(points, coarse->pose, Eigen::Vector2d::Zero());
+  if (!refined) return from_prior;
+  // Each match's fit to the raster less its prior penalty: the maximum a posteriori choice with the
+  // raster as the log-likelihood up to scale and the prior's Gaussian (sigma = window / sigmas).
+  const Eigen::Vector2d sigma = window / o.sigmas;
+  auto posterior = [&](const Pose2& pose) {
+    const Pose2 d = prior.Between(pose);
+    const double m2 = d.translation().squaredNorm() / (sigma.x() * sigma.x()) +
+                      d.theta() * d.theta() / (sigma.y() * sigma.y());
+    return RasterScore(*raster_, query, pose) - o.prior_weight * m2;
+  };
+  const double searched = posterior(refined->pose);
+  if (from_prior && searched <= posterior(from_prior->pose) + o.min_gain) return from_prior;
+  ++counts_.search_chosen;
+  return refined;
 }
 
 std::pair<int, std::vector<KeyframeShareOf>> IcpOdometry::AddKeyframe(
@@ -75,6 +163,7 @@ std::pair<int, std::vector<KeyframeShareOf>> IcpOdometry::AddKeyframe(
   for (const Keyframe& k : keyframes_) points.push_back(k.points);
   map_ = ComposeLocalMap(points, options_.local_map_voxel_m);
   matcher_.emplace(options_.icp, map_.points);
+  raster_.reset();
   last_keyframe_ = pose_;
   return {keyframes_.back().id, std::move(shares)};
 }
@@ -84,13 +173,14 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_in
 }
 
 std::optional<MatchResult> IcpOdometry::GatedMatch(const std::vector<Eigen::Vector2d>& points,
-                                                   const Pose2& prior) const {
+                                                   const Pose2& prior,
+                                                   const Eigen::Vector2d& window) const {
   std::optional<MatchResult> match = matcher_->Match(points, prior);
-  if (match &&
-      (match->score < options_.min_score ||
-       (match->pose.translation() - prior.translation()).norm() > options_.max_correction_m ||
-       std::abs(NormalizeAngle(match->pose.theta() - prior.theta())) >
-           options_.max_correction_rad)) {
+  if (match && (match->score < options_.min_score ||
+                (match->pose.translation() - prior.translation()).norm() >
+                    std::max(options_.max_correction_m, window.x()) ||
+                std::abs(NormalizeAngle(match->pose.theta() - prior.theta())) >
+                    std::max(options_.max_correction_rad, window.y()))) {
     match.reset();
   }
   return match;
@@ -118,7 +208,8 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
   std::optional<MatchResult> match;
   if (!points.empty() && matcher_) {
     for (std::size_t i = 0; i < increments.size(); ++i) {
-      std::optional<MatchResult> m = GatedMatch(points, pose_ * increments[i]);
+      std::optional<MatchResult> m =
+          GatedMatch(points, pose_ * increments[i], SearchWindow(increments[i]));
       if (m && (!match || m->score > match->score)) {
         match = std::move(m);
         chosen = i;
@@ -134,6 +225,9 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
       r * prior_covariance.topLeftCorner<2, 2>() * r.transpose();
   step.pose = prior;
   step.covariance = prior_covariance;
+  if (!points.empty() && matcher_) {
+    match = SearchedMatch(points, prior, SearchWindow(odometry_increment), std::move(match));
+  }
 
   // Failed unless the match below says otherwise (also with no local map yet).
   step.outcome = points.empty() ? IcpOdometryOutcome::kNoPoints : IcpOdometryOutcome::kMatchFailed;
@@ -163,6 +257,7 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
     step.covariance = match->covariance;
     step.score = match->score;
     step.outcome = degenerate ? IcpOdometryOutcome::kDegenerate : IcpOdometryOutcome::kMatched;
+    if (!degenerate) MeasureNoise(prior, step.pose, odometry_increment);
   }
   switch (step.outcome) {
     case IcpOdometryOutcome::kMatched:

@@ -7,13 +7,40 @@
 #include <utility>
 #include <vector>
 
+#include "slam/matching/correlative_matcher.h"
 #include "slam/matching/icp_matcher.h"
 #include "slam/matching/map_frame_drift.h"
+#include "slam/matching/point_raster.h"
 #include "slam/matching/scan_points.h"
 #include "slam/types/pose2.h"
 #include "slam/types/records.h"
 
 namespace slamrig::slam {
+
+/// The correlative search IcpOdometry runs before ICP when the prior may be outside ICP's basin.
+struct IcpOdometrySearchOptions {
+  /// The window: +-sigmas standard deviations of the prior (the increment's noise model scaled by
+  /// the noise measured online); 0: never search.
+  double sigmas = 3.0;
+  /// The search runs when the window is wider than this in x and y or ...
+  double trigger_window_m = 0.15;
+  double trigger_window_rad = 0.1;  ///< ... in yaw, or when ICP's match from the prior failed
+  double max_window_m = 2.0;        ///< the window is at most this wide ...
+  double max_window_rad = 1.0;      ///< ... and this in yaw
+  double resolution_m = 0.1;        ///< the local map's raster for the search ...
+  double blur_m = 0.1;              ///< ... each point blurred by a Gaussian of this sigma
+  /// The searched match replaces the one from the prior when its posterior is higher by this
+  /// much: the points' fit to the raster (mean raster value) less prior_weight times the squared
+  /// Mahalanobis distance from the prior (sigma = window / sigmas); the prior's match wins ties.
+  double min_gain = 0.02;
+  double prior_weight = 0.01;
+  /// The online noise measurement: an exponentially weighted mean (this weight per matched scan)
+  /// of the squared corrections of clear matches, in units of the noise model's sigma; 0: off.
+  double adapt_rate = 0.05;
+
+  /// One message per broken rule (prefixed "search.").
+  std::vector<std::string> Validate() const;
+};
 
 /// Parameters of scan-to-local-map ICP odometry.
 struct IcpOdometryOptions {
@@ -38,14 +65,18 @@ struct IcpOdometryOptions {
   /// A match that moves the pose farther than this from the odometry prior fails.
   double max_correction_m = 0.5;
   double max_correction_rad = 0.3;
-  /// The odometry increment's noise model, for the covariance when the prior is used: standard
-  /// deviations of sigma_xy_per_m * distance + sigma_xy_floor_m and
-  /// sigma_yaw_per_rad * |turn| + sigma_yaw_per_m * distance + sigma_yaw_floor_rad.
+  /// The odometry increment's noise model, for the covariance when the prior is used and the
+  /// search window before the noise is measured: standard deviations of
+  /// sigma_xy_per_m * distance + sigma_xy_floor_m and
+  /// sigma_yaw_per_rad * |turn| + sigma_yaw_per_m * distance + sigma_yaw_floor_rad. Wheel odometry
+  /// is far worse on turns than straight (the wheels skid): a fifth of the turn is typical.
   double sigma_xy_per_m = 0.05;
   double sigma_xy_floor_m = 0.005;
-  double sigma_yaw_per_rad = 0.05;
+  double sigma_yaw_per_rad = 0.2;
   double sigma_yaw_per_m = 0.02;
   double sigma_yaw_floor_rad = 0.002;
+  /// The search before ICP for a prior too uncertain for ICP alone.
+  IcpOdometrySearchOptions search;
 
   /// One message per broken rule (prefixed "icp_odometry."; the ICP and point options' own).
   std::vector<std::string> Validate() const;
@@ -83,6 +114,8 @@ struct IcpOdometryCounts {
   int degenerate = 0;
   int failed = 0;
   int no_points = 0;
+  int searched = 0;       ///< scans searched correlatively before ICP
+  int search_chosen = 0;  ///< ... whose searched match replaced the one from the prior
 };
 
 /// Scan-to-local-map ICP odometry with the wheel odometry as the prior: each scan is matched by
@@ -104,6 +137,9 @@ class IcpOdometry {
   IcpOdometryStep Add(const LaserScan& scan, const std::vector<Pose2>& increments);
 
   const Pose2& pose() const { return pose_; }
+  /// The odometry's noise as measured so far, in units of the noise model's sigma (x and y, yaw):
+  /// 1 until clear matches say the prior is worse than the model.
+  const Eigen::Vector2d& noise_scale() const { return noise_scale_; }
   const IcpOdometryCounts& counts() const { return counts_; }
   /// Points of the current local map, odom frame.
   const std::vector<Eigen::Vector2d>& local_map() const;
@@ -117,10 +153,24 @@ class IcpOdometry {
   /// them (IcpOdometryStep::frame_weights).
   std::pair<int, std::vector<KeyframeShareOf>> AddKeyframe(
       const std::vector<Eigen::Vector2d>& points_base);
+  /// The noise model's standard deviations (x and y, yaw) of `increment`.
+  Eigen::Vector2d ModelSigmas(const Pose2& increment) const;
+  /// The increment's noise model, scaled by the measured noise, in the previous base frame.
   Eigen::Matrix3d IncrementCovariance(const Pose2& increment) const;
-  /// The local map's match from `prior`, or nothing when it fails the score or correction gates.
+  /// The search window (x and y, yaw) of `increment`'s prior: +-sigmas of its measured noise.
+  Eigen::Vector2d SearchWindow(const Pose2& increment) const;
+  /// The better of `from_prior` (ICP's match from `prior`, nothing when it failed) and a
+  /// correlative search within `window` of `prior` refined by ICP, when the window is beyond ICP's
+  /// basin or ICP failed.
+  std::optional<MatchResult> SearchedMatch(const std::vector<Eigen::Vector2d>& points,
+                                           const Pose2& prior, const Eigen::Vector2d& window,
+                                           std::optional<MatchResult> from_prior);
+  /// Updates noise_scale_ from a clear match's correction of the prior.
+  void MeasureNoise(const Pose2& prior, const Pose2& matched, const Pose2& increment);
+  /// The local map's match from `prior`, or nothing when it fails the score or the correction
+  /// gates (max_correction_m and _rad, or `window` where that is wider).
   std::optional<MatchResult> GatedMatch(const std::vector<Eigen::Vector2d>& points,
-                                        const Pose2& prior) const;
+                                        const Pose2& prior, const Eigen::Vector2d& window) const;
 
   IcpOdometryOptions options_;
   Pose2 pose_;
@@ -130,6 +180,12 @@ class IcpOdometry {
   LocalMapPoints map_;              // the matcher's reference, with each point's keyframe
   int next_keyframe_id_ = 0;
   std::optional<IcpMatcher> matcher_;
+  // The local map's raster and its correlative matcher, built when a search first needs them
+  // after each keyframe.
+  std::optional<PointRaster> raster_;
+  std::optional<CorrelativeMatcher> searcher_;
+  Eigen::Vector2d noise_scale_{1.0, 1.0};
+  Eigen::Vector2d noise_mean_size_{1.0, 1.0};
   IcpOdometryCounts counts_;
 };
 

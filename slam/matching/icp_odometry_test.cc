@@ -75,6 +75,43 @@ TEST(IcpOdometryTest, DriftsMuchLessThanOdometryRoundTheOffice) {
   EXPECT_LE(static_cast<int>(icp.local_map().size()), 10 * 1081);
 }
 
+// Odometry far worse than the noise model (a tenth of each step's length and a third of each
+// turn, 1-sigma, beyond ICP's basin on the turns): the search before ICP, with its window from the
+// noise it measures, keeps the lap; ICP alone from the same prior loses it.
+TEST(IcpOdometryTest, SearchesBeyondIcpsBasinWhenTheOdometryIsPoor) {
+  const SegmentWorld world = SegmentWorld::Office();
+  std::vector<Pose2> truth;
+  const std::vector<Pose2> loop = OfficeLoop();
+  for (std::size_t k = 0; k < loop.size(); k += 4) truth.push_back(loop[k]);
+  auto run = [&](double sigmas) {
+    RandomEngine rng(23);
+    IcpOdometryOptions options;
+    options.search.sigmas = sigmas;
+    IcpOdometry icp(options);
+    std::vector<Pose2> estimate;
+    for (std::size_t k = 0; k < truth.size(); ++k) {
+      Pose2 increment;
+      if (k > 0) {
+        const Pose2 step = truth[k - 1].Between(truth[k]);
+        const Eigen::Vector3d n = StandardNormal3(rng);
+        const double d = step.translation().norm();
+        increment = step * Pose2(0.1 * d * n.x(), 0.1 * d * n.y(),
+                                 (std::abs(step.theta()) / 3.0 + 0.02) * n.z());
+      }
+      estimate.push_back(
+          icp.Add(world.Scan(truth[k], Time(), RangeFinderSpec{}, &rng), increment).pose);
+    }
+    return std::make_pair(PositionRmse(estimate, truth), icp.counts());
+  };
+  const auto [searched_rmse, searched] = run(3.0);
+  const auto [icp_rmse, icp_only] = run(0.0);
+  EXPECT_EQ(icp_only.searched, 0);
+  EXPECT_GT(searched.searched, 0);
+  EXPECT_GT(searched.search_chosen, 0);
+  EXPECT_LT(searched_rmse, 0.05);
+  EXPECT_GT(icp_rmse, 4.0 * searched_rmse);
+}
+
 // In a featureless corridor the match is degenerate along the axis: the pose follows odometry
 // along it and the scans across it, and every such scan is counted.
 TEST(IcpOdometryTest, FallsBackToOdometryAlongADegenerateCorridor) {

@@ -30,6 +30,21 @@ void VisitFields(V& v, IcpOptions& o) {
   v("min_correspondences", o.min_correspondences);
 }
 
+/// The field table of IcpOdometrySearchOptions.
+template <typename V>
+void VisitFields(V& v, IcpOdometrySearchOptions& o) {
+  v("sigmas", o.sigmas);
+  v("trigger_window_m", o.trigger_window_m);
+  v("trigger_window_rad", o.trigger_window_rad);
+  v("max_window_m", o.max_window_m);
+  v("max_window_rad", o.max_window_rad);
+  v("resolution_m", o.resolution_m);
+  v("blur_m", o.blur_m);
+  v("min_gain", o.min_gain);
+  v("prior_weight", o.prior_weight);
+  v("adapt_rate", o.adapt_rate);
+}
+
 /// The field table of IcpOdometryOptions.
 template <typename V>
 void VisitFields(V& v, IcpOdometryOptions& o) {
@@ -50,6 +65,7 @@ void VisitFields(V& v, IcpOdometryOptions& o) {
   v("sigma_yaw_per_rad", o.sigma_yaw_per_rad);
   v("sigma_yaw_per_m", o.sigma_yaw_per_m);
   v("sigma_yaw_floor_rad", o.sigma_yaw_floor_rad);
+  v.Struct("search", o.search);
 }
 
 /// The field table of CorrelativeMatcherOptions (the windows of a loop search are set per

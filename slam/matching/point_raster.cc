@@ -1,0 +1,67 @@
+#include "slam/matching/point_raster.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <set>
+#include <utility>
+
+namespace slamrig::slam {
+
+PointRaster RasterOf(const std::vector<Eigen::Vector2d>& points, double resolution_m,
+                     double sigma_m) {
+  PointRaster raster;
+  Eigen::Vector2d lo = points.front(), hi = points.front();
+  for (const Eigen::Vector2d& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const int reach = static_cast<int>(std::ceil(3.0 * sigma_m / resolution_m));
+  const double margin = (reach + 1) * resolution_m;
+  lo -= Eigen::Vector2d::Constant(margin);
+  hi += Eigen::Vector2d::Constant(margin);
+  const int width = static_cast<int>(std::ceil((hi.x() - lo.x()) / resolution_m));
+  const int height = static_cast<int>(std::ceil((hi.y() - lo.y()) / resolution_m));
+  raster.values.assign(static_cast<std::size_t>(width) * height, 0.0f);
+  const double inv_two_var = 1.0 / (2.0 * sigma_m * sigma_m);
+  for (const Eigen::Vector2d& p : points) {
+    const int cx = static_cast<int>(std::floor((p.x() - lo.x()) / resolution_m));
+    const int cy = static_cast<int>(std::floor((p.y() - lo.y()) / resolution_m));
+    for (int iy = std::max(0, cy - reach); iy <= std::min(height - 1, cy + reach); ++iy) {
+      for (int ix = std::max(0, cx - reach); ix <= std::min(width - 1, cx + reach); ++ix) {
+        const Eigen::Vector2d center = lo + resolution_m * Eigen::Vector2d(ix + 0.5, iy + 0.5);
+        const auto value = static_cast<float>(std::exp(-(center - p).squaredNorm() * inv_two_var));
+        float& cell = raster.values[static_cast<std::size_t>(iy) * width + ix];
+        cell = std::max(cell, value);
+      }
+    }
+  }
+  raster.view = GridView{raster.values.data(), width, height, lo, resolution_m};
+  return raster;
+}
+
+double RasterScore(const PointRaster& raster, const std::vector<Eigen::Vector2d>& points,
+                   const Pose2& pose) {
+  const GridView& v = raster.view;
+  double sum = 0.0;
+  for (const Eigen::Vector2d& p : points) {
+    const Eigen::Vector2d q = pose * p;
+    sum += v.At(static_cast<int>(std::floor((q.x() - v.origin.x()) / v.resolution)),
+                static_cast<int>(std::floor((q.y() - v.origin.y()) / v.resolution)));
+  }
+  return points.empty() ? 0.0 : sum / static_cast<double>(points.size());
+}
+
+std::vector<Eigen::Vector2d> Thinned(const std::vector<Eigen::Vector2d>& points, double voxel_m) {
+  std::set<std::pair<std::int64_t, std::int64_t>> seen;
+  std::vector<Eigen::Vector2d> kept;
+  for (const Eigen::Vector2d& p : points) {
+    const std::pair<std::int64_t, std::int64_t> key{
+        static_cast<std::int64_t>(std::floor(p.x() / voxel_m)),
+        static_cast<std::int64_t>(std::floor(p.y() / voxel_m))};
+    if (seen.insert(key).second) kept.push_back(p);
+  }
+  return kept;
+}
+
+}  // namespace slamrig::slam
