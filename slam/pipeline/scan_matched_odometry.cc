@@ -19,6 +19,9 @@ IcpOdometryOptions WideGates() {
   o.sigma_xy_floor_m = 0.05;
   o.sigma_yaw_per_rad = 0.2;
   o.sigma_yaw_floor_rad = 0.02;
+  // Its search is the candidates below (Add's several increments); the search around one prior
+  // on top of them places intel without odometry worse (dead reckoning 19.3 m, not 12.2 m).
+  o.search.sigmas = 0.0;
   return o;
 }
 
