@@ -334,8 +334,10 @@ void RunRecorder::FinishConfig(const ScenarioResult& result, const ConfigResult&
     slam::EncodePath(end, frame, c.estimate.poses(), &buffer_);
     Write("/" + c.name + "/path", RosType::kPath, end);
   }
-  if (!c.run.loop_closures.empty() && c.estimate.size() > 0) {
-    // Loop closures between the final poses, judged against the truth where there is one.
+  if ((!c.run.loop_closures.empty() || !c.run.rejected_loop_closures.empty()) &&
+      c.estimate.size() > 0) {
+    // Loop closures between the final poses, judged against the truth where there is one, and
+    // the candidates the estimator rejected.
     RosMarker loops = Marker(end, frame, "loop_closures", 2, RosMarker::kLineList);
     loops.scale = {0.04, 0, 0};
     loops.color = kOrange;
@@ -361,7 +363,18 @@ void RunRecorder::FinishConfig(const ScenarioResult& result, const ConfigResult&
                          &buffer_);
       late->push_back({at, "/events", RosType::kString, false, buffer_});
     }
-    slam::EncodeMarkerArray(std::vector<RosMarker>{loops}, &buffer_);
+    RosMarker rejected = Marker(end, frame, "rejected_loop_closures", 3, RosMarker::kLineList);
+    rejected.scale = {0.02, 0, 0};
+    rejected.color = kGrey;
+    for (const slam::LoopClosure& l : c.run.rejected_loop_closures) {
+      if (l.from_scan < 0 || l.to_scan < 0 || static_cast<std::size_t>(l.to_scan) >= poses.size() ||
+          static_cast<std::size_t>(l.from_scan) >= poses.size()) {
+        continue;
+      }
+      rejected.points.push_back(poses[static_cast<std::size_t>(l.from_scan)].pose.translation());
+      rejected.points.push_back(poses[static_cast<std::size_t>(l.to_scan)].pose.translation());
+    }
+    slam::EncodeMarkerArray(std::vector<RosMarker>{loops, rejected}, &buffer_);
     Write("/" + c.name + "/graph", RosType::kMarkerArray, end);
   }
   if (!c.run.landmarks.landmarks.empty()) {

@@ -195,7 +195,7 @@ for await (const m of reader.readMessages()) {
   if (stamp !== undefined && stamp !== m.logTime && !channel.topic.endsWith("/path")) {
     fail(`${where} (${channel.topic}): stamp ${stamp} != log time ${m.logTime}`);
   }
-  if (/\/pose$|\/path$|^\/tf$|\/map$|\/error$/.test(channel.topic) || channel.topic === "/tf_static" ||
+  if (/\/pose$|\/path$|^\/tf$|\/map$|\/error$|\/graph$/.test(channel.topic) || channel.topic === "/tf_static" ||
       t.msgs.length === 0) {
     t.msgs.push({ logTime: m.logTime, msg });
   }
@@ -320,6 +320,12 @@ for (const c of configs) {
   for (const [topic, t] of topics) {
     if (topic === `/${c}/particles`) expectType(topic, "geometry_msgs/msg/PoseArray");
     if (topic === `/${c}/graph` || topic === `/${c}/landmarks`) expectType(topic, "visualization_msgs/msg/MarkerArray");
+    if (topic === `/${c}/graph` && m.rejected !== undefined) {
+      // The last graph message carries every rejected candidate as one line.
+      const last = t.msgs.at(-1)?.msg.markers.find((k) => k.ns === "rejected_loop_closures");
+      const lines = (last?.points.length ?? 0) / 2;
+      if (lines !== m.rejected) fail(`/${c}/graph: ${lines} rejected candidates drawn, ${m.rejected} in metrics.json`);
+    }
     if (topic.startsWith(`/${c}/health/`)) {
       expectType(topic, "std_msgs/msg/Float64");
       if (t.count !== online.length) fail(`${topic}: ${t.count} messages for ${online.length} scans`);

@@ -301,6 +301,8 @@ void GraphSlam::SearchLoops() {
     std::optional<PoseGraphEdge> edge = TryClosure(j, variance[j]);
     if (!edge) {
       ++counts_.rejected;
+      rejected_.push_back(
+          {nodes_[j].scan, nodes_[current].scan, graph_.pose(j).Between(graph_.pose(current))});
       continue;
     }
     AcceptClosure(*edge, {nodes_[j].scan, nodes_[current].scan, edge->measurement});

@@ -70,6 +70,9 @@ class GraphSlam {
   /// The accepted loop closures the back end keeps (all of them, or with switchable constraints
   /// those whose switch is on).
   std::vector<LoopClosure> loop_closures() const;
+  /// The candidates that failed their match or a check, each with the graph's relative pose
+  /// between the two scans when it was tried.
+  const std::vector<LoopClosure>& rejected_closures() const { return rejected_; }
   const GraphSlamCounts& counts() const { return counts_; }
   const PoseGraph& graph() const { return graph_; }
 
@@ -112,6 +115,7 @@ class GraphSlam {
   std::vector<Pose2> scan_from_node_;            // each scan in its node's frame
   std::vector<Eigen::Vector2d> edge_variances_;  // (xy, yaw) of each graph edge, in order
   std::vector<LoopClosure> closures_;
+  std::vector<LoopClosure> rejected_;
   std::vector<std::size_t> closure_edges_;  // graph edge of each closure
   std::vector<double> switches_;            // of each graph edge, from the last optimisation
   GraphSlamCounts counts_;

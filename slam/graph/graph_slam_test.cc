@@ -91,6 +91,7 @@ struct IdenticalRoomsRun {
   GraphSlamCounts counts;
   std::vector<LoopClosure> closures;
   LoopClosureScore score;
+  std::vector<LoopClosure> rejected;
 };
 
 // Two identical rooms 8 m apart. The robot circles room A twice, moves to room B (honest
@@ -132,7 +133,8 @@ IdenticalRoomsRun RunIdenticalRooms(GraphSlamOptions options) {
   slam.Finish();
   std::vector<Pose2> reference;
   for (const Pose2& t : truth) reference.push_back(truth[0].Between(t));
-  return {slam.counts(), slam.loop_closures(), ScoreLoopClosures(slam.loop_closures(), reference)};
+  return {slam.counts(), slam.loop_closures(), ScoreLoopClosures(slam.loop_closures(), reference),
+          slam.rejected_closures()};
 }
 
 // The chi2 gate must reject the aliased closures, as they disagree with the graph by far more
@@ -145,6 +147,14 @@ TEST(GraphSlamTest, IdenticalRoomsYieldNoFalseClosure) {
   for (const LoopClosure& c : run.closures) {
     EXPECT_EQ(c.from_scan < 80, c.to_scan < 80) << c.from_scan << " -> " << c.to_scan;
   }
+  // Every rejected candidate is reported, older scan first; room B against room A among them.
+  ASSERT_EQ(static_cast<int>(run.rejected.size()), run.counts.rejected);
+  bool aliased = false;
+  for (const LoopClosure& c : run.rejected) {
+    EXPECT_LT(c.from_scan, c.to_scan);
+    aliased = aliased || (c.from_scan < 80 && c.to_scan >= 80);
+  }
+  EXPECT_TRUE(aliased);
 }
 
 // With the chi2 gate against the graph opened wide, the aliased closures get through on their

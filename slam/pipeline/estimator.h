@@ -106,6 +106,9 @@ class Estimator {
   virtual std::map<std::string, double> Statistics() const { return {}; }
   /// The loop closures it accepted (scan indices in AddScan order), for scoring; default none.
   virtual std::vector<LoopClosure> LoopClosures() const { return {}; }
+  /// The loop-closure candidates it matched and rejected (a failed match or check), for the
+  /// recording; default none.
+  virtual std::vector<LoopClosure> RejectedLoopClosures() const { return {}; }
   /// The landmark map and the sightings behind it (landmark estimators); default none.
   virtual LandmarkMap Landmarks() const { return {}; }
   /// Extras for the live view.

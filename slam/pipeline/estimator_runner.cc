@@ -100,6 +100,7 @@ EstimatorRun EstimatorRunner::TakeResult() {
   run_.statistics = estimator_->Statistics();
   CheckDeclaredStatistics(config_.algorithm, run_.statistics);
   run_.loop_closures = estimator_->LoopClosures();
+  run_.rejected_loop_closures = estimator_->RejectedLoopClosures();
   run_.landmarks = estimator_->Landmarks();
   run_.map = estimator_->map();
   run_.gyro_fallbacks = sync_.gyro_fallbacks();

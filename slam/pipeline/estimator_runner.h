@@ -35,6 +35,7 @@ struct EstimatorRun {
   std::map<std::string, std::vector<double>> traces;       ///< per-scan values by name
   std::map<std::string, double> statistics;                ///< Estimator::Statistics() at the end
   std::vector<LoopClosure> loop_closures;                  ///< Estimator::LoopClosures() at the end
+  std::vector<LoopClosure> rejected_loop_closures;         ///< Estimator::RejectedLoopClosures()
   LandmarkMap landmarks;                                   ///< Estimator::Landmarks() at the end
   OccupancyGrid map{OccupancyGridOptions{}};               ///< the final map
   OdometrySource odometry_source = OdometrySource::kNone;  ///< the odometry used

@@ -47,6 +47,9 @@ class GraphSlamEstimator final : public Estimator {
   /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
   static const std::vector<std::string>& StatisticNames();
   std::vector<LoopClosure> LoopClosures() const override { return slam_.loop_closures(); }
+  std::vector<LoopClosure> RejectedLoopClosures() const override {
+    return slam_.rejected_closures();
+  }
   /// The graph's odometry and loop-closure edges at the current estimate.
   EstimatorView View() const override;
 
