@@ -31,18 +31,20 @@ std::string RunLink(std::size_t index) {
 }
 
 std::string LeaderboardTable(const Leaderboard& board) {
-  std::string h = "<table><tr><th>estimator</th><th>failures</th>";
+  std::string h = "<table><tr><th>estimator</th><th>silent failures</th><th>failures</th>";
   for (const std::string& d : board.datasets) h += "<th>" + EscapeHtml(d) + "</th>";
   h += "</tr>";
   for (std::size_t e = 0; e < board.estimators.size(); ++e) {
-    int runs = 0, failures = 0;
+    int runs = 0, failures = 0, silent = 0;
     for (const LeaderboardCell& c : board.cells[e]) {
       runs += c.runs;
       failures += c.failures;
+      silent += c.silent;
     }
     h += "<tr><th>" + EscapeHtml(board.estimators[e]) + "</th><td class=\"" +
-         (failures > 0 ? "fail" : "pass") + "\">" + std::to_string(failures) + " of " +
-         std::to_string(runs) + "</td>";
+         (silent > 0 ? "fail" : "pass") + "\">" + std::to_string(silent) + " of " +
+         std::to_string(runs) + "</td><td class=\"" + (failures > 0 ? "fail" : "pass") + "\">" +
+         std::to_string(failures) + " of " + std::to_string(runs) + "</td>";
     for (const LeaderboardCell& c : board.cells[e]) {
       if (c.runs == 0) {
         h += "<td class=\"none\">not run</td>";
@@ -125,7 +127,8 @@ Leaderboard BuildLeaderboard(const BenchmarkSuite& suite, const std::vector<std:
     return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
   };
   const std::size_t id_col = column("run"), status_col = column("status"),
-                    failure_col = column("failure"), ate_col = column("ate_rmse_m");
+                    failure_col = column("failure"), ate_col = column("ate_rmse_m"),
+                    diverged_col = column("diverged");
   const std::vector<BenchmarkRun> runs = ExpandBenchmark(suite);
   std::map<std::string, std::size_t> index_of;
   for (std::size_t i = 0; i < runs.size(); ++i) index_of[runs[i].id] = i;
@@ -139,7 +142,10 @@ Leaderboard BuildLeaderboard(const BenchmarkSuite& suite, const std::vector<std:
     ++cell.runs;
     BenchmarkCase c{found->second, row[id_col], row[status_col], row[failure_col],
                     CsvNumber(row[ate_col])};
-    if (c.status != "pass") ++cell.failures;
+    if (c.status != "pass") {
+      ++cell.failures;
+      if (diverged_col >= header.size() || row[diverged_col] != "1") ++cell.silent;
+    }
     if (std::isfinite(c.ate_rmse_m)) cell.ate.push_back(c.ate_rmse_m);
     cases.push_back(std::move(c));
   }

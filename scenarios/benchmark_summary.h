@@ -10,8 +10,10 @@ namespace slamrig::scenario {
 
 /// One estimator on one dataset family: its runs' ATE distribution and failures.
 struct LeaderboardCell {
-  int runs = 0;                               ///< rows in results.csv
-  int failures = 0;                           ///< status other than pass
+  int runs = 0;      ///< rows in results.csv
+  int failures = 0;  ///< status other than pass
+  /// Failures the estimator did not itself report (its `diverged` verdict not 1): silent ones.
+  int silent = 0;
   std::vector<double> ate;                    ///< ATE RMSE of the runs that have one, ascending
   double median = 0.0, p90 = 0.0, max = 0.0;  ///< of `ate` (linear interpolation); 0 when empty
 };

@@ -145,18 +145,24 @@ TEST(BenchmarkSummaryTest, LeaderboardGroupsByEstimatorAndDatasetWithFailuresFir
   testing::TempDir dir;
   const BenchmarkSuite suite = LoadBenchmarkSuite(dir.Write("suite.yaml", kSuite));
   const std::vector<std::string>& header = BenchmarkHeader();
-  auto row = [&](const std::string& id, const std::string& status, const std::string& ate) {
+  const auto diverged_col = static_cast<std::size_t>(
+      std::find(header.begin(), header.end(), "diverged") - header.begin());
+  ASSERT_LT(diverged_col, header.size());
+  auto row = [&](const std::string& id, const std::string& status, const std::string& ate,
+                 const std::string& diverged = "") {
     std::vector<std::string> r(header.size());
     r[0] = id;
     r[4] = status;
     r[5] = status == "pass" ? "" : "why";
     r[6] = ate;
+    r[diverged_col] = diverged;
     return r;
   };
   const std::vector<std::vector<std::string>> rows = {
       row("small seed=3 pf", "pass", "0.1"),    row("small seed=4 pf", "pass", "0.3"),
       row("small seed=5 pf", "fail", "2.5"),    row("small seed=3 graph", "pass", "0.05"),
-      row("small seed=4 graph", "timeout", ""), row("not in the suite", "pass", "9"),
+      row("small seed=4 graph", "fail", "3", "1"), row("small seed=5 graph", "timeout", ""),
+      row("not in the suite", "pass", "9"),
   };
   const Leaderboard board = BuildLeaderboard(suite, header, rows);
   ASSERT_EQ(board.estimators, (std::vector<std::string>{"pf", "graph"}));
@@ -164,20 +170,22 @@ TEST(BenchmarkSummaryTest, LeaderboardGroupsByEstimatorAndDatasetWithFailuresFir
   const LeaderboardCell& pf = board.cells[0][0];
   EXPECT_EQ(pf.runs, 3);
   EXPECT_EQ(pf.failures, 1);
+  EXPECT_EQ(pf.silent, 1);  // pf gives no verdict: its failure is silent
   EXPECT_DOUBLE_EQ(pf.median, 0.3);
   EXPECT_DOUBLE_EQ(pf.p90, 0.3 + 0.8 * 2.2);
   EXPECT_DOUBLE_EQ(pf.max, 2.5);
   const LeaderboardCell& graph = board.cells[1][0];
-  EXPECT_EQ(graph.runs, 2);
-  EXPECT_EQ(graph.failures, 1);
-  EXPECT_EQ(graph.ate, std::vector<double>{0.05});
+  EXPECT_EQ(graph.runs, 3);
+  EXPECT_EQ(graph.failures, 2);
+  EXPECT_EQ(graph.silent, 1);  // the timeout; the other failure said it had diverged
+  EXPECT_EQ(graph.ate, (std::vector<double>{0.05, 3.0}));
   EXPECT_EQ(board.cells[0][1].runs, 0);
-  EXPECT_EQ(board.missing, 8 - 5);
-  ASSERT_EQ(board.worst.size(), 5u);
-  EXPECT_EQ(board.worst[0].id, "small seed=4 graph");  // failed without an ATE: the worst
-  EXPECT_EQ(board.worst[0].run_index, 3u);
-  EXPECT_EQ(board.worst[1].id, "small seed=5 pf");  // failed, ATE 2.5
-  EXPECT_EQ(board.worst[2].id, "small seed=4 pf");  // passed, the largest ATE
+  EXPECT_EQ(board.missing, 8 - 6);
+  ASSERT_EQ(board.worst.size(), 6u);
+  EXPECT_EQ(board.worst[0].id, "small seed=5 graph");  // failed without an ATE: the worst
+  EXPECT_EQ(board.worst[1].id, "small seed=4 graph");  // failed, ATE 3
+  EXPECT_EQ(board.worst[2].id, "small seed=5 pf");     // failed, ATE 2.5
+  EXPECT_EQ(board.worst[3].id, "small seed=4 pf");     // passed, the largest ATE
 }
 
 }  // namespace

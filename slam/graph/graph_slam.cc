@@ -12,6 +12,7 @@
 #include <set>
 #include <utility>
 
+#include "slam/graph/edge_error.h"
 #include "slam/graph/optimality_certificate.h"
 #include "slam/matching/correlative_matcher.h"
 #include "slam/matching/grid_view.h"
@@ -65,6 +66,7 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
       .Positive("loop_sigma_xy_floor_m", loop_sigma_xy_floor_m)
       .Positive("loop_sigma_yaw_floor_rad", loop_sigma_yaw_floor_rad)
       .AtLeast("optimize_every_keyframes", optimize_every_keyframes, 1)
+      .Fraction("diverged_strained_share", diverged_strained_share)
       .Nested("optimizer", optimizer.Validate());
   return rules.errors();
 }
@@ -106,6 +108,23 @@ Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment) {
 void GraphSlam::Finish() {
   if (pending_closure_) Optimize();
   CheckOptimality();
+  JudgeConsistency();
+}
+
+void GraphSlam::JudgeConsistency() {
+  // chi2 with 3 degrees of freedom: its 99 % quantile.
+  constexpr double kChi2Dof3P99 = 11.3449;
+  int kept = 0, strained = 0;
+  const std::vector<PoseGraphEdge>& edges = graph_.edges();
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    if (e < switches_.size() && switches_[e] < 0.5) continue;  // the back end switched it off
+    const Eigen::Vector3d error = EdgeError(graph_, edges[e]);
+    ++kept;
+    if (error.dot(edges[e].information * error) > kChi2Dof3P99) ++strained;
+  }
+  counts_.strained_edges = strained;
+  counts_.diverged =
+      kept > 0 && static_cast<double>(strained) > options_.diverged_strained_share * kept;
 }
 
 void GraphSlam::CheckOptimality() {

@@ -49,6 +49,11 @@ struct GraphSlamCounts {
   /// or when it could not be computed).
   bool certified = false;
   double certificate_lambda_min = std::numeric_limits<double>::quiet_NaN();
+  /// After Finish(): edges kept in the graph whose chi2 at the final poses exceeds chi2_3's 99 %
+  /// quantile, and the estimator's own verdict from them (options' diverged_strained_share):
+  /// the graph contradicts its own measurements, so the estimate is not to be trusted.
+  int strained_edges = 0;
+  bool diverged = false;
 };
 
 /// Online graph SLAM over laser scans with an odometry increment each. Deterministic; not
@@ -105,6 +110,8 @@ class GraphSlam {
   void Optimize();
   // The optimality certificate of the current solution, into counts_.
   void CheckOptimality();
+  // The strained edges and the diverged verdict at the current poses, into counts_.
+  void JudgeConsistency();
 
   GraphSlamOptions options_;
   IcpOdometry odometry_;

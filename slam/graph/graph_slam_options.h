@@ -121,6 +121,12 @@ struct GraphSlamOptions {
   double loop_sigma_yaw_floor_rad = 0.005;
   /// Optimise when a closure was accepted and this many nodes were added since the last run.
   int optimize_every_keyframes = 10;
+  /// Self-diagnosis after the final optimisation: an edge is strained when its chi2 exceeds the
+  /// 99 % quantile of chi2 with 3 dof (11.34); the estimate is judged diverged when more than
+  /// this share of the edges kept in the graph are strained (a consistent graph has about 1 %,
+  /// fewer with the conservative default noise model; a front end that drifted and then closed a
+  /// loop strains every edge between).
+  double diverged_strained_share = 0.05;
   /// The back end; Cauchy on loop closures only, by default.
   PoseGraphOptimizerOptions optimizer = {
       .max_iterations = 50, .robust_loss = RobustLoss::kCauchy, .robust_loss_scale = 1.0};
@@ -170,6 +176,7 @@ void VisitFields(V& v, GraphSlamOptions& o) {
   v("loop_sigma_xy_floor_m", o.loop_sigma_xy_floor_m);
   v("loop_sigma_yaw_floor_rad", o.loop_sigma_yaw_floor_rad);
   v("optimize_every_keyframes", o.optimize_every_keyframes);
+  v("diverged_strained_share", o.diverged_strained_share);
   v.Struct("optimizer", o.optimizer);
 }
 

@@ -78,6 +78,8 @@ TEST(GraphSlamTest, ClosesTheOfficeLoopAndBeatsOdometry) {
   // The final solution passes the optimality check (a low-noise graph: the relaxation is tight).
   EXPECT_TRUE(slam.counts().certified);
   EXPECT_TRUE(std::isfinite(slam.counts().certificate_lambda_min));
+  // A consistent graph: it does not call itself diverged.
+  EXPECT_FALSE(slam.counts().diverged) << slam.counts().strained_edges << " strained edges";
 
   // Every accepted closure agrees with the truth.
   std::vector<Pose2> reference;
@@ -165,6 +167,9 @@ TEST(GraphSlamTest, PairwiseConsistencyRejectsAliasedClosuresWithoutTheGate) {
   options.loop_chi2_gate = 1e9;
   const IdenticalRoomsRun open = RunIdenticalRooms(options);
   ASSERT_GT(open.score.false_closures, 0);  // the gate was what kept them out
+  // The false closures pull room B onto room A against the odometry: the graph says so.
+  EXPECT_GT(open.counts.strained_edges, 0);
+  EXPECT_TRUE(open.counts.diverged) << open.counts.strained_edges << " strained edges";
 
   options.loop_consistency = LoopConsistency::kPairwise;
   const IdenticalRoomsRun pairwise = RunIdenticalRooms(options);

@@ -49,9 +49,10 @@ EstimatorView GraphSlamEstimator::View() const {
 
 const std::vector<std::string>& GraphSlamEstimator::StatisticNames() {
   static const std::vector<std::string> names = {
-      "keyframes",     "loop_closures", "loop_candidates",       "rejected",
-      "optimizations", "final_chi2",    "switched_off",          "odometry_rematched",
-      "inconsistent",  "certified",     "certificate_lambda_min"};
+      "keyframes",     "loop_closures", "loop_candidates",        "rejected",
+      "optimizations", "final_chi2",    "switched_off",           "odometry_rematched",
+      "inconsistent",  "certified",     "certificate_lambda_min", "strained_edges",
+      "diverged"};
   return names;
 }
 
@@ -67,7 +68,9 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"odometry_rematched", c.odometry_rematched},
           {"inconsistent", c.inconsistent},
           {"certified", c.certified ? 1.0 : 0.0},
-          {"certificate_lambda_min", c.certificate_lambda_min}};
+          {"certificate_lambda_min", c.certificate_lambda_min},
+          {"strained_edges", c.strained_edges},
+          {"diverged", c.diverged ? 1.0 : 0.0}};
 }
 
 }  // namespace slamrig::slam
