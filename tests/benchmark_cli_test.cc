@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -57,10 +58,19 @@ TEST(BenchmarkCliTest, RunsEveryPairResumesAndReproduces) {
   const auto rows = Rows(dir.File("a/results.csv"));
   ASSERT_EQ(rows.size(), 1u + 6u);  // header, (2 offices + intel) x 2 estimators
   EXPECT_EQ(rows[0][0], "run");
+  auto column = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(rows[0].begin(), rows[0].end(), name) -
+                                    rows[0].begin());
+  };
+  const std::size_t diverged = column("diverged"), baseline = column("dead_reckoning_ate_rmse_m");
+  ASSERT_LT(diverged, rows[0].size());
+  ASSERT_LT(baseline, rows[0].size());
   for (std::size_t i = 1; i < rows.size(); ++i) {
     EXPECT_EQ(rows[i][4], "pass") << rows[i][0] << ": " << rows[i][5];
-    EXPECT_FALSE(rows[i][6].empty()) << rows[i][0];   // an ATE
-    EXPECT_FALSE(rows[i][12].empty()) << rows[i][0];  // dead reckoning's on the same data
+    EXPECT_FALSE(rows[i][6].empty()) << rows[i][0];         // an ATE
+    EXPECT_FALSE(rows[i][baseline].empty()) << rows[i][0];  // dead reckoning's on the same data
+    // The graph's own verdict (0 on these clean runs); none from the particle filter.
+    EXPECT_EQ(rows[i][diverged], rows[i][3] == "graph" ? "0" : "") << rows[i][0];
   }
   const std::string summary = Read(dir.File("a/summary.html"));
   EXPECT_NE(summary.find("Leaderboard"), std::string::npos);
