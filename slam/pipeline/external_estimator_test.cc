@@ -88,7 +88,9 @@ TEST(ExternalEstimatorTest, StreamOptionsAreReadAndChecked) {
   const YamlNode node = YamlNode::LoadString(
       "algorithm: external\ncommand: [x, \"--seed={seed}\"]\nmode: stream\nanswer_timeout_s: 2\n",
       "s.yaml");
-  const ExternalEstimatorOptions& o = OptionsOf(ParseEstimatorConfig("mine", node));
+  // The config owns the options: kept alive for as long as `o` is read.
+  const EstimatorConfig config = ParseEstimatorConfig("mine", node);
+  const ExternalEstimatorOptions& o = OptionsOf(config);
   EXPECT_EQ(o.mode, ExternalMode::kStream);
   EXPECT_EQ(o.answer_timeout_s, 2.0);
   EXPECT_THAT(Error("algorithm: external\ncommand: [x]\nmode: online\n"),
