@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
+#include <utility>
 
 #include "slam/io/bag/ros_messages.h"
 #include "slam/types/error.h"
@@ -342,19 +344,26 @@ void RunRecorder::FinishConfig(const ScenarioResult& result, const ConfigResult&
     loops.scale = {0.04, 0, 0};
     loops.color = kOrange;
     const auto& poses = c.estimate.poses();
+    // A closure's two scans as indices into the final poses; nothing when either is outside them.
+    auto ends =
+        [&poses](const slam::LoopClosure& l) -> std::optional<std::pair<std::size_t, std::size_t>> {
+      if (l.from_scan < 0 || l.to_scan < 0) return std::nullopt;
+      const auto from = static_cast<std::size_t>(l.from_scan);
+      const auto to = static_cast<std::size_t>(l.to_scan);
+      if (from >= poses.size() || to >= poses.size()) return std::nullopt;
+      return std::pair{from, to};
+    };
     for (std::size_t i = 0; i < c.run.loop_closures.size(); ++i) {
       const slam::LoopClosure& l = c.run.loop_closures[i];
-      if (l.from_scan < 0 || l.to_scan < 0 || static_cast<std::size_t>(l.to_scan) >= poses.size() ||
-          static_cast<std::size_t>(l.from_scan) >= poses.size()) {
-        continue;
-      }
+      const auto scans = ends(l);
+      if (!scans) continue;
       const RosColor colour =
           i < c.loop_is_true.size() ? (c.loop_is_true[i] ? kGreen : kRed) : kOrange;
-      loops.points.push_back(poses[static_cast<std::size_t>(l.from_scan)].pose.translation());
-      loops.points.push_back(poses[static_cast<std::size_t>(l.to_scan)].pose.translation());
+      loops.points.push_back(poses[scans->first].pose.translation());
+      loops.points.push_back(poses[scans->second].pose.translation());
       loops.colors.push_back(colour);
       loops.colors.push_back(colour);
-      const Time at = poses[static_cast<std::size_t>(l.to_scan)].time;
+      const Time at = poses[scans->second].time;
       slam::EncodeString(c.name + ": loop closure scan " + std::to_string(l.from_scan) + " -> " +
                              std::to_string(l.to_scan) +
                              (i < c.loop_is_true.size()
@@ -367,12 +376,10 @@ void RunRecorder::FinishConfig(const ScenarioResult& result, const ConfigResult&
     rejected.scale = {0.02, 0, 0};
     rejected.color = kGrey;
     for (const slam::LoopClosure& l : c.run.rejected_loop_closures) {
-      if (l.from_scan < 0 || l.to_scan < 0 || static_cast<std::size_t>(l.to_scan) >= poses.size() ||
-          static_cast<std::size_t>(l.from_scan) >= poses.size()) {
-        continue;
-      }
-      rejected.points.push_back(poses[static_cast<std::size_t>(l.from_scan)].pose.translation());
-      rejected.points.push_back(poses[static_cast<std::size_t>(l.to_scan)].pose.translation());
+      const auto scans = ends(l);
+      if (!scans) continue;
+      rejected.points.push_back(poses[scans->first].pose.translation());
+      rejected.points.push_back(poses[scans->second].pose.translation());
     }
     slam::EncodeMarkerArray(std::vector<RosMarker>{loops, rejected}, &buffer_);
     Write("/" + c.name + "/graph", RosType::kMarkerArray, end);
