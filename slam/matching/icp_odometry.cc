@@ -24,7 +24,7 @@ std::vector<std::string> IcpOdometrySearchOptions::Validate() const {
       .NonNegative("min_gain", min_gain)
       .NonNegative("prior_weight", prior_weight)
       .Fraction("adapt_rate", adapt_rate);
-  return PrefixErrors("search", rules.errors());
+  return rules.errors();
 }
 
 std::vector<std::string> IcpOdometryOptions::Validate() const {
@@ -45,7 +45,7 @@ std::vector<std::string> IcpOdometryOptions::Validate() const {
       .NonNegative("sigma_yaw_per_rad", sigma_yaw_per_rad)
       .NonNegative("sigma_yaw_per_m", sigma_yaw_per_m)
       .NonNegative("sigma_yaw_floor_rad", sigma_yaw_floor_rad)
-      .Nested("", search.Validate());
+      .Nested("search", search.Validate());
   std::vector<std::string> errors = icp.Validate();
   AppendErrors(&errors, points.Validate());
   AppendErrors(&errors, PrefixErrors("icp_odometry", rules.errors()));

@@ -38,7 +38,7 @@ struct IcpOdometrySearchOptions {
   /// of the squared corrections of clear matches, in units of the noise model's sigma; 0: off.
   double adapt_rate = 0.05;
 
-  /// One message per broken rule (prefixed "search.").
+  /// One message per broken rule (unprefixed; IcpOdometryOptions nests them under "search").
   std::vector<std::string> Validate() const;
 };
 
