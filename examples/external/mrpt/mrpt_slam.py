@@ -1,0 +1,206 @@
+#!/usr/bin/env python3
+"""MRPT's ICP-SLAM or RBPF-SLAM (Debian mrpt-apps) as an external slamrig estimator.
+
+    mrpt_slam.py INPUT.log OUTPUT.tum --method icp|rbpf [--particles N] [--seed S]
+
+slamrig runs it with `input: carmen` (docs/external.md). Its steps, all in the folder
+OUTPUT's folder/mrpt/:
+  1. the CARMEN log's ROBOTLASER1 lines, each scan turned so that it is symmetric about the
+     laser's heading (MRPT spreads a scan's beams over -fov/2..+fov/2), are written to
+     mrpt_input.log and converted by MRPT's carmen2rawlog to an observation-only rawlog;
+  2. rawlog_to_sf.cc (beside this file, compiled once against the Debian MRPT headers into
+     ~/.cache/slamrig-mrpt/) turns it into the action/sensory-frame rawlog that rbpf-slam needs,
+     one entry per scan, each stamped with its scan's time (made strictly increasing: MRPT's
+     odometry filter ignores a reading not later than the one before);
+  3. icp-slam or rbpf-slam runs on it with icp.ini or rbpf.ini (beside this file; headless, no
+     window, no 3D scene), stdout and stderr to mrpt/NAME.out;
+  4. its per-step path log_estimated_path.txt (one pose per entry, so per scan) becomes OUTPUT,
+     a TUM trajectory stamped with the scans' own times (as slamrig asks: one pose per scan).
+
+Any failure: exit code 1 and one line on stderr; OUTPUT is written only when all went well.
+Python 3 standard library only.
+"""
+
+import argparse
+import hashlib
+import math
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+PROGRAMS = {"icp": "icp-slam", "rbpf": "rbpf-slam"}
+
+
+class Failure(Exception):
+    pass
+
+
+def read_scans(path):
+    """The ROBOTLASER1 lines as (time, fields). Any other laser message is refused."""
+    scans = []
+    with open(path) as log:
+        for number, line in enumerate(log, 1):
+            f = line.split()
+            if not f or f[0] in ("PARAM", "ODOM", "TRUEPOS") or f[0].startswith("#"):
+                continue
+            if f[0] != "ROBOTLASER1":
+                raise Failure(f"{path}:{number}: {f[0]}: only ROBOTLASER1 lines carry a scan here")
+            try:
+                n = int(f[8])
+                k = 10 + n + int(f[9 + n])  # the laser pose, after the ranges and remissions
+                if len(f) < k + 12:
+                    raise ValueError(f"{len(f)} fields, {k + 12} needed")
+                scans.append((float(f[k + 11]), f))
+            except (IndexError, ValueError) as e:
+                raise Failure(f"{path}:{number}: ROBOTLASER1: {e}") from None
+    if not scans:
+        raise Failure(f"{path}: no ROBOTLASER1 line (no scans)")
+    return scans
+
+
+def symmetric_line(fields):
+    """A ROBOTLASER1 line whose scan starts at -fov/2: the laser's heading turned to its centre."""
+    f = list(fields)
+    start, fov = float(f[2]), float(f[3])
+    n = int(f[8])
+    k = 10 + n + int(f[9 + n])
+    f[k + 2] = repr(float(f[k + 2]) + start + fov / 2)
+    f[2] = repr(-fov / 2)
+    return " ".join(f) + "\n"
+
+
+def mrpt_times(scans):
+    """The scans' times, each at least 1 us after the one before."""
+    times, last = [], -math.inf
+    for t, _ in scans:
+        last = max(t, last + 1e-6)
+        times.append(last)
+    return times
+
+
+def run(command, log_path):
+    """Runs an MRPT program headless, its output to log_path; a failure names its last line."""
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    with open(log_path, "w") as log:
+        result = subprocess.run(command, stdin=subprocess.DEVNULL, stdout=log,
+                                stderr=subprocess.STDOUT, env=env)
+    if result.returncode != 0:
+        lines = [l.strip() for l in open(log_path, errors="replace") if l.strip()]
+        # An MRPT exception: its "Message:" line says what; the last line is a prompt.
+        lines = [l for l in lines if l.startswith("Message:")] or [
+            l for l in lines if not l.startswith("Press any key")]
+        how = (f"killed by signal {-result.returncode}" if result.returncode < 0
+               else f"exit code {result.returncode}")
+        raise Failure(f"{command[0]}: {how}: {lines[-1] if lines else 'no output'} "
+                      f"(all of it in {log_path})")
+    return open(log_path, errors="replace").read()
+
+
+def rawlog_to_sf():
+    """The converter's binary: SLAMRIG_MRPT_RAWLOG_TO_SF, or rawlog_to_sf.cc compiled once."""
+    if os.environ.get("SLAMRIG_MRPT_RAWLOG_TO_SF"):
+        return os.environ["SLAMRIG_MRPT_RAWLOG_TO_SF"]
+    source = HERE / "rawlog_to_sf.cc"
+    digest = hashlib.sha1(source.read_bytes()).hexdigest()[:12]
+    cache = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "slamrig-mrpt"
+    binary = cache / f"rawlog_to_sf-{digest}"
+    if binary.exists():
+        return str(binary)
+    if not Path("/usr/include/mrpt/obs").is_dir():
+        raise Failure("libmrpt-obs-dev is not installed: apt-get install libmrpt-obs-dev")
+    cache.mkdir(parents=True, exist_ok=True)
+    includes = [f"-I{d}" for d in sorted(Path("/usr/include/mrpt").glob("*/include"))]
+    libs = [f"-lmrpt-{m}" for m in ("obs", "poses", "serialization", "io", "system", "math",
+                                    "rtti", "core")]
+    partial = cache / f"rawlog_to_sf-{digest}.{os.getpid()}"
+    run(["c++", "-std=c++17", "-O2", *includes, "-I/usr/include/eigen3", str(source),
+         "-o", str(partial), *libs], cache / f"rawlog_to_sf-{digest}.build.txt")
+    partial.replace(binary)
+    return str(binary)
+
+
+def read_path(path, count):
+    """log_estimated_path.txt: 'step x y yaw' (icp-slam) or 'step x y z yaw pitch roll t'."""
+    poses = []
+    for number, line in enumerate(open(path), 1):
+        f = line.split()
+        if not f or f[0].startswith("%"):
+            continue
+        try:
+            if len(f) not in (4, 8) or int(f[0]) != len(poses):
+                raise ValueError(f"expected step {len(poses)} with 4 or 8 fields")
+            yaw = float(f[3] if len(f) == 4 else f[4])
+            pose = (float(f[1]), float(f[2]), yaw)
+            if not all(map(math.isfinite, pose)):
+                raise ValueError("not finite")
+        except ValueError as e:
+            raise Failure(f"{path}:{number}: {e}") from None
+        poses.append(pose)
+    if len(poses) != count:
+        raise Failure(f"{path}: {len(poses)} poses for {count} scans")
+    return poses
+
+
+def write_tum(path, scans, poses):
+    partial = path.with_name(path.name + ".partial")
+    with open(partial, "w") as out:
+        for (t, _), (x, y, yaw) in zip(scans, poses):
+            out.write(f"{t:.9f} {x:.9f} {y:.9f} 0 0 0 {math.sin(yaw / 2):.12f} "
+                      f"{math.cos(yaw / 2):.12f}\n")
+    partial.replace(path)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("input")
+    parser.add_argument("output")
+    parser.add_argument("--method", choices=sorted(PROGRAMS), required=True)
+    parser.add_argument("--particles", type=int, default=20, help="rbpf: particles (20)")
+    parser.add_argument("--seed", type=int, default=1, help="rbpf: RANDOM_SEED (1)")
+    args = parser.parse_args()
+    program = PROGRAMS[args.method]
+    try:
+        if args.particles < 1:
+            raise Failure(f"--particles {args.particles}: must be >= 1")
+        for tool in (program, "carmen2rawlog"):
+            if shutil.which(tool) is None:
+                raise Failure("mrpt-apps is not installed: apt-get install mrpt-apps")
+        output = Path(args.output).resolve()
+        work = output.parent / "mrpt"
+        out_dir = work / "out"
+        work.mkdir(parents=True, exist_ok=True)
+        scans = read_scans(args.input)
+
+        with open(work / "mrpt_input.log", "w") as log:
+            log.writelines(symmetric_line(f) for _, f in scans)
+        with open(work / "times.txt", "w") as times:
+            times.writelines(f"{t!r}\n" for t in mrpt_times(scans))
+        run(["carmen2rawlog", "-q", "-w", "-i", str(work / "mrpt_input.log"),
+             "-o", str(work / "obs.rawlog")], work / "carmen2rawlog.out")
+        written = run([rawlog_to_sf(), str(work / "obs.rawlog"), str(work / "times.txt"),
+                       str(work / "sf.rawlog")], work / "rawlog_to_sf.out").split()
+        if written != [str(len(scans))]:
+            raise Failure(f"rawlog_to_sf wrote {' '.join(written)[:40]!r} scans for {len(scans)}")
+
+        values = {"OUT_DIR": str(out_dir), "PARTICLES": str(args.particles),
+                  "SEED": str(args.seed % 2**31)}
+        ini = (HERE / f"{args.method}.ini").read_text()
+        for key, value in values.items():
+            ini = ini.replace(f"@{key}@", value)
+        (work / f"{args.method}.ini").write_text(ini)
+        run([program, str(work / f"{args.method}.ini"), str(work / "sf.rawlog")],
+            work / f"{program}.out")
+
+        poses = read_path(out_dir / "log_estimated_path.txt", len(scans))
+        write_tum(output, scans, poses)
+    except (Failure, OSError) as e:
+        print(f"mrpt_slam.py: {e}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
