@@ -73,8 +73,11 @@ BenchmarkDataset ReadDataset(const YamlNode& node) {
     node.Required("name").Fail("must be a non-empty name without spaces, commas or quotes");
   const auto log = node.Optional("log");
   const auto generate = node.Optional("generate");
-  if (log.has_value() == generate.has_value())
-    node.Fail("needs exactly one of log: (a recorded log) and generate: (generated worlds)");
+  const auto world = node.Optional("world");
+  if (log.has_value() + generate.has_value() + world.has_value() != 1)
+    node.Fail(
+        "needs exactly one of log: (a recorded log), generate: (generated worlds) and world: (a "
+        "world file)");
   if (log) {
     d.log = ResolveLog(*log);
     if (const auto perturb = node.Optional("perturb")) {
@@ -87,11 +90,25 @@ BenchmarkDataset ReadDataset(const YamlNode& node) {
       d.max_scans = static_cast<std::size_t>(n);
     }
   } else {
-    if (generate->Has("seed"))
-      generate->Required("seed").Fail("the worlds' seeds are the dataset's seeds: list them there");
-    const sim::worldgen::GenerateSpec spec = sim::worldgen::ParseGenerateSpec(*generate);
-    generate->ThrowIfInvalid(spec.Validate());
-    d.generate_yaml = generate->ToFlowYaml();
+    if (generate) {
+      if (generate->Has("seed"))
+        generate->Required("seed").Fail(
+            "the worlds' seeds are the dataset's seeds: list them there");
+      const sim::worldgen::GenerateSpec spec = sim::worldgen::ParseGenerateSpec(*generate);
+      generate->ThrowIfInvalid(spec.Validate());
+      d.generate_yaml = generate->ToFlowYaml();
+    } else {
+      d.world = world->ResolvePath(world->As<std::string>());
+      std::error_code error;
+      if (!fs::is_regular_file(d.world, error)) world->Fail("no world file '" + d.world + "'");
+      if (const auto overrides = node.Optional("world_overrides")) {
+        for (const std::string& key : overrides->Keys()) {
+          if (!overrides->Required(key).IsScalar())
+            overrides->Required(key).Fail("a dotted key and a scalar value");
+        }
+        d.world_overrides_yaml = overrides->ToFlowYaml();
+      }
+    }
     if (const auto robot = node.Optional("robot")) {
       const std::string text = robot->As<std::string>();
       const bool is_file =
@@ -168,7 +185,19 @@ BenchmarkSuite LoadBenchmarkSuite(const std::string& path) {
     if (name == kBaselineName && config.algorithm != "dead-reckoning")
       node.Fail(std::string("the name ") + kBaselineName +
                 " is the baseline every run carries; its algorithm must be dead-reckoning");
-    suite.estimators.push_back({name, node.ToFlowYaml()});
+    // A run's scenario lives in its own folder: an external program's ./ and ../ arguments,
+    // relative to the suite, go into it as resolved here.
+    std::string yaml = node.ToFlowYaml();
+    if (config.algorithm == "external") {
+      YAML::Emitter written;
+      slam::WriteEstimatorConfig(config, &written);
+      YAML::Node resolved = YAML::Load(yaml);
+      resolved["command"] = YAML::Load(written.c_str())["command"];
+      YAML::Emitter flow;
+      flow << YAML::Flow << resolved;
+      yaml = flow.c_str();
+    }
+    suite.estimators.push_back({name, yaml});
   }
   if (suite.estimators.empty()) estimators.Fail("needs at least one estimator");
   const YamlNode datasets = root.Required("datasets");
@@ -224,10 +253,16 @@ std::string BenchmarkScenarioYaml(const BenchmarkSuite& suite, const BenchmarkRu
     if (d.max_scans > 0) out << YAML::Key << "max_scans" << YAML::Value << d.max_scans;
     out << YAML::EndMap;
   } else {
-    YAML::Node generate = YAML::Load(d.generate_yaml);
-    generate["seed"] = run.seed;
-    out << YAML::Key << "world" << YAML::Value << YAML::BeginMap << YAML::Key << "generate"
-        << YAML::Value << YAML::Flow << generate << YAML::EndMap;
+    if (!d.world.empty()) {
+      out << YAML::Key << "world" << YAML::Value << d.world;
+      if (!d.world_overrides_yaml.empty())
+        out << YAML::Key << "world_overrides" << YAML::Value << YAML::Load(d.world_overrides_yaml);
+    } else {
+      YAML::Node generate = YAML::Load(d.generate_yaml);
+      generate["seed"] = run.seed;
+      out << YAML::Key << "world" << YAML::Value << YAML::BeginMap << YAML::Key << "generate"
+          << YAML::Value << YAML::Flow << generate << YAML::EndMap;
+    }
     if (!d.robot.empty()) out << YAML::Key << "robot" << YAML::Value << d.robot;
     if (!d.robot_overrides_yaml.empty())
       out << YAML::Key << "robot_overrides" << YAML::Value << YAML::Load(d.robot_overrides_yaml);

@@ -24,6 +24,10 @@ struct BenchmarkDataset {
   std::size_t max_scans = 0;  ///< a log: use the records up to this many scans (0: all)
   /// Generated worlds: flow YAML of `generate:` without its seed (the run's seed is the world's).
   std::string generate_yaml;
+  /// A world file (absolute path; "" for none), the same world at every seed, and flow YAML of
+  /// its `world_overrides:` ("" for none).
+  std::string world;
+  std::string world_overrides_yaml;
   std::string robot;                 ///< a robot file (absolute) or preset name; "" default
   std::string robot_overrides_yaml;  ///< flow YAML ("" for none)
   double duration_s = 0.0;           ///< 0: the scenario's default (a log: whole)

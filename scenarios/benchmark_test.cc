@@ -77,6 +77,42 @@ TEST(BenchmarkSpecTest, EachRunIsAScenarioWithItsSeedItsEstimatorAndTheBaseline)
                 1000 * other.simulated->options.world.drive.waypoints_m.size());
 }
 
+TEST(BenchmarkSpecTest, AWorldFileIsTheSameWorldAtEverySeedWithItsOverrides) {
+  testing::TempDir dir;
+  const std::string world = std::string(SLAMRIG_SOURCE_DIR) + "/worlds/two_rooms.yaml";
+  const BenchmarkSuite suite =
+      LoadBenchmarkSuite(dir.Write("suite.yaml",
+                                   "estimators:\n  mine: {algorithm: external, command: [python3, "
+                                   "./client.py, \"{input}\", \"{output}\"]}\ndatasets:\n"
+                                   "  - name: rooms\n    world: " +
+                                       world +
+                                       "\n    world_overrides: {drive.laps: 2}\n"
+                                       "    seeds: [1, 2]\n    duration_s: 30\n"));
+  const std::vector<BenchmarkRun> runs = ExpandBenchmark(suite);
+  ASSERT_EQ(runs.size(), 2u);
+  const ScenarioSpec one =
+      LoadScenario(dir.Write("run_a.yaml", BenchmarkScenarioYaml(suite, runs[0])));
+  const ScenarioSpec two =
+      LoadScenario(dir.Write("run_b.yaml", BenchmarkScenarioYaml(suite, runs[1])));
+  ASSERT_TRUE(one.simulated.has_value() && two.simulated.has_value());
+  EXPECT_EQ(one.seed, 1u);
+  EXPECT_EQ(two.seed, 2u);
+  EXPECT_EQ(one.simulated->options.world.name, "two_rooms");
+  EXPECT_EQ(one.simulated->options.world.walls.size(), two.simulated->options.world.walls.size());
+  EXPECT_EQ(one.simulated->options.world.drive.laps, 2);
+  // The run's scenario is in another folder: the program is the one beside the suite.
+  const std::string text = BenchmarkScenarioYaml(suite, runs[0]);
+  EXPECT_NE(text.find((dir.path() / "client.py").string()), std::string::npos) << text;
+  EXPECT_NE(ErrorOf("estimators: {pf: {algorithm: pf}}\ndatasets:\n  - name: x\n"
+                    "    world: no/such.yaml\n")
+                .find("datasets[0].world: no world file"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("estimators: {pf: {algorithm: pf}}\ndatasets:\n  - name: x\n"
+                    "    world: a.yaml\n    log: b.log\n")
+                .find("needs exactly one of log:"),
+            std::string::npos);
+}
+
 TEST(BenchmarkSpecTest, BadInputNamesTheFileLineAndKey) {
   EXPECT_EQ(ErrorOf("estimators: {pf: {algorithm: pf}}\ndatasets:\n  - name: x\n"
                     "    generate: {kind: ofice}\n"),
