@@ -9,9 +9,11 @@ the TUM file must hold exactly those poses at the scans' own stamps. Checked: th
 written for MRPT (each scan turned symmetric about its laser's heading), the strictly increasing
 times given to MRPT, the .ini (headless), the TUM file, and each failure as one line on stderr,
 exit code 1 and no output: MRPT not installed, MRPT failing, a path one pose short, a laser
-message the wrapper does not read.
+message the wrapper does not read. The fake rbpf-slam also saves a grid as MRPT does (an 8-bit
+grey PNG and its limits), which must come back as a map_server map with the same pixels.
 """
 
+import json
 import math
 import os
 import subprocess
@@ -41,7 +43,8 @@ FAKE_ICP_SLAM = """
 import os, sys
 ini = dict(l.split("=", 1) for l in open(sys.argv[1]) if "=" in l and not l.startswith("#"))
 ini = {k.strip(): v.strip() for k, v in ini.items()}
-assert ini["LOG_FREQUENCY"] == "0" and ini["SHOW_PROGRESS_3D_REAL_TIME"] == "0", ini
+window = "SHOW_PROGRESS_IN_WINDOW" if "rbpf" in sys.argv[0] else "SHOW_PROGRESS_3D_REAL_TIME"
+assert ini["LOG_FREQUENCY"] == "0" and ini["SAVE_3D_SCENE"] == "0" and ini[window] == "0", ini
 mode = os.environ.get("FAKE_MODE", "")
 if mode == "fail":
     print("==== MRPT exception ====")
@@ -57,6 +60,35 @@ with open(os.path.join(out, "log_estimated_path.txt"), "w") as path:
     for step, f in enumerate(lines):
         k = 10 + int(f[8]) + int(f[9 + int(f[8])])
         path.write("%i %f %f %f\\n" % (step, float(f[k + 3]), float(f[k + 4]), float(f[k + 5])))
+"""
+
+# rbpf-slam's outputs: the path ("step x y z yaw pitch roll t") and the final grid as an 8-bit grey
+# PNG, one row per PNG filter in turn (0 none, 1 sub, 2 up, 3 average, 4 Paeth), with its limits.
+FAKE_RBPF_SLAM = FAKE_ICP_SLAM.replace(
+    '"%i %f %f %f\\n" % (step,', '"%i %f %f 0 %f 0 0 1\\n" % (step,') + """
+import json, struct, zlib
+W, H = 14, 10
+pixels = [[(r * 7919 + c * c * 104729 + (r * c) ** 3) % 251 for c in range(W)] for r in range(H)]
+def paeth(a, b, c):
+    p = a + b - c
+    return min((abs(p - a), 0, a), (abs(p - b), 1, b), (abs(p - c), 2, c))[2]
+raw = b""
+for r, row in enumerate(pixels):
+    above = pixels[r - 1] if r else [0] * W
+    kind = r % 5
+    filtered = []
+    for c, v in enumerate(row):
+        a, b, d = (row[c - 1] if c else 0), above[c], (above[c - 1] if c else 0)
+        filtered.append((v - (0, a, b, (a + b) // 2, paeth(a, b, d))[kind]) % 256)
+    raw += bytes([kind] + filtered)
+def chunk(kind, body):
+    return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+png = (b"\\x89PNG\\r\\n\\x1a\\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", W, H, 8, 0, 0, 0, 0)) +
+       chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+base = os.path.join(out, "finalMap_mrpt__maps__COccupancyGridMap2D_00")
+open(base + ".png", "wb").write(png)
+open(base + "_limits.txt", "w").write("% limits\\n-1.0 6.0 -2.0 3.0\\n")
+open(os.path.join(out, "pixels.txt"), "w").write(json.dumps(pixels))
 """
 
 
@@ -84,7 +116,7 @@ def main():
         bin_dir.mkdir()
         empty.mkdir()
         for name, body in (("carmen2rawlog", FAKE_CARMEN2RAWLOG), ("icp-slam", FAKE_ICP_SLAM),
-                           ("rawlog_to_sf", FAKE_RAWLOG_TO_SF)):
+                           ("rbpf-slam", FAKE_RBPF_SLAM), ("rawlog_to_sf", FAKE_RAWLOG_TO_SF)):
             (bin_dir / name).write_text(f"#!{sys.executable}\n{body}")
             (bin_dir / name).chmod(0o755)
 
@@ -99,13 +131,13 @@ def main():
                        "".join(f"ODOM 0 0 0 0 0 0 {t!r} slamrig {t!r}\n" +
                                robotlaser(t, o, start, fov) for t, o in zip(stamps, odom)))
 
-        def run(out_name, path, mode="", input_log=log):
+        def run(out_name, path, mode="", input_log=log, method="icp"):
             env = dict(os.environ, PATH=str(path), FAKE_MODE=mode,
                        SLAMRIG_MRPT_RAWLOG_TO_SF=str(bin_dir / "rawlog_to_sf"))
             output = tmp / out_name / "output.tum"
             output.parent.mkdir()
             result = subprocess.run([sys.executable, str(script), str(input_log), str(output),
-                                     "--method", "icp"], env=env, capture_output=True, text=True)
+                                     "--method", method], env=env, capture_output=True, text=True)
             return result, output
 
         result, output = run("good", bin_dir)
@@ -130,6 +162,21 @@ def main():
                   f"laser heading {first[-12]}, want {odom[0][2] + start + fov / 2}")
             ini = (work / "icp.ini").read_text()
             check("@" not in ini and f"logOutput_dir = {work / 'out'}" in ini, "icp.ini: " + ini)
+
+        # rbpf-slam: the same poses, and its grid as a map_server map beside the trajectory.
+        result, output = run("rbpf", bin_dir, method="rbpf")
+        check(result.returncode == 0, f"rbpf run: exit {result.returncode}: {result.stderr}")
+        if result.returncode == 0:
+            check(output.read_text() == (tmp / "good/output.tum").read_text(),
+                  "rbpf: another trajectory than icp's from the same poses")
+            pixels = json.loads((output.parent / "mrpt/out/pixels.txt").read_text())
+            pgm = output.with_suffix(".pgm").read_bytes()
+            check(pgm == b"P5\n14 10\n255\n" + bytes(sum(pixels, [])), f"rbpf map: {pgm!r}")
+            meta = output.with_suffix(".yaml").read_text()
+            check("image: output.pgm\nresolution: 0.5\norigin: [-1.0, -2.0, 0.0]\n" in meta,
+                  "rbpf map: " + meta)
+            ini = (output.parent / "mrpt/rbpf.ini").read_text()
+            check("sampleSize = 20\n" in ini and "RANDOM_SEED = 1\n" in ini, "rbpf.ini: " + ini)
 
         bad_log = tmp / "bad.log"
         bad_log.write_text("RAWLASER1 0 -1.5 2 0.5 30 0.01 0 1 2.5 0 0.0 x 0.0\n")

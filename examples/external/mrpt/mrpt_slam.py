@@ -15,7 +15,8 @@ OUTPUT's folder/mrpt/:
   3. icp-slam or rbpf-slam runs on it with icp.ini or rbpf.ini (beside this file; headless, no
      window, no 3D scene), stdout and stderr to mrpt/NAME.out;
   4. its per-step path log_estimated_path.txt (one pose per entry, so per scan) becomes OUTPUT,
-     a TUM trajectory stamped with the scans' own times (as slamrig asks: one pose per scan).
+     a TUM trajectory stamped with the scans' own times (as slamrig asks: one pose per scan);
+     rbpf-slam's final occupancy grid becomes a map_server map beside it (OUTPUT.yaml and .pgm).
 
 Any failure: exit code 1 and one line on stderr; OUTPUT is written only when all went well.
 Python 3 standard library only.
@@ -26,8 +27,10 @@ import hashlib
 import math
 import os
 import shutil
+import struct
 import subprocess
 import sys
+import zlib
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -144,6 +147,58 @@ def read_path(path, count):
     return poses
 
 
+def read_png_grey(path):
+    """The rows of an 8-bit grey, non-interlaced PNG (what MRPT saves a grid as)."""
+    data = Path(path).read_bytes()
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise Failure(f"{path}: not a PNG")
+    pos, compressed, header = 8, b"", None
+    while pos + 8 <= len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        if kind == b"IHDR":
+            header = struct.unpack(">IIBBBBB", data[pos + 8:pos + 21])
+        elif kind == b"IDAT":
+            compressed += data[pos + 8:pos + 8 + length]
+        pos += 12 + length
+    if header is None or (header[2], header[3], header[6]) != (8, 0, 0):
+        raise Failure(f"{path}: not an 8-bit grey PNG")
+    width, height = header[0], header[1]
+    raw = zlib.decompress(compressed)
+    if len(raw) != height * (width + 1):
+        raise Failure(f"{path}: {len(raw)} bytes of pixels for {width} x {height}")
+    rows, above = [], bytearray(width)
+    for r in range(height):
+        kind, row = raw[r * (width + 1)], bytearray(raw[r * (width + 1) + 1:(r + 1) * (width + 1)])
+        for i in range(width):  # the five PNG filters, one byte a pixel
+            a, b, c = (row[i - 1] if i else 0), above[i], (above[i - 1] if i else 0)
+            if kind == 4:  # Paeth: the neighbour nearest a + b - c
+                pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - 2 * c)
+                a = a if pa <= pb and pa <= pc else b if pb <= pc else c
+            row[i] = (row[i] + (0, a, b, (a + b) // 2, a)[kind]) & 255
+        rows.append(bytes(row))
+        above = row
+    return width, height, rows
+
+
+def write_map(out_dir, output):
+    """rbpf-slam's final grid (PNG, row 0 at y_max, white free) as a map_server map beside output."""
+    png = out_dir / "finalMap_mrpt__maps__COccupancyGridMap2D_00.png"
+    limits = out_dir / "finalMap_mrpt__maps__COccupancyGridMap2D_00_limits.txt"
+    width, height, rows = read_png_grey(png)
+    try:
+        x_min, x_max, y_min, y_max = map(float, limits.read_text().splitlines()[1].split())
+    except (IndexError, ValueError) as e:
+        raise Failure(f"{limits}: {e}") from None
+    resolution = (x_max - x_min) / width
+    if abs((y_max - y_min) / height - resolution) > 1e-6 * resolution:
+        raise Failure(f"{limits}: the limits do not fit a {width} x {height} grid")
+    pgm = output.with_suffix(".pgm")
+    pgm.write_bytes(f"P5\n{width} {height}\n255\n".encode() + b"".join(rows))
+    output.with_suffix(".yaml").write_text(
+        f"image: {pgm.name}\nresolution: {resolution!r}\norigin: [{x_min!r}, {y_min!r}, 0.0]\n"
+        "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
+
+
 def write_tum(path, scans, poses):
     partial = path.with_name(path.name + ".partial")
     with open(partial, "w") as out:
@@ -195,6 +250,8 @@ def main():
             work / f"{program}.out")
 
         poses = read_path(out_dir / "log_estimated_path.txt", len(scans))
+        if args.method == "rbpf":  # icp-slam's map is a point cloud: no map
+            write_map(out_dir, output)
         write_tum(output, scans, poses)
     except (Failure, OSError) as e:
         print(f"mrpt_slam.py: {e}", file=sys.stderr)
