@@ -41,10 +41,12 @@ class Failure(Exception):
     pass
 
 
-def read_scans(path):
-    """The ROBOTLASER1 lines as (time, fields). Any other laser message is refused."""
-    scans = []
-    with open(path) as log:
+def convert_scans(path, mrpt_log):
+    """Writes the ROBOTLASER1 lines to mrpt_log, each scan symmetric (symmetric_line), and
+    returns the scans' times. Any other laser message is refused. A line at a time: a long run
+    has gigabytes of ranges."""
+    times = []
+    with open(path) as log, open(mrpt_log, "w") as out:
         for number, line in enumerate(log, 1):
             f = line.split()
             if not f or f[0] in ("PARAM", "ODOM", "TRUEPOS") or f[0].startswith("#"):
@@ -56,32 +58,31 @@ def read_scans(path):
                 k = 10 + n + int(f[9 + n])  # the laser pose, after the ranges and remissions
                 if len(f) < k + 12:
                     raise ValueError(f"{len(f)} fields, {k + 12} needed")
-                scans.append((float(f[k + 11]), f))
+                times.append(float(f[k + 11]))
+                out.write(symmetric_line(f, k))
             except (IndexError, ValueError) as e:
                 raise Failure(f"{path}:{number}: ROBOTLASER1: {e}") from None
-    if not scans:
+    if not times:
         raise Failure(f"{path}: no ROBOTLASER1 line (no scans)")
-    return scans
+    return times
 
 
-def symmetric_line(fields):
-    """A ROBOTLASER1 line whose scan starts at -fov/2: the laser's heading turned to its centre."""
-    f = list(fields)
+def symmetric_line(f, k):
+    """A ROBOTLASER1 line (fields f, laser pose at f[k]) whose scan starts at -fov/2: the
+    laser's heading turned to the scan's centre."""
     start, fov = float(f[2]), float(f[3])
-    n = int(f[8])
-    k = 10 + n + int(f[9 + n])
     f[k + 2] = repr(float(f[k + 2]) + start + fov / 2)
     f[2] = repr(-fov / 2)
     return " ".join(f) + "\n"
 
 
-def mrpt_times(scans):
+def mrpt_times(times):
     """The scans' times, each at least 1 us after the one before."""
-    times, last = [], -math.inf
-    for t, _ in scans:
+    increasing, last = [], -math.inf
+    for t in times:
         last = max(t, last + 1e-6)
-        times.append(last)
-    return times
+        increasing.append(last)
+    return increasing
 
 
 def run(command, log_path):
@@ -99,7 +100,6 @@ def run(command, log_path):
                else f"exit code {result.returncode}")
         raise Failure(f"{command[0]}: {how}: {lines[-1] if lines else 'no output'} "
                       f"(all of it in {log_path})")
-    return open(log_path, errors="replace").read()
 
 
 def rawlog_to_sf():
@@ -199,10 +199,10 @@ def write_map(out_dir, output):
         "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n")
 
 
-def write_tum(path, scans, poses):
+def write_tum(path, times, poses):
     partial = path.with_name(path.name + ".partial")
     with open(partial, "w") as out:
-        for (t, _), (x, y, yaw) in zip(scans, poses):
+        for t, (x, y, yaw) in zip(times, poses):
             out.write(f"{t:.9f} {x:.9f} {y:.9f} 0 0 0 {math.sin(yaw / 2):.12f} "
                       f"{math.cos(yaw / 2):.12f}\n")
     partial.replace(path)
@@ -227,18 +227,15 @@ def main():
         work = output.parent / "mrpt"
         out_dir = work / "out"
         work.mkdir(parents=True, exist_ok=True)
-        scans = read_scans(args.input)
-
-        with open(work / "mrpt_input.log", "w") as log:
-            log.writelines(symmetric_line(f) for _, f in scans)
-        with open(work / "times.txt", "w") as times:
-            times.writelines(f"{t!r}\n" for t in mrpt_times(scans))
+        times = convert_scans(args.input, work / "mrpt_input.log")
+        (work / "times.txt").write_text("".join(f"{t!r}\n" for t in mrpt_times(times)))
         run(["carmen2rawlog", "-q", "-w", "-i", str(work / "mrpt_input.log"),
              "-o", str(work / "obs.rawlog")], work / "carmen2rawlog.out")
-        written = run([rawlog_to_sf(), str(work / "obs.rawlog"), str(work / "times.txt"),
-                       str(work / "sf.rawlog")], work / "rawlog_to_sf.out").split()
-        if written != [str(len(scans))]:
-            raise Failure(f"rawlog_to_sf wrote {' '.join(written)[:40]!r} scans for {len(scans)}")
+        run([rawlog_to_sf(), str(work / "obs.rawlog"), str(work / "times.txt"),
+             str(work / "sf.rawlog")], work / "rawlog_to_sf.out")
+        written = (work / "rawlog_to_sf.out").read_text(errors="replace").split()
+        if written != [str(len(times))]:
+            raise Failure(f"rawlog_to_sf wrote {' '.join(written)[:40]!r} scans for {len(times)}")
 
         values = {"OUT_DIR": str(out_dir), "PARTICLES": str(args.particles),
                   "SEED": str(args.seed % 2**31)}
@@ -249,10 +246,10 @@ def main():
         run([program, str(work / f"{args.method}.ini"), str(work / "sf.rawlog")],
             work / f"{program}.out")
 
-        poses = read_path(out_dir / "log_estimated_path.txt", len(scans))
+        poses = read_path(out_dir / "log_estimated_path.txt", len(times))
         if args.method == "rbpf":  # icp-slam's map is a point cloud: no map
             write_map(out_dir, output)
-        write_tum(output, scans, poses)
+        write_tum(output, times, poses)
     except (Failure, OSError) as e:
         print(f"mrpt_slam.py: {e}", file=sys.stderr)
         return 1
