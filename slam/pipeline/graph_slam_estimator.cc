@@ -23,7 +23,12 @@ ScanEstimate GraphSlamEstimator::AddScan(const SyncedScan& scan) {
     map_.InsertScan(scan.scan, pose);
     node_scans_.push_back(scan.scan);
   }
-  return {pose, std::nullopt, {}, std::nullopt};
+  ScanEstimate estimate;
+  estimate.pose = pose;
+  const bool lost = front_end_health_.Judge(slam_.last_step(), &estimate.trace);
+  health_.Add(lost);
+  estimate.lost = lost;
+  return estimate;
 }
 
 void GraphSlamEstimator::Finish() {
@@ -48,11 +53,21 @@ EstimatorView GraphSlamEstimator::View() const {
 }
 
 const std::vector<std::string>& GraphSlamEstimator::StatisticNames() {
-  static const std::vector<std::string> names = {
-      "keyframes",     "loop_closures", "loop_candidates",        "rejected",
-      "optimizations", "final_chi2",    "switched_off",           "odometry_rematched",
-      "inconsistent",  "certified",     "certificate_lambda_min", "strained_edges",
-      "diverged"};
+  static const std::vector<std::string> names = {"keyframes",
+                                                 "loop_closures",
+                                                 "loop_candidates",
+                                                 "rejected",
+                                                 "optimizations",
+                                                 "final_chi2",
+                                                 "switched_off",
+                                                 "odometry_rematched",
+                                                 "inconsistent",
+                                                 "certified",
+                                                 "certificate_lambda_min",
+                                                 "strained_edges",
+                                                 "diverged",
+                                                 "lost",
+                                                 "chi2_ratio"};
   return names;
 }
 
@@ -70,7 +85,9 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"certified", c.certified ? 1.0 : 0.0},
           {"certificate_lambda_min", c.certificate_lambda_min},
           {"strained_edges", c.strained_edges},
-          {"diverged", c.diverged ? 1.0 : 0.0}};
+          {"diverged", c.diverged || health_.Diverged() ? 1.0 : 0.0},
+          {"lost", health_.losses()},
+          {"chi2_ratio", c.chi2_ratio}};
 }
 
 }  // namespace slamrig::slam

@@ -10,6 +10,7 @@
 #include "slam/grid/occupancy_grid.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
+#include "slam/pipeline/health.h"
 
 namespace slamrig::slam {
 
@@ -58,6 +59,8 @@ class GraphSlamEstimator final : public Estimator {
   GraphSlam slam_;
   OccupancyGrid map_;
   std::vector<LaserScan> node_scans_;  // the scan of each graph node (vertex id), for the map
+  FrontEndHealth front_end_health_;
+  HealthRecord health_;
 };
 
 }  // namespace slamrig::slam

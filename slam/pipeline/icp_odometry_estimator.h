@@ -9,6 +9,7 @@
 #include "slam/matching/matching_fields.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
+#include "slam/pipeline/health.h"
 
 namespace slamrig::slam {
 
@@ -47,6 +48,8 @@ class IcpOdometryEstimator final : public Estimator {
  private:
   IcpOdometry odometry_;
   OccupancyGrid map_;
+  FrontEndHealth front_end_health_;
+  HealthRecord health_;
 };
 
 }  // namespace slamrig::slam

@@ -6,6 +6,7 @@
 #include "slam/pf/particle_filter_options.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
+#include "slam/pipeline/health.h"
 
 namespace slamrig::slam {
 
@@ -38,6 +39,7 @@ class ParticleFilterEstimator final : public Estimator {
   bool was_lost_ = false;
   double lost_at_s_ = NAN;
   double relocalised_at_s_ = NAN;
+  HealthRecord health_;
 };
 
 }  // namespace slamrig::slam

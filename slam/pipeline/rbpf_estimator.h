@@ -7,6 +7,7 @@
 #include "slam/pf/rbpf_options.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
+#include "slam/pipeline/health.h"
 
 namespace slamrig::slam {
 
@@ -43,6 +44,10 @@ class RbpfEstimator final : public Estimator {
   int updates_ = 0;
   double exponent_sum_ = 0.0;
   int failed_matches_ = 0;
+  // The lost rule: the best particle's matched fraction against its own long-term level.
+  QualityRatio matched_ratio_{0.3, 0.02, 20, 0.5};
+  bool lost_ = false;  // at the last update; held between updates
+  HealthRecord health_;
   mutable OccupancyGrid map_;
   mutable int map_version_ = -1;  // update count the map was converted at
 };
