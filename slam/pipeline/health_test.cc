@@ -110,5 +110,64 @@ TEST(HealthTest, QualityRatioFollowsTheRunsOwnLevel) {
   EXPECT_DOUBLE_EQ(cold.Add(0.0), 1.0);
 }
 
+// The NIS of a consistent filter is chi-square: 3-dof draws stay inside the window's quantile
+// nearly always; three times them do not.
+TEST(HealthTest, NisWindowFlagsAnInconsistentFilterOnly) {
+  std::mt19937 random(3);
+  std::chi_squared_distribution<double> chi2(3.0);
+  NisWindow consistent, inflated;
+  int flagged = 0, inflated_flagged = 0;
+  EXPECT_DOUBLE_EQ(consistent.ratio(), 0.0);
+  for (int i = 0; i < 2000; ++i) {
+    const double nis = chi2(random);
+    consistent.Add(nis, 3);
+    inflated.Add(3.0 * nis, 3);
+    flagged += consistent.inconsistent();
+    inflated_flagged += inflated.inconsistent();
+  }
+  EXPECT_LT(flagged, 20) << flagged;  // overlapping windows: a few times 0.1 % at most
+  EXPECT_GT(inflated_flagged, 1800);  // the sum of ten is 90 on average, the bound 59.7
+  // A full window only: nine wild updates are not yet a verdict.
+  NisWindow short_window;
+  for (int i = 0; i < NisWindow::kUpdates - 1; ++i) short_window.Add(1000.0, 3);
+  EXPECT_FALSE(short_window.inconsistent());
+  short_window.Add(1000.0, 3);
+  EXPECT_TRUE(short_window.inconsistent());
+}
+
+IcpOdometryStep Step(IcpOdometryOutcome outcome, double score) {
+  IcpOdometryStep step;
+  step.outcome = outcome;
+  step.score = score;
+  step.covariance = Eigen::Matrix3d::Identity() * 1e-4;
+  step.window = Eigen::Vector2d(0.3, 0.1);
+  return step;
+}
+
+TEST(HealthTest, FrontEndIsLostOnAFailedMatchAndOnAFallingScore) {
+  FrontEndHealth health;
+  std::vector<TraceValue> trace;
+  EXPECT_FALSE(health.Judge(Step(IcpOdometryOutcome::kFirstScan, 0.0), &trace));
+  for (int i = 0; i < 30; ++i) {
+    trace.clear();
+    EXPECT_FALSE(health.Judge(Step(IcpOdometryOutcome::kMatched, 0.9), &trace)) << i;
+  }
+  // Its health values, every scan the same names.
+  std::vector<std::string> names;
+  for (const TraceValue& v : trace) names.push_back(v.name);
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "match_score", "match_score_ratio", "match_conditioning", "searched",
+                       "correction_xy_of_window", "correction_yaw_of_window"}));
+  EXPECT_DOUBLE_EQ(trace[2].value, 1.0);  // an isotropic covariance: well conditioned
+  EXPECT_TRUE(health.Judge(Step(IcpOdometryOutcome::kMatchFailed, 0.0), &trace));
+  EXPECT_TRUE(health.Judge(Step(IcpOdometryOutcome::kNoPoints, 0.0), &trace));
+  EXPECT_FALSE(health.Judge(Step(IcpOdometryOutcome::kMatched, 0.9), &trace));
+  // Matches at a third of the usual score: lost within a few scans, not at the first.
+  EXPECT_FALSE(health.Judge(Step(IcpOdometryOutcome::kMatched, 0.3), &trace));
+  bool lost = false;
+  for (int i = 0; i < 5; ++i) lost = health.Judge(Step(IcpOdometryOutcome::kMatched, 0.3), &trace);
+  EXPECT_TRUE(lost);
+}
+
 }  // namespace
 }  // namespace slamrig::slam
