@@ -1,7 +1,8 @@
 // Self-diagnosis end to end: the particle filter kidnapped in the office must say it was lost
 // (a lost interval at the kidnapping, in metrics.json and the report), `expect: {pf: {lost_max:
 // 0}}` must then fail the run and nothing else, and having recovered it must not call its run
-// diverged.
+// diverged. Graph SLAM on intel's start with doubled odometry noise, which ends 2 m off from one
+// failed match, must call itself diverged; on the clean start it must not.
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -9,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "tests/util/dataset.h"
 #include "tests/util/run_command.h"
 #include "tests/util/temp_dir.h"
 
@@ -60,6 +62,33 @@ TEST(SelfDiagnosisTest, KidnappedFilterDeclaresItsLostIntervalAndLostMaxZeroFail
   EXPECT_TRUE(expectations["pf.diverged_max"]["passed"].as<bool>());
   // The report lists the interval.
   EXPECT_NE(Read(dir.File("out/report.html")).find("Self-diagnosis"), std::string::npos);
+}
+
+// `slamrig slam` on intel's first 200 scans, perturbed as given; the graph's metrics.
+YAML::Node GraphOnIntelStart(const testing::TempDir& dir, const std::string& log,
+                             const std::string& name, const std::string& perturb) {
+  const auto run = testing::RunCommand(std::string(SLAMRIG_BINARY) + " slam " + log +
+                                       " --algorithm graph --max-scans 200 --quiet --out " +
+                                       dir.File(name) + perturb);
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  return YAML::LoadFile(dir.File(name + "/metrics.json"))["configs"]["graph"];
+}
+
+TEST(SelfDiagnosisTest, GraphCallsAnUnrepairedFrontEndLossDiverged) {
+  SLAMRIG_REQUIRE_DATASET(log, "carmen_corrected/intel-corrected.log.gz");
+  testing::TempDir dir;
+  const YAML::Node clean = GraphOnIntelStart(dir, log, "clean", "");
+  EXPECT_LT(clean["ate_rmse_m"].as<double>(), 0.1);
+  EXPECT_EQ(clean["lost"].as<double>(), 0.0);
+  EXPECT_EQ(clean["diverged"].as<double>(), 0.0);
+  const YAML::Node noisy = GraphOnIntelStart(dir, log, "noisy",
+                                             " --perturb odometry.noise_per_m=0.131"
+                                             " --perturb odometry.noise_per_rad=0.348"
+                                             " --perturb scans.drop_fraction=0.1");
+  EXPECT_GT(noisy["ate_rmse_m"].as<double>(), 1.0);  // the failure the verdict must see
+  EXPECT_GE(noisy["lost_intervals"].as<double>(), 1.0);
+  EXPECT_GE(noisy["unrepaired_losses"].as<double>(), 1.0);
+  EXPECT_EQ(noisy["diverged"].as<double>(), 1.0);
 }
 
 }  // namespace

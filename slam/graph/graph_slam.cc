@@ -119,13 +119,15 @@ void GraphSlam::JudgeConsistency() {
   int kept = 0, strained = 0;
   double chi2 = 0.0;
   const std::vector<PoseGraphEdge>& edges = graph_.edges();
+  strained_.assign(edges.size(), false);
   for (std::size_t e = 0; e < edges.size(); ++e) {
     if (e < switches_.size() && switches_[e] < 0.5) continue;  // the back end switched it off
     const Eigen::Vector3d error = EdgeError(graph_, edges[e]);
     ++kept;
     const double edge_chi2 = error.dot(edges[e].information * error);
     chi2 += edge_chi2;
-    if (edge_chi2 > kChi2Dof3P99) ++strained;
+    strained_[e] = edge_chi2 > kChi2Dof3P99;
+    strained += strained_[e];
   }
   counts_.strained_edges = strained;
   const int dof = 3 * kept - 3 * (static_cast<int>(graph_.vertices().size()) - 1);
@@ -162,6 +164,17 @@ std::vector<LoopClosure> GraphSlam::loop_closures() const {
     kept.push_back(closures_[i]);
   }
   return kept;
+}
+
+std::vector<LoopClosure> GraphSlam::UnstrainedLoopClosures() const {
+  std::vector<LoopClosure> agreed;
+  for (std::size_t i = 0; i < closures_.size(); ++i) {
+    const std::size_t e = closure_edges_[i];
+    if (e < switches_.size() && switches_[e] < 0.5) continue;
+    if (e < strained_.size() && strained_[e]) continue;
+    agreed.push_back(closures_[i]);
+  }
+  return agreed;
 }
 
 void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,

@@ -79,6 +79,9 @@ class GraphSlam {
   /// The accepted loop closures the back end keeps (all of them, or with switchable constraints
   /// those whose switch is on).
   std::vector<LoopClosure> loop_closures() const;
+  /// After Finish(): the accepted loop closures the final poses agree with: kept by the back end
+  /// and not strained (JudgeConsistency). A front-end loss that one of them spans is repaired.
+  std::vector<LoopClosure> UnstrainedLoopClosures() const;
   /// The candidates that failed their match or a check, each with the graph's relative pose
   /// between the two scans when it was tried.
   const std::vector<LoopClosure>& rejected_closures() const { return rejected_; }
@@ -131,6 +134,7 @@ class GraphSlam {
   std::vector<LoopClosure> rejected_;
   std::vector<std::size_t> closure_edges_;  // graph edge of each closure
   std::vector<double> switches_;            // of each graph edge, from the last optimisation
+  std::vector<bool> strained_;              // of each graph edge, after Finish()
   GraphSlamCounts counts_;
   IcpOdometryStep last_step_;
   OdometryChain chain_;  // the odometry edges alone, for pairwise consistency

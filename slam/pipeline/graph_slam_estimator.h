@@ -53,6 +53,10 @@ class GraphSlamEstimator final : public Estimator {
   }
   /// The graph's odometry and loop-closure edges at the current estimate.
   EstimatorView View() const override;
+  /// After Finish(): the front end's losses that no loop closure the final poses agree with
+  /// spans (from a scan before the loss to one after it). A lost scan is placed by the odometry
+  /// alone; only such a closure measures, and so corrects, the error it left in the estimate.
+  int UnrepairedLosses() const;
 
  private:
   GraphSlamEstimatorOptions options_;
@@ -61,6 +65,9 @@ class GraphSlamEstimator final : public Estimator {
   std::vector<LaserScan> node_scans_;  // the scan of each graph node (vertex id), for the map
   FrontEndHealth front_end_health_;
   HealthRecord health_;
+  // The first and last scan of each loss of the front end, for the repair test.
+  std::vector<std::pair<int, int>> losses_;
+  int scans_ = 0;
 };
 
 }  // namespace slamrig::slam
