@@ -104,7 +104,9 @@ std::vector<LostInterval> LostIntervals(const Trajectory& online, const std::vec
     if (!lost[i]) continue;
     if (i == 0 || !lost[i - 1]) intervals.push_back({online[i].time, online[i].time, 0});
     ++intervals.back().scans;
-    intervals.back().to = i + 1 < lost.size() ? online[i + 1].time : online[i].time;
+    // A stamp earlier than the interval's start (a log's out-of-order stamps) ends it at its start.
+    intervals.back().to =
+        std::max(intervals.back().from, i + 1 < lost.size() ? online[i + 1].time : online[i].time);
   }
   return intervals;
 }

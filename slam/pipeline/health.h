@@ -2,12 +2,15 @@
 
 // Self-diagnosis shared by the estimators: each reports its own per-scan health values in its
 // trace, and from them, by its own rule, whether it is lost at that scan (ScanEstimate::lost).
-// The rules share two pieces, here: the ratio of a quality's short-term to its long-term average
-// (augmented MCL's w_fast / w_slow, Thrun et al., "Probabilistic Robotics", 2005, Table 8.3),
-// which judges a scan against the run's own level instead of a fixed threshold, and the verdict
-// `diverged` from the lost flags. The runner turns consecutive lost scans into LostIntervals.
+// The rules are built from the pieces here: the ratio of a quality's short-term to its long-term
+// average (augmented MCL's w_fast / w_slow, Thrun et al., "Probabilistic Robotics", 2005,
+// Table 8.3), which judges a scan against the run's own level instead of a fixed threshold; a
+// Kalman filter's NIS over its last updates against its chi-square quantile; the ICP front end's
+// rule; and the verdict `diverged` from the lost flags. The runner turns consecutive lost scans
+// into LostIntervals. docs/estimators.md ("How each estimator judges itself") lists the rules.
 
 #include <deque>
+#include <utility>
 #include <vector>
 
 #include "slam/matching/icp_odometry.h"
@@ -108,8 +111,10 @@ class FrontEndHealth {
 
 /// A run of consecutive lost scans.
 struct LostInterval {
-  Time from;      ///< the first lost scan's time
-  Time to;        ///< the next scan's time (the first one not lost), or the last scan's at the end
+  Time from;  ///< the first lost scan's time
+  /// The next scan's time (the first one not lost), or the last scan's at the end; never before
+  /// `from`.
+  Time to;
   int scans = 0;  ///< lost scans in it
   double seconds() const { return SecondsBetween(to, from); }
 };

@@ -26,7 +26,8 @@ class RbpfEstimator final : public Estimator {
   /// mean_neff, resamples, updates, failed_matches (particle matches that fell back on the
   /// odometry), odometry_rejections (updates whose increment the odometry check replaced),
   /// mean_weight_exponent (the weights' exponent, RbpfStep::weight_exponent, over updates),
-  /// map_tiles (distinct tiles over all particles at the end) and map_tiles_per_particle.
+  /// map_tiles (distinct tiles over all particles at the end) and map_tiles_per_particle; lost
+  /// (losses) and diverged (HealthRecord::Diverged()).
   std::map<std::string, double> Statistics() const override;
   /// The names Statistics() reports, without an instance: the algorithm table's list (and so
   /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
