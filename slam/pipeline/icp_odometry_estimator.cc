@@ -44,7 +44,8 @@ std::map<std::string, double> IcpOdometryEstimator::Statistics() const {
           {"degenerate", c.degenerate},
           {"failed", c.failed + c.no_points},
           {"lost", health_.losses()},
-          {"diverged", health_.Diverged() ? 1.0 : 0.0}};
+          // Every loss stays in the estimate: an odometry closes no loops that could measure it.
+          {"diverged", health_.Diverged() || health_.losses() > 0 ? 1.0 : 0.0}};
 }
 
 }  // namespace slamrig::slam

@@ -40,7 +40,7 @@ class IcpOdometryEstimator final : public Estimator {
   ScanEstimate AddScan(const SyncedScan& scan) override;
   const OccupancyGrid& map() const override { return map_; }
   /// matched, degenerate, failed (match failures and scans without points) scan counts; lost
-  /// (losses of the front end, FrontEndHealth) and diverged (HealthRecord::Diverged()).
+  /// (losses of the front end, FrontEndHealth) and diverged (any loss: nothing repairs one).
   std::map<std::string, double> Statistics() const override;
   /// The names Statistics() reports, without an instance: the algorithm table's list (and so
   /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
