@@ -43,7 +43,7 @@ Pose2 ToPose(py::handle value, const std::string& where) {
 
 slam::ScanEstimate ToScanEstimate(py::handle value, const std::string& where) {
   if (py::isinstance<slam::ScanEstimate>(value)) return value.cast<slam::ScanEstimate>();
-  if (!py::isinstance<py::dict>(value)) return {ToPose(value, where), {}, {}, {}};
+  if (!py::isinstance<py::dict>(value)) return {ToPose(value, where), {}, {}, {}, {}};
   const auto dict = value.cast<py::dict>();
   slam::ScanEstimate estimate;
   for (const auto& [k, v] : dict) {

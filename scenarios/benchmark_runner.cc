@@ -22,10 +22,11 @@ namespace fs = std::filesystem;
 
 // The estimator's figures results.csv carries, in its column order.
 const std::vector<std::string>& FigureNames() {
-  // `diverged`: the estimator's own verdict (1 or 0), empty for one that gives none.
+  // `diverged`: the estimator's own verdict (1 or 0), `lost_s` the seconds it said it was lost;
+  // both empty for one that does not judge itself.
   static const std::vector<std::string> names = {"ate_rmse_m", "ate_max_m",      "final_error_m",
                                                  "map_f1",     "loop_precision", "loop_recall",
-                                                 "diverged"};
+                                                 "diverged",   "lost_s"};
   return names;
 }
 

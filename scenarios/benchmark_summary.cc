@@ -96,12 +96,17 @@ int QuantilePlots(const Leaderboard& board, const std::string& out_dir, std::str
 }
 
 std::string WorstTable(const Leaderboard& board) {
-  std::string h = "<table><tr><th>run</th><th>status</th><th>ATE RMSE (m)</th><th>why</th></tr>";
+  std::string h =
+      "<table><tr><th>run</th><th>status</th><th>ATE RMSE (m)</th><th>diverged (its own "
+      "verdict)</th><th>lost (s)</th><th>why</th></tr>";
   for (const BenchmarkCase& c : board.worst) {
     h += "<tr><td><a href=\"" + RunLink(c.run_index) + "\">" + EscapeHtml(c.id) +
          "</a></td><td class=\"" + (c.status == "pass" ? "pass" : "fail") + "\">" +
          EscapeHtml(c.status) + "</td><td>" + Metres(c.ate_rmse_m) + "</td><td>" +
-         EscapeHtml(c.failure) + "</td></tr>";
+         (c.diverged.empty()  ? "&ndash;"
+          : c.diverged == "1" ? "yes"
+                              : "no") +
+         "</td><td>" + EscapeHtml(c.lost_s) + "</td><td>" + EscapeHtml(c.failure) + "</td></tr>";
   }
   return h + "</table>";
 }
@@ -128,7 +133,7 @@ Leaderboard BuildLeaderboard(const BenchmarkSuite& suite, const std::vector<std:
   };
   const std::size_t id_col = column("run"), status_col = column("status"),
                     failure_col = column("failure"), ate_col = column("ate_rmse_m"),
-                    diverged_col = column("diverged");
+                    diverged_col = column("diverged"), lost_col = column("lost_s");
   const std::vector<BenchmarkRun> runs = ExpandBenchmark(suite);
   std::map<std::string, std::size_t> index_of;
   for (std::size_t i = 0; i < runs.size(); ++i) index_of[runs[i].id] = i;
@@ -140,8 +145,13 @@ Leaderboard BuildLeaderboard(const BenchmarkSuite& suite, const std::vector<std:
     const BenchmarkRun& run = runs[found->second];
     LeaderboardCell& cell = board.cells[run.estimator][run.dataset];
     ++cell.runs;
-    BenchmarkCase c{found->second, row[id_col], row[status_col], row[failure_col],
-                    CsvNumber(row[ate_col])};
+    BenchmarkCase c{found->second,
+                    row[id_col],
+                    row[status_col],
+                    row[failure_col],
+                    CsvNumber(row[ate_col]),
+                    diverged_col < header.size() ? row[diverged_col] : "",
+                    lost_col < header.size() ? row[lost_col] : ""};
     if (c.status != "pass") {
       ++cell.failures;
       if (diverged_col >= header.size() || row[diverged_col] != "1") ++cell.silent;

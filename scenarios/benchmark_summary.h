@@ -23,6 +23,8 @@ struct BenchmarkCase {
   std::size_t run_index = 0;  ///< runs/<run_index>
   std::string id, status, failure;
   double ate_rmse_m = 0.0;  ///< NaN when the run has none
+  /// The estimator's own verdict ("1", "0", empty when it gives none) and its lost seconds.
+  std::string diverged, lost_s;
 };
 
 /// A benchmark's results.csv by estimator and dataset.

@@ -100,6 +100,15 @@ void WriteRunFacts(const ConfigResult& c, slam::JsonWriter* j) {
         .Integer("no_points", m->no_points)
         .EndObject();
   }
+  if (c.run.judges_itself) {
+    // The estimator's lost intervals, seconds since its first scan.
+    std::vector<double> from_s, to_s;
+    for (const slam::LostInterval& interval : c.run.lost_intervals) {
+      from_s.push_back(SecondsBetween(interval.from, c.run.online[0].time));
+      to_s.push_back(SecondsBetween(interval.to, c.run.online[0].time));
+    }
+    j->NumberArray("lost_from_s", from_s).NumberArray("lost_to_s", to_s);
+  }
   j->BeginObject("map")
       .Number("resolution_m", c.run.map.resolution())
       .Integer("width", c.run.map.width())
@@ -570,6 +579,29 @@ std::string SummaryHtml(const ScenarioResult& r) {
 
 // The expectations (when there are any) and the metrics: a row per metric some configuration
 // has, a blank cell where one does not have it.
+// Where each estimator that judges itself said it was lost (seconds since its first scan).
+std::string LostIntervalsHtml(const ScenarioResult& r) {
+  std::ostringstream h;
+  for (const ConfigResult& c : r.configs) {
+    if (!c.run.judges_itself) continue;
+    const auto diverged = c.metrics.find("diverged");
+    h << "<tr><td>" << EscapeHtml(c.name) << "</td><td>"
+      << (diverged != c.metrics.end() && diverged->second == 1.0 ? "yes" : "no") << "</td><td>";
+    if (c.run.lost_intervals.empty()) h << "never lost";
+    for (std::size_t i = 0; i < c.run.lost_intervals.size(); ++i) {
+      const slam::LostInterval& interval = c.run.lost_intervals[i];
+      h << (i ? ", " : "") << Number(SecondsBetween(interval.from, c.run.online[0].time), "%.1f")
+        << "&ndash;" << Number(SecondsBetween(interval.to, c.run.online[0].time), "%.1f") << " s ("
+        << interval.scans << (interval.scans == 1 ? " scan)" : " scans)");
+    }
+    h << "</td></tr>";
+  }
+  if (h.str().empty()) return "";
+  return "<h2>Self-diagnosis</h2><table><tr><th>configuration</th><th>diverged (its own "
+         "verdict)</th><th>lost intervals</th></tr>" +
+         h.str() + "</table>";
+}
+
 std::string TablesHtml(const ScenarioResult& r) {
   std::ostringstream h;
   if (!r.outcomes.empty()) {
@@ -595,6 +627,7 @@ std::string TablesHtml(const ScenarioResult& r) {
     h << "</tr>";
   }
   h << "</table>";
+  h << LostIntervalsHtml(r);
   if (!r.truth_metrics.empty()) {
     h << "<h2>Texture (true poses)</h2><table><tr><th>metric</th><th>truth</th></tr>";
     for (const auto& [name, value] : r.truth_metrics)

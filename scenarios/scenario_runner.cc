@@ -204,6 +204,11 @@ void Score(const ScenarioResult& run, double data_time_s, ConfigResult* c) {
   if (!run.times_synthesised)
     m["realtime_factor"] = c->run.wall_s > 0.0 ? data_time_s / c->run.wall_s : NAN;
   for (const auto& [name, value] : c->run.statistics) m[name] = value;
+  // The estimator's own judgement: its runs of lost scans.
+  if (c->run.judges_itself) {
+    m["lost_intervals"] = static_cast<double>(c->run.lost_intervals.size());
+    m["lost_s"] = slam::LostSeconds(c->run.lost_intervals);
+  }
   if (c->estimate.size() < 2 || run.truth.size() < 2) return;
   const slam::TrajectoryMetrics t = slam::EvaluateTrajectory(c->estimate, run.truth);
   c->reference_from_estimate = t.ate.reference_from_estimate;

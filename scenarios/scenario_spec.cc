@@ -194,10 +194,19 @@ const std::vector<std::string>& LandmarkMetrics() {
   return metrics;
 }
 
+const std::vector<std::string>& HealthMetrics() {
+  static const std::vector<std::string> metrics = {"lost_intervals", "lost_s"};
+  return metrics;
+}
+
 std::vector<std::string> MetricsOf(const slam::EstimatorConfig& config) {
   std::vector<std::string> metrics = KnownMetrics();
   if (const slam::Algorithm* a = slam::FindAlgorithm(config.algorithm)) {
     metrics.insert(metrics.end(), a->statistics.begin(), a->statistics.end());
+    // An estimator that judges itself declares `diverged` (and `lost`); the runner adds its
+    // lost intervals.
+    if (std::find(a->statistics.begin(), a->statistics.end(), "diverged") != a->statistics.end())
+      metrics.insert(metrics.end(), HealthMetrics().begin(), HealthMetrics().end());
     if (a->closes_loops) metrics.insert(metrics.end(), LoopMetrics().begin(), LoopMetrics().end());
     if (a->maps_landmarks)
       metrics.insert(metrics.end(), LandmarkMetrics().begin(), LandmarkMetrics().end());

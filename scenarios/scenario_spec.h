@@ -127,9 +127,13 @@ const std::vector<std::string>& TruthMetrics();
 /// map landmarks).
 const std::vector<std::string>& LandmarkMetrics();
 
+/// The lost intervals of an estimator that judges itself (it declares `diverged`): their count
+/// and total seconds, from its per-scan lost flags (slam/pipeline/health.h).
+const std::vector<std::string>& HealthMetrics();
+
 /// The metrics of `config`, which `expect:` accepts: KnownMetrics(), its algorithm's statistics
-/// (as its estimator declares them) and, for an algorithm that closes loops or maps landmarks,
-/// LoopMetrics() or LandmarkMetrics().
+/// (as its estimator declares them), HealthMetrics() for one that judges itself and, for an
+/// algorithm that closes loops or maps landmarks, LoopMetrics() or LandmarkMetrics().
 std::vector<std::string> MetricsOf(const slam::EstimatorConfig& config);
 
 /// A scenario of one log and `configs`, as a command builds it from its flags (`slamrig slam`):

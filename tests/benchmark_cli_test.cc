@@ -62,15 +62,18 @@ TEST(BenchmarkCliTest, RunsEveryPairResumesAndReproduces) {
     return static_cast<std::size_t>(std::find(rows[0].begin(), rows[0].end(), name) -
                                     rows[0].begin());
   };
-  const std::size_t diverged = column("diverged"), baseline = column("dead_reckoning_ate_rmse_m");
+  const std::size_t diverged = column("diverged"), baseline = column("dead_reckoning_ate_rmse_m"),
+                    lost_s = column("lost_s");
   ASSERT_LT(diverged, rows[0].size());
+  ASSERT_LT(lost_s, rows[0].size());
   ASSERT_LT(baseline, rows[0].size());
   for (std::size_t i = 1; i < rows.size(); ++i) {
     EXPECT_EQ(rows[i][4], "pass") << rows[i][0] << ": " << rows[i][5];
     EXPECT_FALSE(rows[i][6].empty()) << rows[i][0];         // an ATE
     EXPECT_FALSE(rows[i][baseline].empty()) << rows[i][0];  // dead reckoning's on the same data
-    // The graph's own verdict (0 on these clean runs); none from the particle filter.
-    EXPECT_EQ(rows[i][diverged], rows[i][3] == "graph" ? "0" : "") << rows[i][0];
+    // Each estimator's own verdict: 0 on these clean runs; the seconds it said it was lost.
+    EXPECT_EQ(rows[i][diverged], "0") << rows[i][0];
+    EXPECT_FALSE(rows[i][lost_s].empty()) << rows[i][0];
   }
   const std::string summary = Read(dir.File("a/summary.html"));
   EXPECT_NE(summary.find("Leaderboard"), std::string::npos);

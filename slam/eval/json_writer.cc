@@ -37,15 +37,28 @@ void JsonWriter::Key(const std::string& key) {
   has_member_.back() = true;
 }
 
+namespace {
+
+std::string NumberText(double value) {
+  if (!std::isfinite(value)) return "null";
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.9g", value);
+  return buffer;
+}
+
+}  // namespace
+
 JsonWriter& JsonWriter::Number(const std::string& key, double value) {
   Key(key);
-  if (!std::isfinite(value)) {
-    out_ += "null";
-  } else {
-    char buffer[64];
-    std::snprintf(buffer, sizeof(buffer), "%.9g", value);
-    out_ += buffer;
-  }
+  out_ += NumberText(value);
+  return *this;
+}
+
+JsonWriter& JsonWriter::NumberArray(const std::string& key, const std::vector<double>& values) {
+  Key(key);
+  out_ += "[";
+  for (std::size_t i = 0; i < values.size(); ++i) out_ += (i ? ", " : "") + NumberText(values[i]);
+  out_ += "]";
   return *this;
 }
 

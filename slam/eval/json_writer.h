@@ -16,6 +16,8 @@ class JsonWriter {
   JsonWriter& String(const std::string& key, const std::string& value);
   JsonWriter& Bool(const std::string& key, bool value);
   JsonWriter& StringArray(const std::string& key, const std::vector<std::string>& values);
+  /// Numbers as Number() writes them (NaN and infinities null).
+  JsonWriter& NumberArray(const std::string& key, const std::vector<double>& values);
   JsonWriter& BeginObject(const std::string& key);
   JsonWriter& EndObject();
 

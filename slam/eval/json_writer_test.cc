@@ -20,5 +20,12 @@ TEST(JsonWriterTest, WritesNestedObjectsInOrder) {
             "    \"bad\": null\n  },\n  \"ok\": true,\n  \"notes\": [\"x\", \"y\"]\n}\n");
 }
 
+TEST(JsonWriterTest, WritesNumberArrays) {
+  JsonWriter json;
+  json.NumberArray("from_s", {1.5, std::numeric_limits<double>::infinity(), 1e-10})
+      .NumberArray("none", {});
+  EXPECT_EQ(json.Finish(), "{\n  \"from_s\": [1.5, null, 1e-10],\n  \"none\": []\n}\n");
+}
+
 }  // namespace
 }  // namespace slamrig::slam

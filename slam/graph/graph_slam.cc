@@ -12,6 +12,7 @@
 #include <set>
 #include <utility>
 
+#include "slam/eval/chi_square.h"
 #include "slam/graph/edge_error.h"
 #include "slam/graph/optimality_certificate.h"
 #include "slam/matching/correlative_matcher.h"
@@ -80,7 +81,8 @@ GraphSlam::GraphSlam(const GraphSlamOptions& options)
 }
 
 Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment) {
-  const IcpOdometryStep step = odometry_.Add(scan, odometry_increment);
+  last_step_ = odometry_.Add(scan, odometry_increment);
+  const IcpOdometryStep& step = last_step_;
   const int index = static_cast<int>(scan_node_.size());
   const Pose2 since = nodes_.empty() ? Pose2() : nodes_.back().odom_pose.Between(step.pose);
   // A doubtful match becomes a node too, so that the odometry check judges it. (A failed match
@@ -115,14 +117,21 @@ void GraphSlam::JudgeConsistency() {
   // chi2 with 3 degrees of freedom: its 99 % quantile.
   constexpr double kChi2Dof3P99 = 11.3449;
   int kept = 0, strained = 0;
+  double chi2 = 0.0;
   const std::vector<PoseGraphEdge>& edges = graph_.edges();
+  strained_.assign(edges.size(), false);
   for (std::size_t e = 0; e < edges.size(); ++e) {
     if (e < switches_.size() && switches_[e] < 0.5) continue;  // the back end switched it off
     const Eigen::Vector3d error = EdgeError(graph_, edges[e]);
     ++kept;
-    if (error.dot(edges[e].information * error) > kChi2Dof3P99) ++strained;
+    const double edge_chi2 = error.dot(edges[e].information * error);
+    chi2 += edge_chi2;
+    strained_[e] = edge_chi2 > kChi2Dof3P99;
+    strained += strained_[e];
   }
   counts_.strained_edges = strained;
+  const int dof = 3 * kept - 3 * (static_cast<int>(graph_.vertices().size()) - 1);
+  if (dof > 0) counts_.chi2_ratio = chi2 / ChiSquareQuantile(0.99, dof);
   counts_.diverged =
       kept > 0 && static_cast<double>(strained) > options_.diverged_strained_share * kept;
 }
@@ -155,6 +164,17 @@ std::vector<LoopClosure> GraphSlam::loop_closures() const {
     kept.push_back(closures_[i]);
   }
   return kept;
+}
+
+std::vector<LoopClosure> GraphSlam::UnstrainedLoopClosures() const {
+  std::vector<LoopClosure> agreed;
+  for (std::size_t i = 0; i < closures_.size(); ++i) {
+    const std::size_t e = closure_edges_[i];
+    if (e < switches_.size() && switches_[e] < 0.5) continue;
+    if (e < strained_.size() && strained_[e]) continue;
+    agreed.push_back(closures_[i]);
+  }
+  return agreed;
 }
 
 void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,

@@ -53,6 +53,10 @@ struct GraphSlamCounts {
   /// quantile, and the estimator's own verdict from them (options' diverged_strained_share):
   /// the graph contradicts its own measurements, so the estimate is not to be trusted.
   int strained_edges = 0;
+  /// After Finish(): the kept edges' chi2 at the final poses over the 99 % quantile of chi2 with
+  /// their degrees of freedom (3 per edge less 3 per free node): above 1 the measurements
+  /// contradict each other beyond their stated noise (NaN without redundant edges).
+  double chi2_ratio = std::numeric_limits<double>::quiet_NaN();
   bool diverged = false;
 };
 
@@ -75,11 +79,16 @@ class GraphSlam {
   /// The accepted loop closures the back end keeps (all of them, or with switchable constraints
   /// those whose switch is on).
   std::vector<LoopClosure> loop_closures() const;
+  /// After Finish(): the accepted loop closures the final poses agree with: kept by the back end
+  /// and not strained (JudgeConsistency). A front-end loss that one of them spans is repaired.
+  std::vector<LoopClosure> UnstrainedLoopClosures() const;
   /// The candidates that failed their match or a check, each with the graph's relative pose
   /// between the two scans when it was tried.
   const std::vector<LoopClosure>& rejected_closures() const { return rejected_; }
   const GraphSlamCounts& counts() const { return counts_; }
   const PoseGraph& graph() const { return graph_; }
+  /// How the front end (ICP odometry) placed the last scan given to Add(), for its health.
+  const IcpOdometryStep& last_step() const { return last_step_; }
 
  private:
   struct Node {
@@ -125,7 +134,9 @@ class GraphSlam {
   std::vector<LoopClosure> rejected_;
   std::vector<std::size_t> closure_edges_;  // graph edge of each closure
   std::vector<double> switches_;            // of each graph edge, from the last optimisation
+  std::vector<bool> strained_;              // of each graph edge, after Finish()
   GraphSlamCounts counts_;
+  IcpOdometryStep last_step_;
   OdometryChain chain_;  // the odometry edges alone, for pairwise consistency
   PairwiseConsistency consistency_;
   std::vector<PoseGraphEdge> hypothesis_edges_;  // every closure given to consistency_

@@ -224,9 +224,14 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
   prior_covariance.topLeftCorner<2, 2>() =
       r * prior_covariance.topLeftCorner<2, 2>() * r.transpose();
   step.pose = prior;
+  step.prior = prior;
+  step.window = SearchWindow(odometry_increment);
   step.covariance = prior_covariance;
   if (!points.empty() && matcher_) {
-    match = SearchedMatch(points, prior, SearchWindow(odometry_increment), std::move(match));
+    const IcpOdometryCounts before = counts_;
+    match = SearchedMatch(points, prior, step.window, std::move(match));
+    step.searched = counts_.searched > before.searched;
+    step.search_chosen = counts_.search_chosen > before.search_chosen;
   }
 
   // Failed unless the match below says otherwise (also with no local map yet).

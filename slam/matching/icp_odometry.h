@@ -98,9 +98,14 @@ struct IcpOdometryStep {
   /// estimate; huge along a degenerate direction), or the increment's noise model on a fallback.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   IcpOdometryOutcome outcome = IcpOdometryOutcome::kFirstScan;
-  double score = 0.0;     ///< the match's score (IcpMatcher's inlier share) when it was used
-  bool keyframe = false;  ///< the scan joined the local map
-  int keyframe_id = -1;   ///< its number as a keyframe (0, 1, ...); -1 when it did not join
+  double score = 0.0;  ///< the match's score (IcpMatcher's inlier share) when it was used
+  Pose2 prior;         ///< odom_from_base the scan was matched from (the odometry increment's)
+  /// The prior's search window (x and y in m, yaw in rad): +-sigmas of its measured noise.
+  Eigen::Vector2d window = Eigen::Vector2d::Zero();
+  bool searched = false;       ///< a correlative search ran before ICP for this scan ...
+  bool search_chosen = false;  ///< ... and its match replaced the one from the prior
+  bool keyframe = false;       ///< the scan joined the local map
+  int keyframe_id = -1;        ///< its number as a keyframe (0, 1, ...); -1 when it did not join
   /// When it joined: the share in the map's frame (FrameWeights, at the scan's pose) of every
   /// keyframe in the map it was matched against, as this scan saw it; what moves the frame
   /// (KeyframeErrors). Empty for point-to-point ICP.

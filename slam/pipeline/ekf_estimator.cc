@@ -131,6 +131,7 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
         nis_sum_ += update.nis;
         ++scan_updates_;
         last_nis_ = update.nis;
+        nis_window_.Add(update.nis, update.dimension);
       }
       if (step.keyframe) {
         ++keyframes_;
@@ -161,6 +162,7 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
         nis_sum_ += update.nis;
         ++scan_updates_;
         last_nis_ = update.nis;
+        nis_window_.Add(update.nis, update.dimension);
       } else {
         ekf_.AnchorMatcherFrame(step.pose, r);
         anchored_ = true;
@@ -192,16 +194,23 @@ ScanEstimate EkfEstimator::Correct(const LaserScan& scan) {
   // NIS is the latest update's, held between keyframes.
   estimate.trace.push_back({"nis", last_nis_});
   estimate.trace.push_back({"gyro_bias_rad_s", ekf_.gyro_bias()});
+  // Lost: the last scan updates' NIS sum above its chi-square quantile (NisWindow).
+  estimate.trace.push_back({"nis_window_ratio", nis_window_.ratio()});
+  estimate.lost = nis_window_.inconsistent();
+  health_.Add(*estimate.lost);
   map_.InsertScan(scan, estimate.pose);
   return estimate;
 }
 
 const std::vector<std::string>& EkfEstimator::StatisticNames() {
-  static const std::vector<std::string> names = {
-      "gyro_bias_rad_s",   "gyro_scale_error",        "gyro_sigma_rad_s", "scan_updates",
-      "zero_rate_updates", "slip_inflations",         "matched",          "keyframes",
-      "anchors",           "match_covariance_factor", "wheel_slip_m",     "skid_ratio",
-      "mean_nis"};
+  static const std::vector<std::string> names = {"gyro_bias_rad_s",   "gyro_scale_error",
+                                                 "gyro_sigma_rad_s",  "scan_updates",
+                                                 "zero_rate_updates", "slip_inflations",
+                                                 "matched",           "keyframes",
+                                                 "anchors",           "match_covariance_factor",
+                                                 "wheel_slip_m",      "skid_ratio",
+                                                 "mean_nis",          "lost",
+                                                 "diverged"};
   return names;
 }
 
@@ -218,7 +227,9 @@ std::map<std::string, double> EkfEstimator::Statistics() const {
           {"match_covariance_factor", MatchScale()},
           {"wheel_slip_m", feed_.slip().total_slip_m()},
           {"skid_ratio", feed_.slip().skid_ratio()},
-          {"mean_nis", scan_updates_ > 0 ? nis_sum_ / scan_updates_ : 0.0}};
+          {"mean_nis", scan_updates_ > 0 ? nis_sum_ / scan_updates_ : 0.0},
+          {"lost", health_.losses()},
+          {"diverged", health_.Diverged() ? 1.0 : 0.0}};
 }
 
 }  // namespace slamrig::slam

@@ -11,6 +11,7 @@
 #include "slam/matching/map_frame_drift.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
+#include "slam/pipeline/health.h"
 #include "slam/pipeline/wheel_gyro_feed.h"
 
 namespace slamrig::slam {
@@ -142,6 +143,8 @@ class EkfEstimator final : public Estimator {
   double log_match_scale_ = 0.0;  // the estimate of log(factor on the match covariance)
   double nis_sum_ = 0.0;
   double last_nis_ = 0.0;
+  NisWindow nis_window_;
+  HealthRecord health_;
   // The joint errors of the keyframes in the matcher's local map (derived_map_drift).
   KeyframeErrors keyframe_errors_;
 };

@@ -60,6 +60,7 @@ ScanEstimate EkfSlamEstimator::AddScan(const SyncedScan& scan) {
     ++updates_;
     nis_sum_ += update.nis;
     nis_dof_sum_ += update.dimension;
+    nis_window_.Add(update.nis, update.dimension);
   }
   for (std::size_t i = 0; i < observations.size(); ++i) {
     if (update.landmark_of_observation[i] < 0) continue;
@@ -75,6 +76,10 @@ ScanEstimate EkfSlamEstimator::AddScan(const SyncedScan& scan) {
       {"nis_per_dof", update.dimension > 0 ? update.nis / update.dimension : 0.0});
   estimate.trace.push_back({"landmarks", static_cast<double>(slam_.landmarks())});
   estimate.trace.push_back({"pairings", static_cast<double>(update.pairings)});
+  // Lost: the last updates' NIS sum above its chi-square quantile (NisWindow).
+  estimate.trace.push_back({"nis_window_ratio", nis_window_.ratio()});
+  estimate.lost = nis_window_.inconsistent();
+  health_.Add(*estimate.lost);
   if ((scans_ - 1) % options_.map_every_scans == 0) map_.InsertScan(scan.scan, estimate.pose);
   return estimate;
 }
@@ -105,7 +110,9 @@ const std::vector<std::string>& EkfSlamEstimator::StatisticNames() {
                                                  "landmark_updates",
                                                  "zero_rate_updates",
                                                  "gyro_bias_rad_s",
-                                                 "mean_nis_per_dof"};
+                                                 "mean_nis_per_dof",
+                                                 "lost",
+                                                 "diverged"};
   return names;
 }
 
@@ -119,7 +126,9 @@ std::map<std::string, double> EkfSlamEstimator::Statistics() const {
           {"landmark_updates", updates_},
           {"zero_rate_updates", feed_.zero_rate_updates()},
           {"gyro_bias_rad_s", slam_.gyro_bias()},
-          {"mean_nis_per_dof", nis_dof_sum_ > 0.0 ? nis_sum_ / nis_dof_sum_ : 0.0}};
+          {"mean_nis_per_dof", nis_dof_sum_ > 0.0 ? nis_sum_ / nis_dof_sum_ : 0.0},
+          {"lost", health_.losses()},
+          {"diverged", health_.Diverged() ? 1.0 : 0.0}};
 }
 
 }  // namespace slamrig::slam

@@ -9,6 +9,7 @@
 #include "slam/grid/occupancy_grid.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
+#include "slam/pipeline/health.h"
 #include "slam/pipeline/wheel_gyro_feed.h"
 
 namespace slamrig::slam {
@@ -69,6 +70,8 @@ class EkfSlamEstimator final : public Estimator {
   int updates_ = 0;
   double nis_sum_ = 0.0;
   double nis_dof_sum_ = 0.0;
+  NisWindow nis_window_;
+  HealthRecord health_;
 };
 
 }  // namespace slamrig::slam

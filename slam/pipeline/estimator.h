@@ -29,6 +29,10 @@ struct ScanEstimate {
   /// Covariance of (x, y, yaw) of `pose` in the estimator's frame (m^2, m rad, rad^2), where the
   /// estimator has one (a Kalman filter, propagated dead reckoning).
   std::optional<Eigen::Matrix3d> covariance;
+  /// The estimator's own judgement of this scan by its documented rule (slam/pipeline/health.h):
+  /// true when its health values say it is lost here; nullopt from an estimator that cannot
+  /// judge itself (dead reckoning).
+  std::optional<bool> lost;
 };
 
 /// A pose hypothesis with its normalised weight (a particle).

@@ -77,6 +77,8 @@ void EstimatorRunner::Process(const SyncedScan& synced) {
   run_.online.Append(time, estimate.pose);
   if (estimate.mean_pose) run_.mean.Append(time, *estimate.mean_pose);
   if (estimate.covariance) run_.covariances.push_back(*estimate.covariance);
+  lost_.push_back(estimate.lost.value_or(false));
+  judged_scans_ += estimate.lost.has_value();
   if (!estimate.trace.empty()) {
     run_.trace_time_s.push_back(time.seconds());
     for (const TraceValue& v : estimate.trace) run_.traces[v.name].push_back(v.value);
@@ -97,6 +99,10 @@ EstimatorRun EstimatorRunner::TakeResult() {
   if (run_.covariances.size() != run_.online.size()) run_.covariances.clear();
   if (run_.record_rate_covariances.size() != run_.record_rate.size())
     run_.record_rate_covariances.clear();
+  run_.judges_itself = judged_scans_ > 0;
+  SLAMRIG_CHECK(!run_.judges_itself || judged_scans_ == static_cast<int>(lost_.size()),
+                "an estimator that judges itself judges every scan");
+  if (run_.judges_itself) run_.lost_intervals = LostIntervals(run_.online, lost_);
   run_.statistics = estimator_->Statistics();
   CheckDeclaredStatistics(config_.algorithm, run_.statistics);
   run_.loop_closures = estimator_->LoopClosures();

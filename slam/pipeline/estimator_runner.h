@@ -12,6 +12,7 @@
 #include "slam/odometry/scan_sync.h"
 #include "slam/pipeline/estimator.h"
 #include "slam/pipeline/estimator_config.h"
+#include "slam/pipeline/health.h"
 #include "slam/pipeline/scan_matched_odometry.h"
 #include "slam/types/trajectory.h"
 
@@ -31,9 +32,12 @@ struct EstimatorRun {
   /// the covariances when every one had one; empty for estimators that only report at scans.
   Trajectory record_rate;
   std::vector<Eigen::Matrix3d> record_rate_covariances;
-  std::vector<double> trace_time_s;                        ///< scan times of the traces, seconds
-  std::map<std::string, std::vector<double>> traces;       ///< per-scan values by name
-  std::map<std::string, double> statistics;                ///< Estimator::Statistics() at the end
+  std::vector<double> trace_time_s;                   ///< scan times of the traces, seconds
+  std::map<std::string, std::vector<double>> traces;  ///< per-scan values by name
+  std::map<std::string, double> statistics;           ///< Estimator::Statistics() at the end
+  /// Whether the estimator judged every scan (ScanEstimate::lost), and its runs of lost scans.
+  bool judges_itself = false;
+  std::vector<LostInterval> lost_intervals;
   std::vector<LoopClosure> loop_closures;                  ///< Estimator::LoopClosures() at the end
   std::vector<LoopClosure> rejected_loop_closures;         ///< Estimator::RejectedLoopClosures()
   LandmarkMap landmarks;                                   ///< Estimator::Landmarks() at the end
@@ -87,6 +91,8 @@ class EstimatorRunner {
   std::unique_ptr<Estimator> estimator_;
   std::function<void(std::size_t, const SyncedScan&, const ScanEstimate&)> on_scan_;
   EstimatorRun run_;
+  std::vector<bool> lost_;  // ScanEstimate::lost of each scan (false where it had none)
+  int judged_scans_ = 0;    // scans that had one
   Pose2 pose_;
   bool finished_ = false;
 };

@@ -1,5 +1,7 @@
 #include "slam/pipeline/graph_slam_estimator.h"
 
+#include <algorithm>
+
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
@@ -23,7 +25,16 @@ ScanEstimate GraphSlamEstimator::AddScan(const SyncedScan& scan) {
     map_.InsertScan(scan.scan, pose);
     node_scans_.push_back(scan.scan);
   }
-  return {pose, std::nullopt, {}, std::nullopt};
+  ScanEstimate estimate;
+  estimate.pose = pose;
+  const bool lost = front_end_health_.Judge(slam_.last_step(), &estimate.trace);
+  health_.Add(lost);
+  estimate.lost = lost;
+  if (lost && (losses_.empty() || losses_.back().second != scans_ - 1))
+    losses_.emplace_back(scans_, scans_);
+  if (lost) losses_.back().second = scans_;
+  ++scans_;
+  return estimate;
 }
 
 void GraphSlamEstimator::Finish() {
@@ -47,12 +58,34 @@ EstimatorView GraphSlamEstimator::View() const {
   return view;
 }
 
+int GraphSlamEstimator::UnrepairedLosses() const {
+  const std::vector<LoopClosure> closures = slam_.UnstrainedLoopClosures();
+  int unrepaired = 0;
+  for (const auto& [first, last] : losses_) {
+    unrepaired += std::none_of(closures.begin(), closures.end(), [&](const LoopClosure& c) {
+      return c.from_scan < first && c.to_scan > last;
+    });
+  }
+  return unrepaired;
+}
+
 const std::vector<std::string>& GraphSlamEstimator::StatisticNames() {
-  static const std::vector<std::string> names = {
-      "keyframes",     "loop_closures", "loop_candidates",        "rejected",
-      "optimizations", "final_chi2",    "switched_off",           "odometry_rematched",
-      "inconsistent",  "certified",     "certificate_lambda_min", "strained_edges",
-      "diverged"};
+  static const std::vector<std::string> names = {"keyframes",
+                                                 "loop_closures",
+                                                 "loop_candidates",
+                                                 "rejected",
+                                                 "optimizations",
+                                                 "final_chi2",
+                                                 "switched_off",
+                                                 "odometry_rematched",
+                                                 "inconsistent",
+                                                 "certified",
+                                                 "certificate_lambda_min",
+                                                 "strained_edges",
+                                                 "diverged",
+                                                 "lost",
+                                                 "chi2_ratio",
+                                                 "unrepaired_losses"};
   return names;
 }
 
@@ -70,7 +103,10 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"certified", c.certified ? 1.0 : 0.0},
           {"certificate_lambda_min", c.certificate_lambda_min},
           {"strained_edges", c.strained_edges},
-          {"diverged", c.diverged ? 1.0 : 0.0}};
+          {"diverged", c.diverged || health_.Diverged() || UnrepairedLosses() > 0 ? 1.0 : 0.0},
+          {"lost", health_.losses()},
+          {"chi2_ratio", c.chi2_ratio},
+          {"unrepaired_losses", UnrepairedLosses()}};
 }
 
 }  // namespace slamrig::slam

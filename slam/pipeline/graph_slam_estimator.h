@@ -10,6 +10,7 @@
 #include "slam/grid/occupancy_grid.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
+#include "slam/pipeline/health.h"
 
 namespace slamrig::slam {
 
@@ -41,7 +42,8 @@ class GraphSlamEstimator final : public Estimator {
   std::optional<std::vector<Pose2>> RevisedPoses() const override { return slam_.Poses(); }
   const OccupancyGrid& map() const override { return map_; }
   /// keyframes, loop_closures, loop_candidates, rejected, optimizations, final_chi2,
-  /// switched_off, odometry_rematched, inconsistent.
+  /// switched_off, odometry_rematched, inconsistent, the certificate's, and its own judgement:
+  /// strained_edges, chi2_ratio, unrepaired_losses, lost, diverged.
   std::map<std::string, double> Statistics() const override;
   /// The names Statistics() reports, without an instance: the algorithm table's list (and so
   /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
@@ -52,12 +54,21 @@ class GraphSlamEstimator final : public Estimator {
   }
   /// The graph's odometry and loop-closure edges at the current estimate.
   EstimatorView View() const override;
+  /// After Finish(): the front end's losses that no loop closure the final poses agree with
+  /// spans (from a scan before the loss to one after it). A lost scan is placed by the odometry
+  /// alone; only such a closure measures, and so corrects, the error it left in the estimate.
+  int UnrepairedLosses() const;
 
  private:
   GraphSlamEstimatorOptions options_;
   GraphSlam slam_;
   OccupancyGrid map_;
   std::vector<LaserScan> node_scans_;  // the scan of each graph node (vertex id), for the map
+  FrontEndHealth front_end_health_;
+  HealthRecord health_;
+  // The first and last scan of each loss of the front end, for the repair test.
+  std::vector<std::pair<int, int>> losses_;
+  int scans_ = 0;
 };
 
 }  // namespace slamrig::slam

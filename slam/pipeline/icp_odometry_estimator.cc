@@ -24,17 +24,28 @@ IcpOdometryEstimator::IcpOdometryEstimator(const IcpOdometryEstimatorOptions& op
 ScanEstimate IcpOdometryEstimator::AddScan(const SyncedScan& scan) {
   const IcpOdometryStep step = odometry_.Add(scan.scan, scan.increment);
   map_.InsertScan(scan.scan, step.pose);
-  return {step.pose, std::nullopt, {}, std::nullopt};
+  ScanEstimate estimate;
+  estimate.pose = step.pose;
+  const bool lost = front_end_health_.Judge(step, &estimate.trace);
+  health_.Add(lost);
+  estimate.lost = lost;
+  return estimate;
 }
 
 const std::vector<std::string>& IcpOdometryEstimator::StatisticNames() {
-  static const std::vector<std::string> names = {"matched", "degenerate", "failed"};
+  static const std::vector<std::string> names = {"matched", "degenerate", "failed", "lost",
+                                                 "diverged"};
   return names;
 }
 
 std::map<std::string, double> IcpOdometryEstimator::Statistics() const {
   const IcpOdometryCounts& c = odometry_.counts();
-  return {{"matched", c.matched}, {"degenerate", c.degenerate}, {"failed", c.failed + c.no_points}};
+  return {{"matched", c.matched},
+          {"degenerate", c.degenerate},
+          {"failed", c.failed + c.no_points},
+          {"lost", health_.losses()},
+          // Every loss stays in the estimate: an odometry closes no loops that could measure it.
+          {"diverged", health_.Diverged() || health_.losses() > 0 ? 1.0 : 0.0}};
 }
 
 }  // namespace slamrig::slam

@@ -9,6 +9,7 @@
 #include "slam/matching/matching_fields.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
+#include "slam/pipeline/health.h"
 
 namespace slamrig::slam {
 
@@ -38,7 +39,8 @@ class IcpOdometryEstimator final : public Estimator {
 
   ScanEstimate AddScan(const SyncedScan& scan) override;
   const OccupancyGrid& map() const override { return map_; }
-  /// matched, degenerate, failed (match failures and scans without points) scan counts.
+  /// matched, degenerate, failed (match failures and scans without points) scan counts; lost
+  /// (losses of the front end, FrontEndHealth) and diverged (any loss: nothing repairs one).
   std::map<std::string, double> Statistics() const override;
   /// The names Statistics() reports, without an instance: the algorithm table's list (and so
   /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
@@ -47,6 +49,8 @@ class IcpOdometryEstimator final : public Estimator {
  private:
   IcpOdometry odometry_;
   OccupancyGrid map_;
+  FrontEndHealth front_end_health_;
+  HealthRecord health_;
 };
 
 }  // namespace slamrig::slam

@@ -31,7 +31,11 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
       step.best_pose,
       step.mean_pose,
       {{"neff", step.neff}, {"match_quality", step.quality}, {"lost", step.lost ? 1.0 : 0.0}},
-      std::nullopt};
+      std::nullopt,
+      step.lost};
+  // The filter's own lost test: the short-term average of the match quality below lost_ratio
+  // times its long-term one (ParticleFilterOptions::relocalisation).
+  health_.Add(step.lost);
   if (filter_.options().adaptive_sigma.enabled) {
     estimate.trace.push_back({"field_sigma_m", filter_.field_sigma_m()});
   }
@@ -40,8 +44,9 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
 
 const std::vector<std::string>& ParticleFilterEstimator::StatisticNames() {
   static const std::vector<std::string> names = {
-      "mean_neff", "resamples", "updates",          "lost",          "relocalisations",
-      "resumed",   "lost_at_s", "relocalised_at_s", "field_sigma_m", "wall_distance_m"};
+      "mean_neff",       "resamples",       "updates",   "lost",
+      "relocalisations", "resumed",         "lost_at_s", "relocalised_at_s",
+      "field_sigma_m",   "wall_distance_m", "diverged"};
   return names;
 }
 
@@ -55,7 +60,8 @@ std::map<std::string, double> ParticleFilterEstimator::Statistics() const {
           {"lost_at_s", lost_at_s_},
           {"relocalised_at_s", relocalised_at_s_},
           {"field_sigma_m", filter_.field_sigma_m()},
-          {"wall_distance_m", filter_.wall_distance_m()}};
+          {"wall_distance_m", filter_.wall_distance_m()},
+          {"diverged", health_.Diverged() ? 1.0 : 0.0}};
 }
 
 EstimatorView ParticleFilterEstimator::View() const {

@@ -6,6 +6,7 @@
 #include "slam/pf/particle_filter_options.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
+#include "slam/pipeline/health.h"
 
 namespace slamrig::slam {
 
@@ -20,7 +21,8 @@ class ParticleFilterEstimator final : public Estimator {
   const OccupancyGrid& map() const override { return filter_.map(); }
   /// mean_neff (over scans), resamples, updates (scans the filter ran on, not just odometry);
   /// lost and relocalisations (counts), lost_at_s and relocalised_at_s (the first loss and the
-  /// first relocalisation after it, seconds since the first scan; NaN when none).
+  /// first relocalisation after it, seconds since the first scan; NaN when none); diverged (lost
+  /// at the end or on more than kDivergedLostShare of the scans).
   std::map<std::string, double> Statistics() const override;
   /// The names Statistics() reports, without an instance: the algorithm table's list (and so
   /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
@@ -38,6 +40,7 @@ class ParticleFilterEstimator final : public Estimator {
   bool was_lost_ = false;
   double lost_at_s_ = NAN;
   double relocalised_at_s_ = NAN;
+  HealthRecord health_;
 };
 
 }  // namespace slamrig::slam

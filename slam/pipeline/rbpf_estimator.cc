@@ -1,5 +1,6 @@
 #include "slam/pipeline/rbpf_estimator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -23,10 +24,22 @@ ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
   updates_ += step.updated;
   failed_matches_ += step.failed_matches;
   if (step.updated) exponent_sum_ += step.weight_exponent;
-  return {step.best_pose,
-          step.mean_pose,
-          {{"neff", step.neff}, {"matched_fraction", step.matched_fraction}},
-          std::nullopt};
+  // Lost: the best particle's matched fraction, averaged over the last few updates, below half
+  // its long-term level (the pf's lost_ratio rule on the RBPF's own quality).
+  if (step.updated) lost_ = matched_ratio_.Add(step.matched_fraction) < kLostRatio;
+  health_.Add(lost_);
+  const double particles =
+      static_cast<double>(std::max<std::size_t>(filter_.particles().size(), 1));
+  ScanEstimate estimate{step.best_pose,
+                        step.mean_pose,
+                        {{"neff", step.neff},
+                         {"neff_ratio", step.neff / particles},
+                         {"matched_fraction", step.matched_fraction},
+                         {"matched_fraction_ratio", matched_ratio_.ratio()},
+                         {"failed_match_share", step.failed_matches / particles}},
+                        std::nullopt,
+                        lost_};
+  return estimate;
 }
 
 std::optional<std::vector<Pose2>> RbpfEstimator::RevisedPoses() const {
@@ -57,7 +70,9 @@ const std::vector<std::string>& RbpfEstimator::StatisticNames() {
                                                  "odometry_rejections",
                                                  "mean_weight_exponent",
                                                  "map_tiles",
-                                                 "map_tiles_per_particle"};
+                                                 "map_tiles_per_particle",
+                                                 "lost",
+                                                 "diverged"};
   return names;
 }
 
@@ -74,7 +89,9 @@ std::map<std::string, double> RbpfEstimator::Statistics() const {
           {"map_tiles_per_particle",
            filter_.particles().empty()
                ? 0.0
-               : static_cast<double>(tiles) / static_cast<double>(filter_.particles().size())}};
+               : static_cast<double>(tiles) / static_cast<double>(filter_.particles().size())},
+          {"lost", health_.losses()},
+          {"diverged", health_.Diverged() ? 1.0 : 0.0}};
 }
 
 EstimatorView RbpfEstimator::View() const {

@@ -7,6 +7,7 @@
 #include "slam/pf/rbpf_options.h"
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
+#include "slam/pipeline/health.h"
 
 namespace slamrig::slam {
 
@@ -25,7 +26,8 @@ class RbpfEstimator final : public Estimator {
   /// mean_neff, resamples, updates, failed_matches (particle matches that fell back on the
   /// odometry), odometry_rejections (updates whose increment the odometry check replaced),
   /// mean_weight_exponent (the weights' exponent, RbpfStep::weight_exponent, over updates),
-  /// map_tiles (distinct tiles over all particles at the end) and map_tiles_per_particle.
+  /// map_tiles (distinct tiles over all particles at the end) and map_tiles_per_particle; lost
+  /// (losses) and diverged (HealthRecord::Diverged()).
   std::map<std::string, double> Statistics() const override;
   /// The names Statistics() reports, without an instance: the algorithm table's list (and so
   /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
@@ -43,6 +45,10 @@ class RbpfEstimator final : public Estimator {
   int updates_ = 0;
   double exponent_sum_ = 0.0;
   int failed_matches_ = 0;
+  // The lost rule: the best particle's matched fraction against its own long-term level.
+  QualityRatio matched_ratio_{0.3, 0.02, 20, 0.5};
+  bool lost_ = false;  // at the last update; held between updates
+  HealthRecord health_;
   mutable OccupancyGrid map_;
   mutable int map_version_ = -1;  // update count the map was converted at
 };

@@ -1,0 +1,120 @@
+#include "slam/pipeline/health.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+#include "slam/eval/chi_square.h"
+#include "slam/types/check.h"
+
+namespace slamrig::slam {
+
+QualityRatio::QualityRatio(double fast_rate, double slow_rate, int warmup, double hold_below)
+    : fast_rate_(fast_rate), slow_rate_(slow_rate), warmup_(warmup), hold_below_(hold_below) {
+  SLAMRIG_CHECK(0.0 < slow_rate && slow_rate < fast_rate && fast_rate <= 1.0 && warmup >= 1,
+                "QualityRatio: needs 0 < slow_rate < fast_rate <= 1 and warmup >= 1");
+}
+
+double QualityRatio::Add(double quality) {
+  // The first sample starts both averages; later ones move each by its own rate.
+  if (samples_ == 0) {
+    fast_ = slow_ = quality;
+  } else {
+    fast_ += fast_rate_ * (quality - fast_);
+    if (!(warm() && quality < hold_below_ * slow_)) slow_ += slow_rate_ * (quality - slow_);
+  }
+  ++samples_;
+  return ratio();
+}
+
+double QualityRatio::ratio() const {
+  if (!warm() || !(slow_ > 0.0)) return 1.0;
+  return fast_ / slow_;
+}
+
+void NisWindow::Add(double nis, int dimension) {
+  SLAMRIG_CHECK(dimension > 0, "NisWindow::Add: dimension must be > 0");
+  window_.emplace_back(nis, dimension);
+  nis_sum_ += nis;
+  dimension_sum_ += dimension;
+  if (static_cast<int>(window_.size()) > kUpdates) {
+    nis_sum_ -= window_.front().first;
+    dimension_sum_ -= window_.front().second;
+    window_.pop_front();
+  }
+}
+
+double NisWindow::ratio() const {
+  if (window_.empty()) return 0.0;
+  return nis_sum_ / ChiSquareQuantile(kProbability, dimension_sum_);
+}
+
+void HealthRecord::Add(bool lost) {
+  ++scans_;
+  if (lost) {
+    ++lost_scans_;
+    if (!lost_now_) ++losses_;
+  }
+  lost_now_ = lost;
+}
+
+bool HealthRecord::Diverged() const {
+  return lost_now_ || static_cast<double>(lost_scans_) > kDivergedLostShare * scans_;
+}
+
+FrontEndHealth::FrontEndHealth() : score_ratio_(0.3, 0.02, 10, kLostRatio) {}
+
+bool FrontEndHealth::Judge(const IcpOdometryStep& step, std::vector<TraceValue>* trace) {
+  const bool matched = step.outcome == IcpOdometryOutcome::kMatched ||
+                       step.outcome == IcpOdometryOutcome::kDegenerate;
+  const bool first = step.outcome == IcpOdometryOutcome::kFirstScan;
+  // Degeneracy: the smallest over the largest eigenvalue of the match's translation covariance
+  // (of the ICP Hessian's inverse): 1 for a match constrained alike in every direction, near 0
+  // along a corridor; 0 without a match.
+  double conditioning = 0.0;
+  if (matched) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(step.covariance.topLeftCorner<2, 2>());
+    conditioning = eig.eigenvalues()[1] > 0.0 ? eig.eigenvalues()[0] / eig.eigenvalues()[1] : 0.0;
+  }
+  const double ratio = first ? 1.0 : score_ratio_.Add(matched ? step.score : 0.0);
+  // The correction of the prior in units of its search window (+-sigmas of the measured noise).
+  const Eigen::Vector2d correction =
+      first ? Eigen::Vector2d::Zero().eval()
+            : Eigen::Vector2d((step.pose.translation() - step.prior.translation()).norm() /
+                                  std::max(step.window.x(), 1e-9),
+                              std::abs(NormalizeAngle(step.pose.theta() - step.prior.theta())) /
+                                  std::max(step.window.y(), 1e-9));
+  trace->push_back({"match_score", matched ? step.score : 0.0});
+  trace->push_back({"match_score_ratio", ratio});
+  trace->push_back({"match_conditioning", conditioning});
+  trace->push_back({"searched", step.searched ? (step.search_chosen ? 2.0 : 1.0) : 0.0});
+  trace->push_back({"correction_xy_of_window", correction.x()});
+  trace->push_back({"correction_yaw_of_window", correction.y()});
+  // Lost: the match failed (the scan placed by the odometry alone, blind) or the match score's
+  // short-term average fell below half its long-term level.
+  const bool failed = step.outcome == IcpOdometryOutcome::kMatchFailed ||
+                      step.outcome == IcpOdometryOutcome::kNoPoints;
+  return !first && (failed || ratio < kLostRatio);
+}
+
+std::vector<LostInterval> LostIntervals(const Trajectory& online, const std::vector<bool>& lost) {
+  SLAMRIG_CHECK(online.size() == lost.size(), "LostIntervals: one flag per scan");
+  std::vector<LostInterval> intervals;
+  for (std::size_t i = 0; i < lost.size(); ++i) {
+    if (!lost[i]) continue;
+    if (i == 0 || !lost[i - 1]) intervals.push_back({online[i].time, online[i].time, 0});
+    ++intervals.back().scans;
+    // A stamp earlier than the interval's start (a log's out-of-order stamps) ends it at its start.
+    intervals.back().to =
+        std::max(intervals.back().from, i + 1 < lost.size() ? online[i + 1].time : online[i].time);
+  }
+  return intervals;
+}
+
+double LostSeconds(const std::vector<LostInterval>& intervals) {
+  double seconds = 0.0;
+  for (const LostInterval& interval : intervals) seconds += interval.seconds();
+  return seconds;
+}
+
+}  // namespace slamrig::slam

@@ -1,0 +1,127 @@
+#pragma once
+
+// Self-diagnosis shared by the estimators: each reports its own per-scan health values in its
+// trace, and from them, by its own rule, whether it is lost at that scan (ScanEstimate::lost).
+// The rules are built from the pieces here: the ratio of a quality's short-term to its long-term
+// average (augmented MCL's w_fast / w_slow, Thrun et al., "Probabilistic Robotics", 2005,
+// Table 8.3), which judges a scan against the run's own level instead of a fixed threshold; a
+// Kalman filter's NIS over its last updates against its chi-square quantile; the ICP front end's
+// rule; and the verdict `diverged` from the lost flags. The runner turns consecutive lost scans
+// into LostIntervals. docs/estimators.md ("How each estimator judges itself") lists the rules.
+
+#include <deque>
+#include <utility>
+#include <vector>
+
+#include "slam/matching/icp_odometry.h"
+#include "slam/pipeline/estimator.h"
+#include "slam/types/time.h"
+#include "slam/types/trajectory.h"
+
+namespace slamrig::slam {
+
+/// A quality whose short-term average falls below this share of its long-term one is lost (the
+/// pf's relocalisation.lost_ratio default).
+inline constexpr double kLostRatio = 0.5;
+
+/// An estimator calls its run diverged when it was lost at its last scan or on more than this
+/// share of its scans: a loss it recovered from is a lost interval, not a failed run.
+inline constexpr double kDivergedLostShare = 0.1;
+
+/// The short-term over the long-term exponentially weighted average of a positive quality (a
+/// match score, a matched fraction): about 1 while the quality holds its usual level, well below
+/// 1 when it falls. Dimensionless, so a threshold on it holds for any dataset's level.
+class QualityRatio {
+ public:
+  /// Weights per sample of the short- and long-term averages, 0 < slow_rate < fast_rate <= 1;
+  /// the ratio is given once `warmup` samples are in (before that, 1). A sample below
+  /// `hold_below` times the long-term average leaves that average alone (0: none does): the
+  /// level to come back to, which a long loss must not become.
+  QualityRatio(double fast_rate, double slow_rate, int warmup, double hold_below = 0.0);
+
+  /// Adds one quality (>= 0) and returns the ratio after it.
+  double Add(double quality);
+  /// The current ratio (1 before the warm-up ends or while the long-term average is 0).
+  double ratio() const;
+  bool warm() const { return samples_ >= warmup_; }
+
+ private:
+  double fast_rate_, slow_rate_;
+  int warmup_;
+  double hold_below_;
+  int samples_ = 0;
+  double fast_ = 0.0, slow_ = 0.0;
+};
+
+/// A Kalman filter's consistency over its last updates: the sum of their normalised innovations
+/// squared (NIS) is chi-square with the sum of their dimensions as degrees of freedom when the
+/// filter is consistent (Bar-Shalom et al., "Estimation with Applications to Tracking and
+/// Navigation", 2001, Sec. 5.4.2); above its 99.9 % quantile the filter's model no longer
+/// explains its measurements. A window, not one update, so that one outlier does not decide.
+class NisWindow {
+ public:
+  static constexpr int kUpdates = 10;  ///< updates in the window
+  static constexpr double kProbability = 0.999;
+
+  /// Adds one update's NIS and its dimension (> 0).
+  void Add(double nis, int dimension);
+  /// The window's NIS sum over its chi-square quantile: > 1 is inconsistent; 0 while empty.
+  double ratio() const;
+  /// Inconsistent: a full window whose ratio is above 1.
+  bool inconsistent() const { return static_cast<int>(window_.size()) == kUpdates && ratio() > 1; }
+
+ private:
+  std::deque<std::pair<double, int>> window_;
+  double nis_sum_ = 0.0;
+  int dimension_sum_ = 0;
+};
+
+/// An estimator's per-scan lost flags, counted: the statistics `lost` (losses) and `diverged`.
+class HealthRecord {
+ public:
+  void Add(bool lost);
+
+  int scans() const { return scans_; }
+  int lost_scans() const { return lost_scans_; }
+  /// Times it became lost (runs of consecutive lost scans).
+  int losses() const { return losses_; }
+  bool lost_at_end() const { return lost_now_; }
+  /// Lost at the last scan, or on more than kDivergedLostShare of the scans.
+  bool Diverged() const;
+
+ private:
+  int scans_ = 0;
+  int lost_scans_ = 0;
+  int losses_ = 0;
+  bool lost_now_ = false;
+};
+
+/// The health of a scan-to-local-map front end (IcpOdometry: the graph's and icp-odometry's) at
+/// each scan, and its lost rule.
+class FrontEndHealth {
+ public:
+  FrontEndHealth();
+  /// Judges the step that placed one scan: appends its health values to `trace` and returns
+  /// whether the front end is lost there.
+  bool Judge(const IcpOdometryStep& step, std::vector<TraceValue>* trace);
+
+ private:
+  QualityRatio score_ratio_;
+};
+
+/// A run of consecutive lost scans.
+struct LostInterval {
+  Time from;  ///< the first lost scan's time
+  /// The next scan's time (the first one not lost), or the last scan's at the end; never before
+  /// `from`.
+  Time to;
+  int scans = 0;  ///< lost scans in it
+  double seconds() const { return SecondsBetween(to, from); }
+};
+
+/// The lost intervals of a run: `lost[i]` for the scan at `online[i]` (same length).
+std::vector<LostInterval> LostIntervals(const Trajectory& online, const std::vector<bool>& lost);
+/// Their total length, seconds.
+double LostSeconds(const std::vector<LostInterval>& intervals);
+
+}  // namespace slamrig::slam

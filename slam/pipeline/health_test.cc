@@ -1,0 +1,173 @@
+#include "slam/pipeline/health.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+namespace slamrig::slam {
+namespace {
+
+Trajectory Stamped(const std::vector<double>& times_s) {
+  Trajectory t;
+  for (double s : times_s) t.Append(Time::FromSeconds(s), Pose2());
+  return t;
+}
+
+TEST(HealthTest, LostIntervalsRunFromTheFirstLostScanToTheNextOneNotLost) {
+  const Trajectory online = Stamped({0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0});
+  const std::vector<LostInterval> intervals =
+      LostIntervals(online, {false, true, true, false, true, false, true});
+  ASSERT_EQ(intervals.size(), 3u);
+  EXPECT_EQ(intervals[0].from, Time::FromSeconds(0.5));
+  EXPECT_EQ(intervals[0].to, Time::FromSeconds(1.5));
+  EXPECT_EQ(intervals[0].scans, 2);
+  EXPECT_EQ(intervals[1].from, Time::FromSeconds(2.0));
+  EXPECT_EQ(intervals[1].to, Time::FromSeconds(2.5));
+  // Lost at the last scan: it ends there.
+  EXPECT_EQ(intervals[2].from, Time::FromSeconds(3.0));
+  EXPECT_EQ(intervals[2].to, Time::FromSeconds(3.0));
+  EXPECT_DOUBLE_EQ(LostSeconds(intervals), 1.5);
+  EXPECT_TRUE(LostIntervals(online, std::vector<bool>(7, false)).empty());
+}
+
+// Random flag sequences: the intervals cover exactly the lost scans, and HealthRecord counts
+// them as the intervals do.
+TEST(HealthTest, IntervalsAndRecordAgreeWithTheFlagsOnRandomRuns) {
+  std::mt19937 random(7);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int n = 1 + static_cast<int>(random() % 40);
+    std::vector<double> times;
+    std::vector<bool> lost;
+    HealthRecord record;
+    double t = 0.0;
+    for (int i = 0; i < n; ++i) {
+      t += 0.1 + 0.01 * static_cast<double>(random() % 10);
+      times.push_back(t);
+      lost.push_back(random() % 3 == 0);
+      record.Add(lost.back());
+    }
+    const std::vector<LostInterval> intervals = LostIntervals(Stamped(times), lost);
+    int lost_scans = 0;
+    for (const LostInterval& interval : intervals) {
+      lost_scans += interval.scans;
+      EXPECT_LE(interval.from, interval.to);
+    }
+    EXPECT_EQ(lost_scans, static_cast<int>(std::count(lost.begin(), lost.end(), true)));
+    EXPECT_EQ(record.lost_scans(), lost_scans);
+    EXPECT_EQ(record.losses(), static_cast<int>(intervals.size()));
+    EXPECT_EQ(record.lost_at_end(), static_cast<bool>(lost.back()));
+    EXPECT_EQ(record.Diverged(),
+              lost.back() || lost_scans > kDivergedLostShare * static_cast<double>(n));
+  }
+}
+
+TEST(HealthTest, RecoveredLossIsNotDivergence) {
+  HealthRecord record;
+  for (int i = 0; i < 100; ++i) record.Add(i >= 40 && i < 45);  // 5 % lost, recovered
+  EXPECT_EQ(record.losses(), 1);
+  EXPECT_FALSE(record.Diverged());
+  record.Add(true);  // lost at the end
+  EXPECT_TRUE(record.Diverged());
+  HealthRecord long_loss;
+  for (int i = 0; i < 100; ++i) long_loss.Add(i >= 10 && i < 30);  // 20 % lost
+  EXPECT_TRUE(long_loss.Diverged());
+}
+
+TEST(HealthTest, QualityRatioFollowsTheRunsOwnLevel) {
+  // Two runs at levels a factor 10 apart give the same ratios: no absolute threshold.
+  QualityRatio low(0.5, 0.01, 5), high(0.5, 0.01, 5);
+  EXPECT_DOUBLE_EQ(low.ratio(), 1.0);
+  for (int i = 0; i < 50; ++i) {
+    low.Add(0.07);
+    high.Add(0.7);
+  }
+  EXPECT_NEAR(low.ratio(), 1.0, 1e-12);
+  // A fall to a third: the short-term average follows within a few samples, the long-term one
+  // barely moves.
+  for (int i = 0; i < 6; ++i) {
+    low.Add(0.07 / 3);
+    high.Add(0.7 / 3);
+  }
+  EXPECT_NEAR(low.ratio(), high.ratio(), 1e-12);
+  EXPECT_LT(low.ratio(), 0.4);
+  EXPECT_GT(low.ratio(), 1.0 / 3);
+  // Holding the long-term level: a long fall stays a fall.
+  QualityRatio held(0.5, 0.05, 5, 0.5), unheld(0.5, 0.05, 5);
+  for (int i = 0; i < 20; ++i) {
+    held.Add(1.0);
+    unheld.Add(1.0);
+  }
+  for (int i = 0; i < 200; ++i) {
+    held.Add(0.2);
+    unheld.Add(0.2);
+  }
+  EXPECT_NEAR(held.ratio(), 0.2, 1e-9);
+  EXPECT_NEAR(unheld.ratio(), 1.0, 1e-3);
+  // Not warm yet: 1.
+  QualityRatio cold(0.5, 0.01, 5);
+  cold.Add(1.0);
+  EXPECT_DOUBLE_EQ(cold.Add(0.0), 1.0);
+}
+
+// The NIS of a consistent filter is chi-square: 3-dof draws stay inside the window's quantile
+// nearly always; three times them do not.
+TEST(HealthTest, NisWindowFlagsAnInconsistentFilterOnly) {
+  std::mt19937 random(3);
+  std::chi_squared_distribution<double> chi2(3.0);
+  NisWindow consistent, inflated;
+  int flagged = 0, inflated_flagged = 0;
+  EXPECT_DOUBLE_EQ(consistent.ratio(), 0.0);
+  for (int i = 0; i < 2000; ++i) {
+    const double nis = chi2(random);
+    consistent.Add(nis, 3);
+    inflated.Add(3.0 * nis, 3);
+    flagged += consistent.inconsistent();
+    inflated_flagged += inflated.inconsistent();
+  }
+  EXPECT_LT(flagged, 20) << flagged;  // overlapping windows: a few times 0.1 % at most
+  EXPECT_GT(inflated_flagged, 1800);  // the sum of ten is 90 on average, the bound 59.7
+  // A full window only: nine wild updates are not yet a verdict.
+  NisWindow short_window;
+  for (int i = 0; i < NisWindow::kUpdates - 1; ++i) short_window.Add(1000.0, 3);
+  EXPECT_FALSE(short_window.inconsistent());
+  short_window.Add(1000.0, 3);
+  EXPECT_TRUE(short_window.inconsistent());
+}
+
+IcpOdometryStep Step(IcpOdometryOutcome outcome, double score) {
+  IcpOdometryStep step;
+  step.outcome = outcome;
+  step.score = score;
+  step.covariance = Eigen::Matrix3d::Identity() * 1e-4;
+  step.window = Eigen::Vector2d(0.3, 0.1);
+  return step;
+}
+
+TEST(HealthTest, FrontEndIsLostOnAFailedMatchAndOnAFallingScore) {
+  FrontEndHealth health;
+  std::vector<TraceValue> trace;
+  EXPECT_FALSE(health.Judge(Step(IcpOdometryOutcome::kFirstScan, 0.0), &trace));
+  for (int i = 0; i < 30; ++i) {
+    trace.clear();
+    EXPECT_FALSE(health.Judge(Step(IcpOdometryOutcome::kMatched, 0.9), &trace)) << i;
+  }
+  // Its health values, every scan the same names.
+  std::vector<std::string> names;
+  for (const TraceValue& v : trace) names.push_back(v.name);
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "match_score", "match_score_ratio", "match_conditioning", "searched",
+                       "correction_xy_of_window", "correction_yaw_of_window"}));
+  EXPECT_DOUBLE_EQ(trace[2].value, 1.0);  // an isotropic covariance: well conditioned
+  EXPECT_TRUE(health.Judge(Step(IcpOdometryOutcome::kMatchFailed, 0.0), &trace));
+  EXPECT_TRUE(health.Judge(Step(IcpOdometryOutcome::kNoPoints, 0.0), &trace));
+  EXPECT_FALSE(health.Judge(Step(IcpOdometryOutcome::kMatched, 0.9), &trace));
+  // Matches at a third of the usual score: lost within a few scans, not at the first.
+  EXPECT_FALSE(health.Judge(Step(IcpOdometryOutcome::kMatched, 0.3), &trace));
+  bool lost = false;
+  for (int i = 0; i < 5; ++i) lost = health.Judge(Step(IcpOdometryOutcome::kMatched, 0.3), &trace);
+  EXPECT_TRUE(lost);
+}
+
+}  // namespace
+}  // namespace slamrig::slam

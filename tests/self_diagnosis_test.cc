@@ -1,0 +1,95 @@
+// Self-diagnosis end to end: the particle filter kidnapped in the office must say it was lost
+// (a lost interval at the kidnapping, in metrics.json and the report), `expect: {pf: {lost_max:
+// 0}}` must then fail the run and nothing else, and having recovered it must not call its run
+// diverged. Graph SLAM on intel's start with doubled odometry noise, which ends 2 m off from one
+// failed match, must call itself diverged; on the clean start it must not.
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "tests/util/dataset.h"
+#include "tests/util/run_command.h"
+#include "tests/util/temp_dir.h"
+
+namespace slamrig {
+namespace {
+
+std::string Read(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(SelfDiagnosisTest, KidnappedFilterDeclaresItsLostIntervalAndLostMaxZeroFails) {
+  testing::TempDir dir;
+  const std::string source = SLAMRIG_SOURCE_DIR;
+  // scenarios/kidnapping.yaml cut to 75 s: the kidnapping at 60 s and the relocalisation after.
+  const std::string scenario = dir.Write(
+      "kidnap.yaml", "name: kidnap\nworld: " + source + "/worlds/office.yaml\nrobot: " + source +
+                         "/robots/ece276a.yaml\nseed: 1\nduration_s: 75\n"
+                         "world_overrides: {drive.laps: 2}\n"
+                         "faults:\n  kidnap:\n"
+                         "    - {at_s: 60, to: {x_m: 10.0, y_m: 1.25, yaw_rad: 0.0}}\n"
+                         "slam:\n  pf: {algorithm: pf, particles: 100}\n"
+                         "expect:\n  pf: {lost_max: 0, lost_intervals_min: 1, "
+                         "lost_intervals_max: 1, diverged_max: 0}\n");
+  const auto run = testing::RunCommand(std::string(SLAMRIG_BINARY) + " run " + scenario +
+                                       " --out " + dir.File("out") + " --quiet");
+  EXPECT_EQ(run.exit_code, 3) << run.output;  // an expectation failed
+  const YAML::Node metrics = YAML::LoadFile(dir.File("out/metrics.json"));
+  const YAML::Node pf = metrics["configs"]["pf"];
+  EXPECT_EQ(pf["lost"].as<double>(), 1.0);
+  EXPECT_EQ(pf["lost_intervals"].as<double>(), 1.0);
+  EXPECT_EQ(pf["diverged"].as<double>(), 0.0);
+  // The interval starts at the first scan after the kidnapping and ends at the relocalisation.
+  ASSERT_EQ(pf["run"]["lost_from_s"].size(), 1u);
+  const double from_s = pf["run"]["lost_from_s"][0].as<double>();
+  const double to_s = pf["run"]["lost_to_s"][0].as<double>();
+  EXPECT_GE(from_s, 60.0);
+  EXPECT_LE(from_s, 62.0);
+  EXPECT_GT(to_s, from_s);
+  EXPECT_LE(to_s, 90.0);
+  EXPECT_NEAR(pf["lost_s"].as<double>(), to_s - from_s, 1e-6);
+  // lost_max: 0 is the one expectation that fails.
+  const YAML::Node expectations = metrics["expectations"];
+  EXPECT_FALSE(expectations["pf.lost_max"]["passed"].as<bool>());
+  EXPECT_TRUE(expectations["pf.lost_intervals_min"]["passed"].as<bool>());
+  EXPECT_TRUE(expectations["pf.lost_intervals_max"]["passed"].as<bool>());
+  EXPECT_TRUE(expectations["pf.diverged_max"]["passed"].as<bool>());
+  // The report lists the interval.
+  EXPECT_NE(Read(dir.File("out/report.html")).find("Self-diagnosis"), std::string::npos);
+}
+
+// `slamrig slam` on intel's first 200 scans, perturbed as given; the graph's metrics.
+YAML::Node GraphOnIntelStart(const testing::TempDir& dir, const std::string& log,
+                             const std::string& name, const std::string& perturb) {
+  const auto run = testing::RunCommand(std::string(SLAMRIG_BINARY) + " slam " + log +
+                                       " --algorithm graph --max-scans 200 --quiet --out " +
+                                       dir.File(name) + perturb);
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  return YAML::LoadFile(dir.File(name + "/metrics.json"))["configs"]["graph"];
+}
+
+TEST(SelfDiagnosisTest, GraphCallsAnUnrepairedFrontEndLossDiverged) {
+  SLAMRIG_REQUIRE_DATASET(log, "carmen_corrected/intel-corrected.log.gz");
+  testing::TempDir dir;
+  const YAML::Node clean = GraphOnIntelStart(dir, log, "clean", "");
+  EXPECT_LT(clean["ate_rmse_m"].as<double>(), 0.1);
+  EXPECT_EQ(clean["lost"].as<double>(), 0.0);
+  EXPECT_EQ(clean["diverged"].as<double>(), 0.0);
+  const YAML::Node noisy = GraphOnIntelStart(dir, log, "noisy",
+                                             " --perturb odometry.noise_per_m=0.131"
+                                             " --perturb odometry.noise_per_rad=0.348"
+                                             " --perturb scans.drop_fraction=0.1");
+  EXPECT_GT(noisy["ate_rmse_m"].as<double>(), 1.0);  // the failure the verdict must see
+  EXPECT_GE(noisy["lost_intervals"].as<double>(), 1.0);
+  EXPECT_GE(noisy["unrepaired_losses"].as<double>(), 1.0);
+  EXPECT_EQ(noisy["diverged"].as<double>(), 1.0);
+}
+
+}  // namespace
+}  // namespace slamrig
