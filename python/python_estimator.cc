@@ -305,8 +305,9 @@ std::unique_ptr<slam::Estimator> MakePythonEstimator(const slam::PythonEstimator
   // A class or a factory is called; an object that already estimates is used as it is.
   if (py::isinstance<py::type>(target) || !py::hasattr(target, "add_scan")) {
     py::dict kwargs;
-    for (const auto& [key, value] : options.options) {
-      std::visit([&](const auto& v) { kwargs[py::str(key)] = py::cast(v); }, value);
+    for (const auto& option : options.options) {
+      std::visit([&](const auto& v) { kwargs[py::str(option.first)] = py::cast(v); },
+                 option.second);
     }
     if (AcceptsKeyword(target, "seed") && !kwargs.contains("seed")) kwargs["seed"] = context.seed;
     if (AcceptsKeyword(target, "robot") && !kwargs.contains("robot")) {

@@ -61,9 +61,10 @@ EstimatorView GraphSlamEstimator::View() const {
 int GraphSlamEstimator::UnrepairedLosses() const {
   const std::vector<LoopClosure> closures = slam_.UnstrainedLoopClosures();
   int unrepaired = 0;
-  for (const auto& [first, last] : losses_) {
+  for (const auto& loss : losses_) {
+    // A closure repairs the loss when it spans it: from a scan before it to one after it.
     unrepaired += std::none_of(closures.begin(), closures.end(), [&](const LoopClosure& c) {
-      return c.from_scan < first && c.to_scan > last;
+      return c.from_scan < loss.first && c.to_scan > loss.second;
     });
   }
   return unrepaired;
