@@ -27,13 +27,8 @@ ScanEstimate GraphSlamEstimator::AddScan(const SyncedScan& scan) {
   }
   ScanEstimate estimate;
   estimate.pose = pose;
-  const bool lost = front_end_health_.Judge(slam_.last_step(), &estimate.trace);
-  health_.Add(lost);
-  estimate.lost = lost;
-  if (lost && (losses_.empty() || losses_.back().second != scans_ - 1))
-    losses_.emplace_back(scans_, scans_);
-  if (lost) losses_.back().second = scans_;
-  ++scans_;
+  estimate.lost = front_end_health_.Judge(slam_.last_step(), &estimate.trace);
+  health_.Add(*estimate.lost);
   return estimate;
 }
 
@@ -61,7 +56,7 @@ EstimatorView GraphSlamEstimator::View() const {
 int GraphSlamEstimator::UnrepairedLosses() const {
   const std::vector<LoopClosure> closures = slam_.UnstrainedLoopClosures();
   int unrepaired = 0;
-  for (const auto& loss : losses_) {
+  for (const auto& loss : health_.loss_scans()) {
     // A closure repairs the loss when it spans it: from a scan before it to one after it.
     unrepaired += std::none_of(closures.begin(), closures.end(), [&](const LoopClosure& c) {
       return c.from_scan < loss.first && c.to_scan > loss.second;
@@ -92,6 +87,7 @@ const std::vector<std::string>& GraphSlamEstimator::StatisticNames() {
 
 std::map<std::string, double> GraphSlamEstimator::Statistics() const {
   const GraphSlamCounts& c = slam_.counts();
+  const int unrepaired_losses = UnrepairedLosses();
   return {{"keyframes", c.keyframes},
           {"loop_closures", c.loop_closures},
           {"loop_candidates", c.loop_candidates},
@@ -104,10 +100,10 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"certified", c.certified ? 1.0 : 0.0},
           {"certificate_lambda_min", c.certificate_lambda_min},
           {"strained_edges", c.strained_edges},
-          {"diverged", c.diverged || health_.Diverged() || UnrepairedLosses() > 0 ? 1.0 : 0.0},
+          {"diverged", c.diverged || health_.Diverged() || unrepaired_losses > 0 ? 1.0 : 0.0},
           {"lost", health_.losses()},
           {"chi2_ratio", c.chi2_ratio},
-          {"unrepaired_losses", UnrepairedLosses()}};
+          {"unrepaired_losses", unrepaired_losses}};
 }
 
 }  // namespace slamrig::slam

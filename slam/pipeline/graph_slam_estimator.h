@@ -65,10 +65,7 @@ class GraphSlamEstimator final : public Estimator {
   OccupancyGrid map_;
   std::vector<LaserScan> node_scans_;  // the scan of each graph node (vertex id), for the map
   FrontEndHealth front_end_health_;
-  HealthRecord health_;
-  // The first and last scan of each loss of the front end, for the repair test.
-  std::vector<std::pair<int, int>> losses_;
-  int scans_ = 0;
+  HealthRecord health_;  // its loss_scans() are the repair test's
 };
 
 }  // namespace slamrig::slam

@@ -50,12 +50,13 @@ double NisWindow::ratio() const {
 }
 
 void HealthRecord::Add(bool lost) {
-  ++scans_;
   if (lost) {
     ++lost_scans_;
-    if (!lost_now_) ++losses_;
+    if (!lost_now_) loss_scans_.emplace_back(scans_, scans_);
+    loss_scans_.back().second = scans_;
   }
   lost_now_ = lost;
+  ++scans_;
 }
 
 bool HealthRecord::Diverged() const {

@@ -84,7 +84,9 @@ class HealthRecord {
   int scans() const { return scans_; }
   int lost_scans() const { return lost_scans_; }
   /// Times it became lost (runs of consecutive lost scans).
-  int losses() const { return losses_; }
+  int losses() const { return static_cast<int>(loss_scans_.size()); }
+  /// Each loss's first and last scan, counted from 0 in Add order.
+  const std::vector<std::pair<int, int>>& loss_scans() const { return loss_scans_; }
   bool lost_at_end() const { return lost_now_; }
   /// Lost at the last scan, or on more than kDivergedLostShare of the scans.
   bool Diverged() const;
@@ -92,7 +94,7 @@ class HealthRecord {
  private:
   int scans_ = 0;
   int lost_scans_ = 0;
-  int losses_ = 0;
+  std::vector<std::pair<int, int>> loss_scans_;
   bool lost_now_ = false;
 };
 
