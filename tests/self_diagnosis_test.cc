@@ -7,22 +7,13 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include <fstream>
-#include <sstream>
-
 #include "tests/util/dataset.h"
+#include "tests/util/read_file.h"
 #include "tests/util/run_command.h"
 #include "tests/util/temp_dir.h"
 
 namespace slamrig {
 namespace {
-
-std::string Read(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 TEST(SelfDiagnosisTest, KidnappedFilterDeclaresItsLostIntervalAndLostMaxZeroFails) {
   testing::TempDir dir;
@@ -61,7 +52,8 @@ TEST(SelfDiagnosisTest, KidnappedFilterDeclaresItsLostIntervalAndLostMaxZeroFail
   EXPECT_TRUE(expectations["pf.lost_intervals_max"]["passed"].as<bool>());
   EXPECT_TRUE(expectations["pf.diverged_max"]["passed"].as<bool>());
   // The report lists the interval.
-  EXPECT_NE(Read(dir.File("out/report.html")).find("Self-diagnosis"), std::string::npos);
+  EXPECT_NE(testing::ReadFile(dir.File("out/report.html")).find("Self-diagnosis"),
+            std::string::npos);
 }
 
 // `slamrig slam` on intel's first 200 scans, perturbed as given; the graph's metrics.
