@@ -48,12 +48,17 @@ void AddLiveFlags(ArgParser* parser, LiveFlags* flags) {
                     "twice as fast, 0 as fast as it goes; a client changes it with the "
                     "slamrig.pace parameter [default: 1]",
                     &flags->pace);
+  parser->AddFlag("live-wait",
+                  "with --live, hold the run at its start until a client subscribes to a topic, "
+                  "so that a viewer opened after the command sees the whole run",
+                  &flags->wait);
 }
 
 std::unique_ptr<scenario::LiveServer> StartLive(const std::string& command, const LiveFlags& flags,
                                                 scenario::RunnerOptions* options) {
   if (!flags.live) {
     if (!flags.pace.empty()) throw ConfigError(command + ": --live-pace needs --live");
+    if (flags.wait) throw ConfigError(command + ": --live-wait needs --live");
     return nullptr;
   }
   scenario::LiveOptions live;
@@ -76,12 +81,14 @@ std::unique_ptr<scenario::LiveServer> StartLive(const std::string& command, cons
     }
     live.pace = pace;
   }
+  live.wait_for_watcher = flags.wait;
   auto server = std::make_unique<scenario::LiveServer>(live);
   scenario::LiveServer* s = server.get();
   options->live = s;
   options->pace = [s](Time t) { s->Pace(t); };
   std::fprintf(stderr, "live: Foxglove WebSocket on %s (Foxglove: Open connection)\n",
                s->url().c_str());
+  if (flags.wait) std::fprintf(stderr, "live: the run starts when a client subscribes\n");
   std::fflush(stderr);
   return server;
 }

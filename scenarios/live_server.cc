@@ -111,7 +111,8 @@ struct LiveServer::Impl {
   std::atomic<int> watchers{0};  // sessions with at least one subscription
   std::atomic<std::uint64_t> sent{0}, dropped{0}, clients{0};
 
-  // The run's thread only: the pacing's anchor.
+  // The run's thread only: the pacing's anchor, and whether the run still waits for a watcher.
+  bool holding = false;
   bool anchored = false;
   SteadyClock::time_point anchor_wall;
   std::int64_t anchor_ns = 0, last_pace_ns = 0;
@@ -455,6 +456,7 @@ LiveServer::LiveServer(LiveOptions options) : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.options = std::move(options);
   m.pace = m.options.pace;
+  m.holding = m.options.wait_for_watcher;
   const std::string where = m.options.address + ":" + std::to_string(m.options.port);
   beast::error_code ec;
   const net::ip::address address = net::ip::make_address(m.options.address, ec);
@@ -525,6 +527,17 @@ bool LiveServer::Wants(const std::string& topic, slam::RosType type, bool latche
 
 void LiveServer::Pace(Time time) {
   Impl& m = *impl_;
+  if (m.holding) {
+    // Held from the first step that advertised a topic, which a client can subscribe to.
+    {
+      std::lock_guard lock(m.mu);
+      if (m.channels.empty()) return;
+    }
+    while (m.watchers.load() == 0 && InterruptSignal() == 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    m.holding = false;
+  }
   // The clients' clock follows the run's even when no message they take is made.
   if (m.watchers.load() > 0) {
     std::lock_guard lock(m.mu);

@@ -19,6 +19,9 @@ struct LiveOptions {
   /// The run's speed while a client is subscribed, as a factor of real time (1 real time, 2
   /// twice as fast, 0 as fast as it goes); a client changes it with the `slamrig.pace` parameter.
   double pace = 1.0;
+  /// Holds the run at the first Pace() after a topic was declared until a client subscribes to
+  /// something, so that a viewer opened after the start sees the run from its beginning.
+  bool wait_for_watcher = false;
   /// Bytes of messages queued for one client before further messages to it are dropped.
   std::size_t queue_bytes = 16u << 20;
 };
@@ -62,7 +65,9 @@ class LiveServer final : public slam::MessageSink {
   /// True for a latched topic and for one a client is subscribed to; declares the topic.
   bool Wants(const std::string& topic, slam::RosType type, bool latched) override;
   /// The run has reached `time` on its own clock: sleeps until the wall clock catches up with
-  /// it at the current pace while a client is subscribed; returns at once otherwise.
+  /// it at the current pace while a client is subscribed; returns at once otherwise. With
+  /// LiveOptions::wait_for_watcher, the first call after a topic was declared first waits for a
+  /// subscription (or an interrupt signal).
   void Pace(Time time);
   /// Lets the clients receive what is queued for them, for at most `drain_s` seconds of wall
   /// time (less when none of them takes anything for half a second), then closes their

@@ -150,6 +150,17 @@ TEST(CliTest, BadFlagsFailWithUsageError) {
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.output, HasSubstr("scans.drop_fraction = 2; must be in [0, 1]"));
   EXPECT_FALSE(std::filesystem::exists(dir.File("o")));
+  // The live view's flags without --live, or with a bad pace: one line, nothing written.
+  for (const auto& [flags, message] : std::vector<std::pair<std::string, std::string>>{
+           {"--live-wait", "--live-wait needs --live"},
+           {"--live-pace 2", "--live-pace needs --live"},
+           {"--live 0 --live-pace -1", "--live-pace: expected a number >= 0"}}) {
+    run = RunCommand(Slamrig("slam " + log + " " + flags + " --out " + dir.File("o")));
+    EXPECT_EQ(run.exit_code, 2) << flags;
+    EXPECT_THAT(run.output, HasSubstr(message)) << flags;
+    EXPECT_EQ(CountLines(run.output), 1) << run.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.File("o"))) << flags;
+  }
 }
 
 TEST(CliTest, RunWritesAReportAndFailsOnAnUnmetExpectation) {

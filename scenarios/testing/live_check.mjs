@@ -2,7 +2,7 @@
 // (@foxglove/ws-protocol over the `ws` package) and its ROS 2 decoder
 // (@foxglove/rosmsg, @foxglove/rosmsg2-serialization).
 //
-// Usage: node live_check.mjs NODE_MODULES_PARENT watch URL
+// Usage: node live_check.mjs NODE_MODULES_PARENT watch URL [from-start]
 //        node live_check.mjs NODE_MODULES_PARENT stall URL
 // watch: connects while the run goes, checks serverInfo (capabilities parameters and time),
 //   subscribes to /scan, /tf, /pf/pose, /dead_reckoning/pose, /pf/particles, /pf/map and /clock
@@ -13,13 +13,15 @@
 //   for `slamrig.pace` 2 and checks that the run's clock then advances at most ~2x the wall
 //   clock; unsubscribes /scan and checks that no /scan arrives after; then disconnects
 //   mid-run (the run goes on: the test checks that it ends with the same results).
+//   With from-start (a run held by --live-wait until this client subscribes), the first /clock
+//   message must be of the run's first second.
 // stall: connects, subscribes to every channel, then never reads again (its socket paused),
 //   until it is killed: the run must not wait for it.
 // Exit 0 when everything holds; otherwise one line per failure and exit 1.
 import path from "node:path";
 import { createRequire } from "node:module";
 
-const [, , modulesParent, mode, url] = process.argv;
+const [, , modulesParent, mode, url, option] = process.argv;
 const require = createRequire(path.join(path.resolve(modulesParent), "package.json"));
 const { FoxgloveClient } = require("@foxglove/ws-protocol");
 const WebSocket = require("ws");
@@ -134,6 +136,7 @@ async function watch() {
   let unsubscribedAt = null;
   let scansAfter = 0;
   let closed = false;
+  let firstClock = null;       // log time (ns) of the first /clock message
 
   const subscribe = (c) => {
     if (topicSub.has(c.topic)) return;
@@ -175,7 +178,10 @@ async function watch() {
     }
     counts.set(s.topic, (counts.get(s.topic) ?? 0) + 1);
     checkMessage(s.topic, m, timestamp, state);
-    if (s.topic === "/clock") samples.push([Date.now(), Number(timestamp)]);
+    if (s.topic === "/clock") {
+      if (firstClock === null) firstClock = timestamp;
+      samples.push([Date.now(), Number(timestamp)]);
+    }
   });
   client.on("close", () => { closed = true; });
   client.on("error", (e) => fail(`client error: ${e.message ?? e}`));
@@ -228,6 +234,9 @@ async function watch() {
   }
   if (timeFrames < 100) fail(`only ${timeFrames} time frames`);
   if (closed) fail("the server closed the connection mid-run");
+  if (option === "from-start" && !(firstClock !== null && firstClock <= 1000000000n)) {
+    fail(`the first /clock at ${firstClock} ns: the run did not wait for this client`);
+  }
   const summary = [...counts].map(([t, n]) => `${t} ${n}`).join(", ");
   client.close();  // mid-run: the run must go on
   clearTimeout(giveUp);

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Checks `slamrig run --live` with Foxglove's own WebSocket client (live_check.mjs):
 #   1. a short office run without --live: the results to compare with;
-#   2. the same run with --live on a free port, watched by @foxglove/ws-protocol's client
+#   2. the same run with --live on a free port and --live-wait (held until the watcher
+#      subscribes: it must see the run's first second), watched by @foxglove/ws-protocol's client
 #      (subscriptions, every message decoded, the latched /tf_static, pacing at 2x real time
 #      asked through the slamrig.pace parameter, an unsubscription), which disconnects
 #      mid-run, beside a client that subscribes to everything, stops reading and is killed
@@ -134,8 +135,8 @@ rc=0
 check_rc plain "$rc"
 plain_ms=$((($(date +%s%N) - start) / 1000000))
 
-# 2. Watched, with a second server on the same port refused before its run starts.
-start_live watched
+# 2. Watched from the start, with a second server on the same port refused before its run starts.
+start_live watched --live-wait
 rc=0
 "$slamrig" run "${run_args[@]}" --out "$work/busy" --live "$port" >/dev/null 2>"$work/busy.err" || rc=$?
 if [[ $rc -eq 0 || $rc -eq 3 ]]; then failed "a second --live on port $port exited $rc"; fi
@@ -144,14 +145,15 @@ if [[ $(wc -l <"$work/busy.err") -ne 1 ]] || ! grep -q "cannot listen on 127.0.0
 fi
 if [[ -e "$work/busy" ]]; then failed "a port in use left a report folder"; fi
 echo "live_foxglove_test: a port in use: $(cat "$work/busy.err")"
-# Beside the watcher, a client that subscribes to everything, stops reading and vanishes
-# (SIGKILL) mid-run.
+# The watcher first: the run starts when it subscribes. Then, beside it, a client that subscribes
+# to everything, stops reading and vanishes (SIGKILL) mid-run.
+node "$here/live_check.mjs" "$modules" watch "ws://127.0.0.1:$port" from-start &
+watch_pid=$!
+pids+=("$watch_pid")
+sleep 2
 node "$here/live_check.mjs" "$modules" stall "ws://127.0.0.1:$port" >"$work/vanish.out" 2>&1 &
 vanish_pid=$!
 pids+=("$vanish_pid")
-node "$here/live_check.mjs" "$modules" watch "ws://127.0.0.1:$port" &
-watch_pid=$!
-pids+=("$watch_pid")
 sleep 3
 kill -KILL "$vanish_pid" 2>/dev/null || failed "the vanishing client ended before it was killed"
 wait "$vanish_pid" 2>/dev/null || true
