@@ -202,21 +202,20 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
     return step;
   }
 
-  // The match from each increment; the best-scoring one that passes the gates is kept, and its
-  // increment is the prior (the first increment's when none passes).
-  std::size_t chosen = 0;
+  // The match from each increment, the first (the prediction) the prior: another seed's match
+  // replaces the prediction's only when it scores better by search.min_gain (where the scan
+  // cannot tell, along a corridor, the prediction stands, not the seed that overlaps the map
+  // best, which is standing still), and the search and the degenerate directions keep to it.
   std::optional<MatchResult> match;
+  const Pose2& odometry_increment = increments.front();
   if (!points.empty() && matcher_) {
     for (std::size_t i = 0; i < increments.size(); ++i) {
       std::optional<MatchResult> m =
           GatedMatch(points, pose_ * increments[i], SearchWindow(increments[i]));
-      if (m && (!match || m->score > match->score)) {
-        match = std::move(m);
-        chosen = i;
-      }
+      const double margin = match && i > 0 ? options_.search.min_gain : 0.0;
+      if (m && (!match || m->score > match->score + margin)) match = std::move(m);
     }
   }
-  const Pose2& odometry_increment = increments[chosen];
   const Pose2 prior = pose_ * odometry_increment;
   // The increment's noise, rotated from the previous base frame into the odom frame.
   const Eigen::Matrix2d r = Eigen::Rotation2Dd(pose_.theta()).toRotationMatrix();

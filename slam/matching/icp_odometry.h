@@ -136,9 +136,10 @@ class IcpOdometry {
   /// Places `scan`, taken after the robot moved by `odometry_increment` (base frame at the previous
   /// scan to base frame at this one, from the wheel odometry; ignored for the first scan).
   IcpOdometryStep Add(const LaserScan& scan, const Pose2& odometry_increment);
-  /// Places `scan` from several candidate increments (a motion prediction and its alternatives):
-  /// the match from each, the best-scoring one that passes the gates kept, its increment then the
-  /// prior (the first's when none passes). One increment: exactly Add(scan, increment).
+  /// Places `scan` from several candidate increments, the first the prior (a motion prediction)
+  /// and the others seeds for ICP: the match from each that passes the gates, a seed's replacing
+  /// the best so far only when it scores better by search.min_gain; the search, the fallback and
+  /// the degenerate directions keep to the prior. One increment: exactly Add(scan, increment).
   IcpOdometryStep Add(const LaserScan& scan, const std::vector<Pose2>& increments);
 
   const Pose2& pose() const { return pose_; }

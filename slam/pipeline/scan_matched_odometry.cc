@@ -2,27 +2,32 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 namespace slamrig::slam {
 namespace {
 
-// IcpOdometry's defaults with the gates opened for a prior that is only a prediction: a robot
-// at 1 m/s and 1 rad/s that changes speed between two scans 0.2 s apart is off by a few
-// decimetres and tenths of a radian.
+// IcpOdometry's defaults with a prior that is only a prediction: a robot that changes speed or
+// turns between two scans is off it by decimetres and tenths of a radian however short the
+// interval, so the model's floors are wide (the search window +-3 sigma: 1.2 m and 0.75 rad at
+// least) and the search runs on every scan. No online noise measurement: the prediction's errors
+// are the robot's changes of mind, not a noise level to learn.
 IcpOdometryOptions WideGates() {
   IcpOdometryOptions o;
   o.max_correction_m = 1.0;
   o.max_correction_rad = 0.6;
-  // The prediction's own uncertainty, for the covariance where it stands: wider than wheels'.
   o.sigma_xy_per_m = 0.2;
-  o.sigma_xy_floor_m = 0.05;
+  o.sigma_xy_floor_m = 0.4;
   o.sigma_yaw_per_rad = 0.2;
-  o.sigma_yaw_floor_rad = 0.02;
-  // Its search is the candidates below (Add's several increments); the search around one prior
-  // on top of them places intel without odometry worse (dead reckoning 19.3 m, not 12.2 m).
-  o.search.sigmas = 0.0;
+  o.sigma_yaw_floor_rad = 0.25;
+  o.search.sigmas = 3.0;
+  o.search.adapt_rate = 0.0;
   return o;
+}
+
+Pose2 Scaled(const Pose2& increment, double k) {
+  return Pose2(k * increment.x(), k * increment.y(), k * increment.theta());
 }
 
 }  // namespace
@@ -31,17 +36,21 @@ ScanMatchedOdometry::ScanMatchedOdometry() : odometry_(WideGates()) {}
 
 SyncedScan ScanMatchedOdometry::Apply(const SyncedScan& scan) {
   SyncedScan out = scan;
-  // Constant velocity: the last matched increment, scaled to this interval (at most twice: an
-  // interval after a very short one would otherwise stretch a small motion into a leap); after a
-  // failed match the velocity is not known, and the robot is predicted still.
+  // Constant velocity: the last matched increment, scaled down to a shorter interval but never
+  // stretched beyond itself (a log whose scans are triggered by motion, as the corrected CARMEN
+  // logs are, has intervals that vary while the motion per scan does not); the stretched one, at
+  // most twice, is a further candidate (a time-triggered log that lost a scan). After a failed
+  // match the velocity is not known, and the robot is predicted still.
   Pose2 prediction;
+  std::optional<Pose2> stretched;
   if (started_ && last_matched_ && last_dt_s_ > 0.0 && scan.dt_s > 0.0) {
-    const double k = std::min(scan.dt_s / last_dt_s_, 2.0);
-    prediction =
-        Pose2(k * last_increment_.x(), k * last_increment_.y(), k * last_increment_.theta());
+    const double ratio = scan.dt_s / last_dt_s_;
+    prediction = Scaled(last_increment_, std::min(ratio, 1.0));
+    if (ratio > 1.0) stretched = Scaled(last_increment_, std::min(ratio, 2.0));
   }
-  // The wide search: the prediction, standing still, and the prediction turned or moved by
-  // what a robot may change between two scans; the best match wins.
+  // The prediction first (IcpOdometry's prior, kept where the scan cannot tell), then standing
+  // still, and the prediction turned or moved by what a robot may change between two scans: a
+  // seed wins over the prediction only by a clearly better match.
   std::vector<Pose2> candidates = {prediction, Pose2()};
   for (const double turn : {-0.3, 0.3}) {
     candidates.push_back(Pose2(prediction.x(), prediction.y(), prediction.theta() + turn));
@@ -49,6 +58,7 @@ SyncedScan ScanMatchedOdometry::Apply(const SyncedScan& scan) {
   for (const double step : {-0.3, 0.3}) {
     candidates.push_back(prediction * Pose2(step, 0.0, 0.0));
   }
+  if (stretched) candidates.push_back(*stretched);
   const IcpOdometryStep step = odometry_.Add(scan.scan, candidates);
   const Pose2 increment = started_ ? pose_.Between(step.pose) : Pose2();
   last_matched_ = step.outcome == IcpOdometryOutcome::kMatched ||

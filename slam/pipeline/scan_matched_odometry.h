@@ -10,12 +10,15 @@ namespace slamrig::slam {
 
 /// The motion between scans of a log without odometry (`odometry: {source: none}`, or a log
 /// whose odometry is missing): each scan is matched against a local map of the last keyframes
-/// (IcpOdometry), from a constant-velocity prediction (the last matched increment, scaled to
-/// this interval's length) and its alternatives (standing still, turned or moved by a few
-/// decimetres), the best match kept, with gates wide enough for a robot that speeds up or turns
-/// between two scans. Where every match fails the prediction stands; where the match is
-/// degenerate, along the degenerate direction only. Every estimator then takes the result as its
-/// odometry, with its own motion noise around it. Deterministic.
+/// (IcpOdometry) from a constant-velocity prediction (the last matched increment, scaled down to
+/// a shorter interval, never stretched beyond itself) and seeds around it (standing still, turned
+/// or moved by a few decimetres, stretched to a longer interval), then a correlative search of
+/// +-1.2 m and +-0.75 rad at least around the prediction; the best match is kept, the prediction
+/// winning ties (along a corridor the scan cannot tell how far the robot went: the prediction
+/// says it, not the seed that overlaps the map best, standing still). Where every match fails the
+/// prediction stands; where the match is degenerate, along the degenerate direction only. Every
+/// estimator then takes the result as its odometry, with its own motion noise around it.
+/// Deterministic.
 class ScanMatchedOdometry {
  public:
   ScanMatchedOdometry();
