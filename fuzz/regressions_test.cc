@@ -4,21 +4,16 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 #include <string>
 
 #include "fuzz/reader_entries.h"
+#include "tests/util/read_file.h"
 
 namespace slamrig::fuzz {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 // Runs every file below fuzz/<folder>/<entry>/ and returns how many there were; with
 // `must_accept`, a clean rejection fails too.
@@ -30,7 +25,7 @@ int RunFolder(const std::string& folder, const ReaderEntry& entry, bool must_acc
     if (!file.is_regular_file()) continue;
     ++files;
     SCOPED_TRACE(file.path().string());
-    const std::string bytes = Slurp(file.path());
+    const std::string bytes = slamrig::testing::ReadFile(file.path());
     try {
       const ReaderResult result = RunReaderEntry(entry, bytes);
       if (must_accept) {

@@ -9,13 +9,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "scenarios/scenario_runner.h"
 #include "scenarios/scenario_spec.h"
 #include "slam/io/log_reader.h"
 #include "slam/pipeline/estimator_runner.h"
 #include "slam/types/pose2.h"
+#include "tests/util/read_file.h"
 
 namespace slamrig::scenario {
 namespace {
@@ -71,13 +71,6 @@ std::string Failure(const ScenarioResult& r, const std::string& name) {
   for (const ConfigFailure& f : r.failures)
     if (f.name == name) return f.message;
   return "not failed";
-}
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 // 20 s of the office loop: the built-in dead reckoning, the shipped Python client on the run as
@@ -186,10 +179,11 @@ TEST(ExternalRunTest, ProgramsFailAloneAndTheClientMatchesBuiltInDeadReckoning) 
   EXPECT_FALSE(r.passed);
   for (const ExpectationOutcome& o : r.outcomes) EXPECT_TRUE(o.passed) << o.Describe();
   WriteReport(r, options.work_dir);
-  const std::string metrics = Slurp(dir / "report/metrics.json");
+  const std::string metrics = slamrig::testing::ReadFile(dir / "report/metrics.json");
   EXPECT_THAT(metrics, ::testing::HasSubstr("\"failure\": \"python3: killed by signal 6"));
-  EXPECT_THAT(Slurp(dir / "report/crash_stderr.txt"), ::testing::HasSubstr("lost in the corridor"));
-  EXPECT_THAT(Slurp(dir / "report/external_dr_stdout.txt"),
+  EXPECT_THAT(slamrig::testing::ReadFile(dir / "report/crash_stderr.txt"),
+              ::testing::HasSubstr("lost in the corridor"));
+  EXPECT_THAT(slamrig::testing::ReadFile(dir / "report/external_dr_stdout.txt"),
               ::testing::HasSubstr("dead_reckoning.py: " + scans + " poses"));
   EXPECT_THAT(ExpectationTable(r), ::testing::HasSubstr("FAIL   hang (external) failed:"));
   fs::remove_all(dir);

@@ -7,10 +7,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "scenarios/scenario_runner.h"
 #include "scenarios/scenario_spec.h"
+#include "tests/util/read_file.h"
 
 namespace slamrig::scenario {
 namespace {
@@ -29,13 +29,6 @@ std::string Failure(const ScenarioResult& r, const std::string& name) {
   for (const ConfigFailure& f : r.failures)
     if (f.name == name) return f.message;
   return "not failed";
-}
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 // A Python program that runs the shipped client with `patch` applied to it first.
@@ -177,13 +170,14 @@ TEST(ExternalStreamTest, ClientsGiveTheBuiltInsBitsAndBrokenProgramsFailAlone) {
 
   // The trajectories the report writes are the built-in's, byte for byte.
   WriteReport(r, options.work_dir);
-  const std::string builtin_tum = Slurp(dir / "report/dead_reckoning.tum");
+  const std::string builtin_tum = slamrig::testing::ReadFile(dir / "report/dead_reckoning.tum");
   EXPECT_GT(builtin_tum.size(), 10000u);
-  EXPECT_EQ(Slurp(dir / "report/stream_py.tum"), builtin_tum);
-  EXPECT_EQ(Slurp(dir / "report/stream_cc.tum"), builtin_tum);
-  EXPECT_THAT(Slurp(dir / "report/metrics.json"),
+  EXPECT_EQ(slamrig::testing::ReadFile(dir / "report/stream_py.tum"), builtin_tum);
+  EXPECT_EQ(slamrig::testing::ReadFile(dir / "report/stream_cc.tum"), builtin_tum);
+  EXPECT_THAT(slamrig::testing::ReadFile(dir / "report/metrics.json"),
               HasSubstr("\"failure\": \"python3: killed by signal 6"));
-  EXPECT_THAT(Slurp(dir / "report/crash_stderr.txt"), HasSubstr("lost in the corridor"));
+  EXPECT_THAT(slamrig::testing::ReadFile(dir / "report/crash_stderr.txt"),
+              HasSubstr("lost in the corridor"));
   fs::remove_all(dir);
 }
 

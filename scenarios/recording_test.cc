@@ -3,8 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "sim/presets.h"
 #include "sim/world_yaml.h"
@@ -12,16 +10,10 @@
 #include "slam/io/carmen_reader.h"
 #include "slam/io/tum_io.h"
 #include "slam/odometry/wheel_odometry.h"
+#include "tests/util/read_file.h"
 
 namespace slamrig::scenario {
 namespace {
-
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 sim::SimulatorOptions Office(std::uint64_t seed) {
   sim::SimulatorOptions o;
@@ -33,20 +25,20 @@ sim::SimulatorOptions Office(std::uint64_t seed) {
 RunSummary WriteRun(std::uint64_t seed, const std::string& name) {
   RunOptions run;
   run.duration_s = 3.0;
-  return RecordSimulation(Office(seed), run, testing::TempDir() + "/" + name);
+  return RecordSimulation(Office(seed), run, ::testing::TempDir() + "/" + name);
 }
 
 TEST(RunWriterTest, SameSeedByteIdenticalFilesOtherSeedOtherNoise) {
   const RunSummary a = WriteRun(7, "run_a"), b = WriteRun(7, "run_b"), c = WriteRun(8, "run_c");
   ASSERT_EQ(a.files.size(), 5u);
   for (std::size_t i = 0; i < a.files.size(); ++i) {
-    const std::string bytes = Slurp(a.files[i]);
+    const std::string bytes = slamrig::testing::ReadFile(a.files[i]);
     EXPECT_FALSE(bytes.empty()) << a.files[i];
-    EXPECT_EQ(bytes, Slurp(b.files[i])) << a.files[i];
+    EXPECT_EQ(bytes, slamrig::testing::ReadFile(b.files[i])) << a.files[i];
   }
   // Another seed: other sensor noise in the log, but the same physics, so the same truth.
-  EXPECT_NE(Slurp(a.files[0]), Slurp(c.files[0]));
-  EXPECT_EQ(Slurp(a.files[1]), Slurp(c.files[1]));
+  EXPECT_NE(slamrig::testing::ReadFile(a.files[0]), slamrig::testing::ReadFile(c.files[0]));
+  EXPECT_EQ(slamrig::testing::ReadFile(a.files[1]), slamrig::testing::ReadFile(c.files[1]));
 }
 
 TEST(RunWriterTest, OurCarmenReaderReadsTheLogBack) {
@@ -86,7 +78,7 @@ RunSummary WriteBagRun(std::uint64_t seed, const std::string& name, RecordingFor
   run.duration_s = 3.0;
   RecordingOptions recording;
   recording.format = format;
-  return RecordSimulation(Office(seed), run, testing::TempDir() + "/" + name, recording);
+  return RecordSimulation(Office(seed), run, ::testing::TempDir() + "/" + name, recording);
 }
 
 TEST(RunWriterTest, BagsHoldTheSameRunAsTheCarmenLog) {
@@ -98,7 +90,9 @@ TEST(RunWriterTest, BagsHoldTheSameRunAsTheCarmenLog) {
     EXPECT_EQ(std::filesystem::path(bag.files[0]).filename(), "run");
     // truth.tum and the yaml files do not depend on the format.
     for (std::size_t i = 1; i < bag.files.size(); ++i) {
-      EXPECT_EQ(Slurp(bag.files[i]), Slurp(carmen.files[i])) << bag.files[i];
+      EXPECT_EQ(slamrig::testing::ReadFile(bag.files[i]),
+                slamrig::testing::ReadFile(carmen.files[i]))
+          << bag.files[i];
     }
     EXPECT_EQ(bag.num_scans, carmen.num_scans);
     EXPECT_EQ(bag.num_odometry, carmen.num_odometry);
@@ -138,7 +132,8 @@ TEST(RunWriterTest, BagsHoldTheSameRunAsTheCarmenLog) {
   // The same seed again: the same bag bytes.
   const RunSummary again = WriteBagRun(5, "run_fmt_mcap_again", RecordingFormat::kMcap);
   const std::string mcap = "/run_0.mcap";
-  EXPECT_EQ(Slurp(again.files[0] + mcap), Slurp(testing::TempDir() + "/run_fmt_mcap/run" + mcap));
+  EXPECT_EQ(slamrig::testing::ReadFile(again.files[0] + mcap),
+            slamrig::testing::ReadFile(::testing::TempDir() + "/run_fmt_mcap/run" + mcap));
 }
 
 }  // namespace

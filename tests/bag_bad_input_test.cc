@@ -11,8 +11,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
+#include "tests/util/read_file.h"
 #include "tests/util/run_command.h"
 #include "tests/util/temp_dir.h"
 
@@ -33,18 +33,11 @@ std::string SimulateBag(const testing::TempDir& dir, const std::string& name,
   return out + "/run";
 }
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // Flips one byte in the middle of the payload of the first Chunk record (opcode 0x06) of an
 // MCAP file, walking the records from the 8-byte magic: opcode (1 byte), length (uint64 LE),
 // content.
 void FlipByteInFirstChunk(const std::string& path) {
-  std::string bytes = ReadAll(path);
+  std::string bytes = slamrig::testing::ReadFile(path);
   std::size_t at = 8;
   while (at + 9 <= bytes.size()) {
     const auto opcode = static_cast<unsigned char>(bytes[at]);

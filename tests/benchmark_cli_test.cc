@@ -8,11 +8,11 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "scenarios/benchmark_spec.h"
 #include "scenarios/sweep_summary.h"
 #include "tests/util/dataset.h"
+#include "tests/util/read_file.h"
 #include "tests/util/run_command.h"
 #include "tests/util/temp_dir.h"
 
@@ -30,13 +30,6 @@ std::vector<std::vector<std::string>> Rows(const std::string& csv) {
 std::vector<std::vector<std::string>> WithoutTiming(std::vector<std::vector<std::string>> rows) {
   for (auto& r : rows) r.resize(r.size() >= 3 ? r.size() - 3 : 0);
   return rows;
-}
-
-std::string Read(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 std::string Suite(double timeout_s) {
@@ -75,10 +68,11 @@ TEST(BenchmarkCliTest, RunsEveryPairResumesAndReproduces) {
     EXPECT_EQ(rows[i][diverged], "0") << rows[i][0];
     EXPECT_FALSE(rows[i][lost_s].empty()) << rows[i][0];
   }
-  const std::string summary = Read(dir.File("a/summary.html"));
+  const std::string summary = slamrig::testing::ReadFile(dir.File("a/summary.html"));
   EXPECT_NE(summary.find("Leaderboard"), std::string::npos);
   EXPECT_NE(summary.find("runs/0000/report.html"), std::string::npos);
-  EXPECT_NE(Read(dir.File("a/runs/0005/scenario.yaml")).find("max_scans: 80"), std::string::npos);
+  EXPECT_NE(slamrig::testing::ReadFile(dir.File("a/runs/0005/scenario.yaml")).find("max_scans: 80"),
+            std::string::npos);
 
   const auto again =
       testing::RunCommand(binary + " benchmark " + suite + " --out " + dir.File("a") + " --quiet");
@@ -116,7 +110,8 @@ TEST(BenchmarkCliTest, ARunPastTheTimeoutIsKilledAndFailed) {
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[1][4], "timeout");
   EXPECT_EQ(rows[1][5], "still running after 0.5 s");
-  EXPECT_NE(Read(dir.File("out/summary.html")).find("timeout"), std::string::npos);
+  EXPECT_NE(slamrig::testing::ReadFile(dir.File("out/summary.html")).find("timeout"),
+            std::string::npos);
 }
 
 // Every shipped suite loads: its logs are there, its worlds generate, its estimators resolve.

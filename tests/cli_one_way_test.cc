@@ -6,10 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <string>
 
+#include "tests/util/read_file.h"
 #include "tests/util/run_command.h"
 #include "tests/util/temp_dir.h"
 
@@ -22,13 +22,6 @@ using testing::RunCommand;
 using testing::TempDir;
 
 std::string Slamrig(const std::string& args) { return std::string(SLAMRIG_BINARY) + " " + args; }
-
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // The robot section of a report's config.yaml: from "robot:" to the next top-level key.
 std::string RobotSection(const std::string& config_yaml) {
@@ -52,8 +45,9 @@ TEST(CliOneWayTest, SimulateQuietPrintsNothingAndWritesTheSameRun) {
       RunCommand(Slamrig("simulate office --duration 3 --quiet --out " + dir.File("b")));
   ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
   EXPECT_EQ(quiet.output, "");
-  EXPECT_GT(Slurp(dir.File("a/run.log")).size(), 1000u);
-  EXPECT_EQ(Slurp(dir.File("a/run.log")), Slurp(dir.File("b/run.log")));
+  EXPECT_GT(slamrig::testing::ReadFile(dir.File("a/run.log")).size(), 1000u);
+  EXPECT_EQ(slamrig::testing::ReadFile(dir.File("a/run.log")),
+            slamrig::testing::ReadFile(dir.File("b/run.log")));
   // Errors still come through.
   const auto bad =
       RunCommand(Slamrig("simulate office --quiet --format nope --out " + dir.File("c")));
@@ -78,11 +72,12 @@ TEST(CliOneWayTest, AScenarioWithoutRobotDrivesSimulatesDefaultRobot) {
       dir.Write("named.yaml", body + "robot: " + dir.File("s/robot.yaml") + "\n");
   const auto run_named = RunCommand(Slamrig("run " + named + " --quiet --out " + dir.File("b")));
   ASSERT_EQ(run_named.exit_code, 0) << run_named.output;
-  const std::string robot = RobotSection(Slurp(dir.File("a/config.yaml")));
+  const std::string robot = RobotSection(slamrig::testing::ReadFile(dir.File("a/config.yaml")));
   EXPECT_THAT(robot, HasSubstr("name: ece276a"));
   EXPECT_GT(robot.size(), 200u);
-  EXPECT_EQ(robot, RobotSection(Slurp(dir.File("b/config.yaml"))));
-  EXPECT_EQ(Slurp(dir.File("a/truth.tum")), Slurp(dir.File("b/truth.tum")));
+  EXPECT_EQ(robot, RobotSection(slamrig::testing::ReadFile(dir.File("b/config.yaml"))));
+  EXPECT_EQ(slamrig::testing::ReadFile(dir.File("a/truth.tum")),
+            slamrig::testing::ReadFile(dir.File("b/truth.tum")));
 }
 
 // Every line whole: no carriage return, and the verdict line starts a line of its own.

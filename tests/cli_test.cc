@@ -5,10 +5,10 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "tests/util/dataset.h"
+#include "tests/util/read_file.h"
 #include "tests/util/run_command.h"
 #include "tests/util/temp_dir.h"
 
@@ -21,13 +21,6 @@ using ::testing::StartsWith;
 using testing::TempDir;
 
 std::string Slamrig(const std::string& args) { return std::string(SLAMRIG_BINARY) + " " + args; }
-
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // `text` without its comment lines and the lines holding one of `words`.
 std::string Without(const std::string& text, const std::vector<std::string>& words) {
@@ -192,15 +185,16 @@ TEST(CliTest, TheReportsConfigReproducesTheRun) {
       RunCommand(Slamrig("run " + dir.File("a/config.yaml") + " --quiet --out " + dir.File("b")));
   ASSERT_EQ(again.exit_code, first.exit_code) << again.output;
   // metrics.json equal line for line, the wall-clock figures (and the expectation on one) aside.
-  const std::string a = Slurp(dir.File("a/metrics.json"));
+  const std::string a = slamrig::testing::ReadFile(dir.File("a/metrics.json"));
   EXPECT_GT(a.size(), 500u);
-  EXPECT_EQ(
-      Without(a, {"realtime_factor", "wall_time_s", "\"value\""}),
-      Without(Slurp(dir.File("b/metrics.json")), {"realtime_factor", "wall_time_s", "\"value\""}));
-  EXPECT_EQ(Slurp(dir.File("a/pf.tum")), Slurp(dir.File("b/pf.tum")));
+  EXPECT_EQ(Without(a, {"realtime_factor", "wall_time_s", "\"value\""}),
+            Without(slamrig::testing::ReadFile(dir.File("b/metrics.json")),
+                    {"realtime_factor", "wall_time_s", "\"value\""}));
+  EXPECT_EQ(slamrig::testing::ReadFile(dir.File("a/pf.tum")),
+            slamrig::testing::ReadFile(dir.File("b/pf.tum")));
   // And the resolved configuration resolves to itself.
-  EXPECT_EQ(Without(Slurp(dir.File("a/config.yaml")), {}),
-            Without(Slurp(dir.File("b/config.yaml")), {}));
+  EXPECT_EQ(Without(slamrig::testing::ReadFile(dir.File("a/config.yaml")), {}),
+            Without(slamrig::testing::ReadFile(dir.File("b/config.yaml")), {}));
 }
 
 TEST(CliTest, BadScenarioInputNamesFileLineAndKey) {

@@ -4,8 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "slam/graph/edge_error.h"
@@ -14,6 +12,7 @@
 #include "slam/graph/pose_graph_optimizer.h"
 #include "slam/graph/testing/random_graph.h"
 #include "tests/util/dataset.h"
+#include "tests/util/read_file.h"
 #include "tests/util/run_command.h"
 #include "tests/util/temp_dir.h"
 
@@ -23,13 +22,6 @@ namespace {
 using testing::RunCommand;
 
 const std::string kBinary = SLAMRIG_BINARY;
-
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 int CountLines(const std::string& text) {
   int n = 0;
@@ -57,7 +49,7 @@ TEST(OptimizeCliTest, WritesTheLibrarysOptimumAndPrintsTheSummaryAndTheCertifica
   slam::PoseGraph expected = slam::ReadG2o(in);
   slam::InitializeChordal(&expected);
   const slam::PoseGraphSummary s = slam::PoseGraphOptimizer({}).Optimize(&expected);
-  EXPECT_EQ(Slurp(out), slam::FormatG2o(expected));
+  EXPECT_EQ(slamrig::testing::ReadFile(out), slam::FormatG2o(expected));
   char chi2[32];
   std::snprintf(chi2, sizeof(chi2), "-> %.6g in", slam::Chi2(slam::ReadG2o(out)));
   EXPECT_NE(result.output.find(chi2), std::string::npos) << result.output << " vs " << chi2;

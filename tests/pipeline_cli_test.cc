@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "tests/util/read_file.h"
 #include "tests/util/run_command.h"
 #include "tests/util/temp_dir.h"
 
@@ -18,13 +19,6 @@ namespace {
 using testing::RunCommand;
 
 const std::string kBinary = SLAMRIG_BINARY;
-
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // Every key path of a JSON document ("configs.graph.run.map.width"), an expectation's name
 // (a value of the run, not of the schema) aside.
@@ -82,7 +76,8 @@ TEST(PipelineCliTest, SlamAndALogScenarioWriteTheSameMetricsSchema) {
   const auto again = RunCommand(kBinary + " run " + dir.File("slam") +
                                 "/config.yaml --quiet --out " + dir.File("again"));
   ASSERT_EQ(again.exit_code, 0) << again.output;
-  EXPECT_EQ(Slurp(dir.File("slam") + "/graph.tum"), Slurp(dir.File("again") + "/graph.tum"));
+  EXPECT_EQ(slamrig::testing::ReadFile(dir.File("slam") + "/graph.tum"),
+            slamrig::testing::ReadFile(dir.File("again") + "/graph.tum"));
 }
 
 // The metric rows of a report.html: the text of each row's first cell in the metrics table.
@@ -104,7 +99,7 @@ TEST(PipelineCliTest, TheReportListsOnlyWhatApplies) {
   const auto r = RunCommand(kBinary + " slam " + log +
                             " --algorithm dead-reckoning --quiet --out " + dir.File("dr"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const std::string html = Slurp(dir.File("dr") + "/report.html");
+  const std::string html = slamrig::testing::ReadFile(dir.File("dr") + "/report.html");
   const std::vector<std::string> rows = MetricRows(html);
   ASSERT_FALSE(rows.empty()) << html;
   for (const std::string& row : rows) {
@@ -133,7 +128,7 @@ TEST(PipelineCliTest, TheReportListsOnlyWhatApplies) {
 // claimed on the console, in metrics.json or in the report.
 TEST(PipelineCliTest, SynthesisedTimesGiveNoRealTimeFactor) {
   testing::TempDir dir;
-  std::istringstream in(Slurp(SimulatedLog(dir)));
+  std::istringstream in(slamrig::testing::ReadFile(SimulatedLog(dir)));
   std::ofstream zeroed(dir.File("zero.log"));
   std::string line;
   while (std::getline(in, line)) {
@@ -155,10 +150,10 @@ TEST(PipelineCliTest, SynthesisedTimesGiveNoRealTimeFactor) {
   const std::string said = "times synthesised from line order; no real-time factor";
   EXPECT_NE(r.output.find(said), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("real time)"), std::string::npos) << r.output;
-  const std::string json = Slurp(dir.File("out") + "/metrics.json");
+  const std::string json = slamrig::testing::ReadFile(dir.File("out") + "/metrics.json");
   EXPECT_NE(json.find("\"times_synthesised\": true"), std::string::npos) << json;
   EXPECT_EQ(json.find("realtime_factor"), std::string::npos) << json;
-  const std::string html = Slurp(dir.File("out") + "/report.html");
+  const std::string html = slamrig::testing::ReadFile(dir.File("out") + "/report.html");
   EXPECT_NE(html.find(said), std::string::npos);
   EXPECT_EQ(html.find("realtime_factor"), std::string::npos);
   // The untouched log has its real-time factor.
@@ -167,7 +162,8 @@ TEST(PipelineCliTest, SynthesisedTimesGiveNoRealTimeFactor) {
                  "/run.log --algorithm dead-reckoning --quiet --out " + dir.File("real"));
   ASSERT_EQ(real.exit_code, 0) << real.output;
   EXPECT_NE(real.output.find("x real time)"), std::string::npos) << real.output;
-  EXPECT_NE(Slurp(dir.File("real") + "/metrics.json").find("\"times_synthesised\": false"),
+  EXPECT_NE(slamrig::testing::ReadFile(dir.File("real") + "/metrics.json")
+                .find("\"times_synthesised\": false"),
             std::string::npos);
 }
 

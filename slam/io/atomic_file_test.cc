@@ -3,10 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 
 #include "slam/types/error.h"
+#include "tests/util/read_file.h"
 #include "tests/util/temp_dir.h"
 
 namespace slamrig::slam {
@@ -14,16 +14,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
 TEST(AtomicFileTest, ReplacesTheFileAndLeavesNoTemporary) {
   testing::TempDir dir;
   const std::string path = dir.Write("a.txt", "old contents");
   WriteFileAtomically(path, "new");
-  EXPECT_EQ(Slurp(path), "new");
+  EXPECT_EQ(slamrig::testing::ReadFile(path), "new");
   int files = 0;
   for ([[maybe_unused]] const auto& f : fs::directory_iterator(dir.path())) ++files;
   EXPECT_EQ(files, 1);

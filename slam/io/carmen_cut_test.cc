@@ -18,6 +18,7 @@
 #include "slam/io/dataset.h"
 #include "slam/io/log_reader.h"
 #include "slam/types/error.h"
+#include "tests/util/read_file.h"
 #include "tests/util/temp_dir.h"
 
 namespace slamrig::slam {
@@ -26,13 +27,6 @@ namespace {
 namespace fs = std::filesystem;
 using TempDir = slamrig::testing::TempDir;
 using ::testing::HasSubstr;
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 void WriteAll(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
@@ -126,7 +120,7 @@ std::vector<std::string> Split(const std::string& text) {
 
 TEST(CarmenCutTest, EveryCutOfAPlainLogReadsItsWholeLines) {
   TempDir dir;
-  const std::string text = ReadAll(WriteTestLog(dir, 60));
+  const std::string text = slamrig::testing::ReadFile(WriteTestLog(dir, 60));
   const CarmenLog whole = ReadCarmenLog(dir.File("whole.log"));
   std::mt19937_64 rng(34);
   std::uniform_int_distribution<std::size_t> at(1, text.size() - 1);
@@ -184,7 +178,7 @@ std::string Gzip(const std::string& text, const std::string& path) {
   gzFile f = gzopen(path.c_str(), "wb");
   gzwrite(f, text.data(), static_cast<unsigned>(text.size()));
   gzclose(f);
-  return ReadAll(path);
+  return slamrig::testing::ReadFile(path);
 }
 
 // What zlib itself gets out of a cut gzip stream, independently of gzgets.
@@ -208,7 +202,7 @@ std::string Inflate(const std::string& compressed) {
 
 TEST(CarmenCutTest, EveryCutOfAGzipLogReadsWhatDecompresses) {
   TempDir dir;
-  const std::string text = ReadAll(WriteTestLog(dir, 200));
+  const std::string text = slamrig::testing::ReadFile(WriteTestLog(dir, 200));
   const CarmenLog whole = ReadCarmenLog(dir.File("whole.log"));
   const std::string gz = Gzip(text, dir.File("whole.log.gz"));
   std::mt19937_64 rng(34);
@@ -245,7 +239,7 @@ TEST(CarmenCutTest, EveryCutOfAGzipLogReadsWhatDecompresses) {
 
 TEST(CarmenCutTest, AWholeLastLineWithoutNewlineIsKept) {
   TempDir dir;
-  const std::string text = ReadAll(WriteTestLog(dir, 5));
+  const std::string text = slamrig::testing::ReadFile(WriteTestLog(dir, 5));
   const std::string path = dir.Write("no_newline.log", text.substr(0, text.size() - 1));
   const CarmenLog log = ReadCarmenLog(path);
   EXPECT_EQ(log.truncated, "");
@@ -257,7 +251,7 @@ TEST(CarmenCutTest, AWholeLastLineWithoutNewlineIsKept) {
 // `slamrig simulate --out DIR` writes DIR/run.log (or the bag DIR/run): DIR names its run.
 TEST(LogFolderTest, AFolderWithOneRunReadsIt) {
   TempDir dir;
-  const std::string text = ReadAll(WriteTestLog(dir, 5));
+  const std::string text = slamrig::testing::ReadFile(WriteTestLog(dir, 5));
   fs::create_directories(dir.File("sim"));
   WriteAll(dir.File("sim/run.log"), text);
   WriteAll(dir.File("sim/truth.tum"), "1000 0 0 0 0 0 0 1\n");
@@ -283,7 +277,7 @@ TEST(LogFolderTest, AFolderWithOneRunReadsIt) {
 
 TEST(LogFolderTest, StrictReadingRefusesACutLog) {
   TempDir dir;
-  const std::string text = ReadAll(WriteTestLog(dir, 5));
+  const std::string text = slamrig::testing::ReadFile(WriteTestLog(dir, 5));
   const std::string path = dir.Write("cut.log", text.substr(0, text.size() - 20));
   LogReadOptions strict;
   strict.strict = true;

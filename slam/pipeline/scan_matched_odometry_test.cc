@@ -115,7 +115,8 @@ TEST(ScanMatchedOdometryTest, SameScansSameBits) {
     }
     return poses;
   };
-  EXPECT_EQ(lap(), lap());
+  const std::vector<Pose2> first = lap();
+  EXPECT_EQ(first, lap());
 }
 
 }  // namespace

@@ -5,13 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "slam/io/bag/bag_reader.h"
 #include "slam/io/carmen_reader.h"
 #include "slam/io/dataset.h"
 #include "slam/types/error.h"
+#include "tests/util/read_file.h"
 #include "tests/util/run_command.h"
 #include "tests/util/temp_dir.h"
 
@@ -19,13 +18,6 @@ namespace slamrig::slam {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 std::string Simulate(const slamrig::testing::TempDir& dir, const std::string& name,
                      const std::string& format) {
@@ -80,8 +72,10 @@ TEST(BagCliTest, SimulatedBagsMatchTheCarmenLog) {
   }
   // Same arguments, same bytes.
   const std::string again = Simulate(dir, "m2", "mcap");
-  EXPECT_EQ(ReadAll(again + "/run/run_0.mcap"), ReadAll(mcap + "/run/run_0.mcap"));
-  EXPECT_EQ(ReadAll(again + "/run/metadata.yaml"), ReadAll(mcap + "/run/metadata.yaml"));
+  EXPECT_EQ(slamrig::testing::ReadFile(again + "/run/run_0.mcap"),
+            slamrig::testing::ReadFile(mcap + "/run/run_0.mcap"));
+  EXPECT_EQ(slamrig::testing::ReadFile(again + "/run/metadata.yaml"),
+            slamrig::testing::ReadFile(mcap + "/run/metadata.yaml"));
 }
 
 TEST(BagCliTest, SlamReadsABagAndRejectsADamagedOne) {
@@ -91,7 +85,8 @@ TEST(BagCliTest, SlamReadsABagAndRejectsADamagedOne) {
   auto r = slamrig::testing::RunCommand(std::string(SLAMRIG_BINARY) + " slam " + sim +
                                         "/run --algorithm dead-reckoning --quiet --out " + out);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(ReadAll(out + "/metrics.json").find("\"log_format\": \"ros2bag\""), std::string::npos);
+  EXPECT_NE(slamrig::testing::ReadFile(out + "/metrics.json").find("\"log_format\": \"ros2bag\""),
+            std::string::npos);
   EXPECT_TRUE(fs::exists(out + "/trajectory.tum"));
 
   // Cut the file, as a recording killed mid-way leaves it: the run scores the messages before
@@ -109,7 +104,8 @@ TEST(BagCliTest, SlamReadsABagAndRejectsADamagedOne) {
   EXPECT_TRUE(r.output.starts_with(note)) << r.output;
   EXPECT_TRUE(r.output.ends_with(" scans of an unknown total; the rest is lost\n")) << r.output;
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
-  EXPECT_NE(ReadAll(cut_out + "/metrics.json").find(note.substr(6)), std::string::npos);
+  EXPECT_NE(slamrig::testing::ReadFile(cut_out + "/metrics.json").find(note.substr(6)),
+            std::string::npos);
   EXPECT_TRUE(fs::exists(cut_out + "/trajectory.tum"));
 
   const std::string bad_out = dir.File("bad");
@@ -174,8 +170,8 @@ TEST(BagCliTest, SlamOnASimulateFolderFindsItsRun) {
     ASSERT_EQ(r.exit_code, 0) << r.output;
     r = slamrig::testing::RunCommand(slam + run + " --out " + dir.File(format + "_run"));
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    EXPECT_EQ(ReadAll(dir.File(format + "_dir/trajectory.tum")),
-              ReadAll(dir.File(format + "_run/trajectory.tum")));
+    EXPECT_EQ(slamrig::testing::ReadFile(dir.File(format + "_dir/trajectory.tum")),
+              slamrig::testing::ReadFile(dir.File(format + "_run/trajectory.tum")));
   }
   fs::copy(dir.File("mcap/run"), dir.File("carmen/run"), fs::copy_options::recursive);
   const auto r = slamrig::testing::RunCommand(std::string(SLAMRIG_BINARY) + " slam " +

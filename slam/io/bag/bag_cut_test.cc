@@ -11,7 +11,6 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
-#include <sstream>
 
 #include "slam/io/bag/bag_reader.h"
 #include "slam/io/bag/bag_writer.h"
@@ -20,6 +19,7 @@
 #include "slam/io/bag/testing/synthetic_records.h"
 #include "slam/io/log_reader.h"
 #include "slam/types/error.h"
+#include "tests/util/read_file.h"
 #include "tests/util/temp_dir.h"
 
 namespace slamrig::slam {
@@ -28,13 +28,6 @@ namespace {
 namespace fs = std::filesystem;
 using TempDir = slamrig::testing::TempDir;
 using ::testing::HasSubstr;
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 void WriteAll(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
@@ -169,7 +162,7 @@ class CutMcapTest : public ::testing::TestWithParam<McapCompression> {};
 TEST_P(CutMcapTest, EveryCutReadsTheMessagesOfTheWholeChunksBeforeIt) {
   TempDir dir;
   const std::string file = WriteTestBag(dir, BagStorage::kMcap, GetParam());
-  const std::string bytes = ReadAll(file);
+  const std::string bytes = slamrig::testing::ReadFile(file);
   const RawBag whole = ReadMcapFile(file);
   const Dataset whole_data = ReadBag(CutBag(dir, "run_0.mcap", bytes));
   std::size_t data_end = 0;
@@ -230,7 +223,7 @@ INSTANTIATE_TEST_SUITE_P(Compressions, CutMcapTest,
 TEST(CutMcapTest, DamageBeforeTheCutIsStillAnError) {
   TempDir dir;
   const std::string file = WriteTestBag(dir, BagStorage::kMcap, McapCompression::kNone);
-  std::string bytes = ReadAll(file);
+  std::string bytes = slamrig::testing::ReadFile(file);
   bytes.resize(bytes.size() * 3 / 4);
   const std::size_t at = bytes.find(std::string("laser\0", 6));
   bytes[at] = static_cast<char>(bytes[at] ^ 0x10);
@@ -241,7 +234,7 @@ TEST(CutMcapTest, DamageBeforeTheCutIsStillAnError) {
 TEST(CutMcapTest, OnlyTheLastFileOfABagMayBeCut) {
   TempDir dir;
   const std::string file = WriteTestBag(dir, BagStorage::kMcap, McapCompression::kZstd);
-  const std::string bytes = ReadAll(file);
+  const std::string bytes = slamrig::testing::ReadFile(file);
   const std::string folder = dir.File("split");
   fs::create_directories(folder);
   WriteAll(folder + "/a_0.mcap", bytes.substr(0, bytes.size() / 2));
@@ -260,7 +253,7 @@ TEST(CutMcapTest, OnlyTheLastFileOfABagMayBeCut) {
 TEST(CutSqliteTest, EveryCutReadsAPrefixOfTheRows) {
   TempDir dir;
   const std::string file = WriteTestBag(dir, BagStorage::kSqlite3, McapCompression::kNone);
-  const std::string bytes = ReadAll(file);
+  const std::string bytes = slamrig::testing::ReadFile(file);
   const RawBag whole = ReadSqliteBagFile(file);
   const Dataset whole_data = ReadBag(CutBag(dir, "run_0.db3", bytes));
   const std::size_t page = 4096;

@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
-#include <sstream>
 
 #include "slam/io/bag/bag_reader.h"
 #include "slam/io/bag/bag_writer.h"
@@ -17,6 +16,7 @@
 #include "slam/io/bag/ros_messages.h"
 #include "slam/io/bag/testing/synthetic_records.h"
 #include "slam/types/error.h"
+#include "tests/util/read_file.h"
 #include "tests/util/temp_dir.h"
 
 namespace slamrig::slam {
@@ -24,13 +24,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using TempDir = slamrig::testing::TempDir;
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 void WriteAll(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
@@ -168,7 +161,8 @@ TEST(BagTest, EmptyBagsAreValid) {
     const Dataset back = ReadBag(folder);
     EXPECT_TRUE(back.records.empty());
     EXPECT_TRUE(back.reference.empty());
-    EXPECT_NE(ReadAll(folder + "/metadata.yaml").find("  message_count: 0\n"), std::string::npos);
+    EXPECT_NE(slamrig::testing::ReadFile(folder + "/metadata.yaml").find("  message_count: 0\n"),
+              std::string::npos);
   }
 }
 
@@ -200,7 +194,7 @@ TEST(BagTest, MetadataListsTopicsAndCounts) {
   // 0.1 s: 10 IMU samples and 4 each of ticks, odometry, scans and truth; 4 /tf, 1 /tf_static
   // and 10 /clock (100 Hz) messages: 41 in all.
   WriteBag(testing::SyntheticRun(0.1, 1, 8), dir.File("m"), {});
-  const std::string yaml = ReadAll(dir.File("m/metadata.yaml"));
+  const std::string yaml = slamrig::testing::ReadFile(dir.File("m/metadata.yaml"));
   for (const char* key :
        {"rosbag2_bagfile_information:\n  version: 6\n  storage_identifier: mcap\n",
         "  custom_data:\n    slamrig.ticks_per_revolution: \"360\"\n", "  message_count: 41\n",
@@ -291,7 +285,7 @@ class CorruptMcapTest : public ::testing::Test {
     options.chunk_size_bytes = 4096;
     WriteBag(testing::SyntheticRun(0.5, 5, 64), dir_.File("b"), options);
     file_ = dir_.File("b/b_0.mcap");
-    bytes_ = ReadAll(file_);
+    bytes_ = slamrig::testing::ReadFile(file_);
   }
   std::string ErrorAfter(const std::string& bytes, bool strict = false) {
     WriteAll(file_, bytes);
@@ -360,7 +354,7 @@ TEST(CorruptBagTest, ChunkThatDoesNotDecompress) {
     options.compression = c;
     WriteBag(testing::SyntheticRun(0.2, 5, 64), dir.File("b"), options);
     const std::string file = dir.File("b/b_0.mcap");
-    std::string b = ReadAll(file);
+    std::string b = slamrig::testing::ReadFile(file);
     // Overwrite the start of the compressed records, just after the compression name.
     const std::string name(McapCompressionName(c));
     const std::string field = std::string(1, static_cast<char>(name.size())) +
@@ -470,7 +464,7 @@ TEST(CorruptBagTest, RandomDamageIsAParseErrorOrHarmless) {
     WriteBag(testing::SyntheticRun(0.1, 9, 32), folder, options);
     const std::string file = folder + "/" + fs::path(folder).filename().string() +
                              (storage == BagStorage::kMcap ? "_0.mcap" : "_0.db3");
-    const std::string good = ReadAll(file);
+    const std::string good = slamrig::testing::ReadFile(file);
     int errors = 0;
     const int trials = 45;
     for (int trial = 0; trial < trials; ++trial) {
