@@ -109,9 +109,14 @@ int Main(int argc, char** argv) {
     if (command != c.name) continue;
     try {
       const int code = c.run(command_args);
-      // A signal after the last check: the outputs are complete, but the caller asked to stop
-      // and must not take this for a finished command (a sweep would record the run).
-      if (InterruptSignal() != 0) return ReportInterrupted(InterruptSignal());
+      // A signal after the last check came when the outputs were complete (every command that
+      // stops early on a signal throws): the exit code says what the folder holds, a finished
+      // command, as a caller that checks the code and the folder together (a sweep, a script)
+      // must find them.
+      if (const int signal = InterruptSignal(); signal != 0) {
+        std::fprintf(stderr, "slamrig: %s came after the outputs were complete; they are kept\n",
+                     SignalName(signal).c_str());
+      }
       return code;
     } catch (const std::exception& e) {
       // Whatever failed after a signal failed because of it (a wait cut short, a child gone).
