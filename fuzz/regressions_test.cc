@@ -13,6 +13,8 @@
 namespace slamrig::fuzz {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 namespace fs = std::filesystem;
 
 // Runs every file below fuzz/<folder>/<entry>/ and returns how many there were; with
@@ -25,7 +27,7 @@ int RunFolder(const std::string& folder, const ReaderEntry& entry, bool must_acc
     if (!file.is_regular_file()) continue;
     ++files;
     SCOPED_TRACE(file.path().string());
-    const std::string bytes = slamrig::testing::ReadFile(file.path());
+    const std::string bytes = ReadFile(file.path());
     try {
       const ReaderResult result = RunReaderEntry(entry, bytes);
       if (must_accept) {

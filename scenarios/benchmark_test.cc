@@ -41,6 +41,12 @@ std::string ErrorOf(const std::string& text) {
   return "";
 }
 
+// Run `run` of `suite`'s scenario, written into `dir` as `file` and read back.
+ScenarioSpec RunScenario(const testing::TempDir& dir, const std::string& file,
+                         const BenchmarkSuite& suite, const BenchmarkRun& run) {
+  return LoadScenario(dir.Write(file, BenchmarkScenarioYaml(suite, run)));
+}
+
 TEST(BenchmarkSpecTest, ExpandsDatasetsSeedsAndEstimatorsInFileOrder) {
   testing::TempDir dir;
   const BenchmarkSuite suite = LoadBenchmarkSuite(dir.Write("suite.yaml", kSuite));
@@ -58,8 +64,8 @@ TEST(BenchmarkSpecTest, EachRunIsAScenarioWithItsSeedItsEstimatorAndTheBaseline)
   testing::TempDir dir;
   const BenchmarkSuite suite = LoadBenchmarkSuite(dir.Write("suite.yaml", kSuite));
   const std::vector<BenchmarkRun> runs = ExpandBenchmark(suite);
-  const std::string text = BenchmarkScenarioYaml(suite, runs[3]);  // small, seed 4, graph
-  const ScenarioSpec scenario = LoadScenario(dir.Write("run.yaml", text));
+  const ScenarioSpec scenario =
+      RunScenario(dir, "run.yaml", suite, runs[3]);  // small, seed 4, graph
   EXPECT_EQ(scenario.seed, 4u);
   EXPECT_EQ(scenario.duration_s, 20.0);
   ASSERT_TRUE(scenario.simulated.has_value());
@@ -69,8 +75,7 @@ TEST(BenchmarkSpecTest, EachRunIsAScenarioWithItsSeedItsEstimatorAndTheBaseline)
   EXPECT_EQ(scenario.configs[1].name, "graph");
   EXPECT_TRUE(scenario.expectations.empty());
   // The world is the dataset's at the run's seed: another seed gives another world.
-  const ScenarioSpec other =
-      LoadScenario(dir.Write("other.yaml", BenchmarkScenarioYaml(suite, runs[1])));
+  const ScenarioSpec other = RunScenario(dir, "other.yaml", suite, runs[1]);
   EXPECT_NE(scenario.simulated->options.world.walls.size() +
                 1000 * scenario.simulated->options.world.drive.waypoints_m.size(),
             other.simulated->options.world.walls.size() +
@@ -90,10 +95,9 @@ TEST(BenchmarkSpecTest, AWorldFileIsTheSameWorldAtEverySeedWithItsOverrides) {
                                        "    seeds: [1, 2]\n    duration_s: 30\n"));
   const std::vector<BenchmarkRun> runs = ExpandBenchmark(suite);
   ASSERT_EQ(runs.size(), 2u);
-  const ScenarioSpec one =
-      LoadScenario(dir.Write("run_a.yaml", BenchmarkScenarioYaml(suite, runs[0])));
-  const ScenarioSpec two =
-      LoadScenario(dir.Write("run_b.yaml", BenchmarkScenarioYaml(suite, runs[1])));
+  const std::string text = BenchmarkScenarioYaml(suite, runs[0]);
+  const ScenarioSpec one = LoadScenario(dir.Write("run_a.yaml", text));
+  const ScenarioSpec two = RunScenario(dir, "run_b.yaml", suite, runs[1]);
   ASSERT_TRUE(one.simulated.has_value() && two.simulated.has_value());
   EXPECT_EQ(one.seed, 1u);
   EXPECT_EQ(two.seed, 2u);
@@ -101,7 +105,6 @@ TEST(BenchmarkSpecTest, AWorldFileIsTheSameWorldAtEverySeedWithItsOverrides) {
   EXPECT_EQ(one.simulated->options.world.walls.size(), two.simulated->options.world.walls.size());
   EXPECT_EQ(one.simulated->options.world.drive.laps, 2);
   // The run's scenario is in another folder: the program is the one beside the suite.
-  const std::string text = BenchmarkScenarioYaml(suite, runs[0]);
   EXPECT_NE(text.find((dir.path() / "client.py").string()), std::string::npos) << text;
   EXPECT_NE(ErrorOf("estimators: {pf: {algorithm: pf}}\ndatasets:\n  - name: x\n"
                     "    world: no/such.yaml\n")

@@ -20,6 +20,8 @@
 namespace slamrig::scenario {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 namespace fs = std::filesystem;
 
 Trajectory At(const std::vector<double>& seconds) {
@@ -179,11 +181,11 @@ TEST(ExternalRunTest, ProgramsFailAloneAndTheClientMatchesBuiltInDeadReckoning) 
   EXPECT_FALSE(r.passed);
   for (const ExpectationOutcome& o : r.outcomes) EXPECT_TRUE(o.passed) << o.Describe();
   WriteReport(r, options.work_dir);
-  const std::string metrics = slamrig::testing::ReadFile(dir / "report/metrics.json");
+  const std::string metrics = ReadFile(dir / "report/metrics.json");
   EXPECT_THAT(metrics, ::testing::HasSubstr("\"failure\": \"python3: killed by signal 6"));
-  EXPECT_THAT(slamrig::testing::ReadFile(dir / "report/crash_stderr.txt"),
+  EXPECT_THAT(ReadFile(dir / "report/crash_stderr.txt"),
               ::testing::HasSubstr("lost in the corridor"));
-  EXPECT_THAT(slamrig::testing::ReadFile(dir / "report/external_dr_stdout.txt"),
+  EXPECT_THAT(ReadFile(dir / "report/external_dr_stdout.txt"),
               ::testing::HasSubstr("dead_reckoning.py: " + scans + " poses"));
   EXPECT_THAT(ExpectationTable(r), ::testing::HasSubstr("FAIL   hang (external) failed:"));
   fs::remove_all(dir);

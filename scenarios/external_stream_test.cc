@@ -15,6 +15,8 @@
 namespace slamrig::scenario {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 namespace fs = std::filesystem;
 using ::testing::AllOf;
 using ::testing::HasSubstr;
@@ -170,14 +172,13 @@ TEST(ExternalStreamTest, ClientsGiveTheBuiltInsBitsAndBrokenProgramsFailAlone) {
 
   // The trajectories the report writes are the built-in's, byte for byte.
   WriteReport(r, options.work_dir);
-  const std::string builtin_tum = slamrig::testing::ReadFile(dir / "report/dead_reckoning.tum");
+  const std::string builtin_tum = ReadFile(dir / "report/dead_reckoning.tum");
   EXPECT_GT(builtin_tum.size(), 10000u);
-  EXPECT_EQ(slamrig::testing::ReadFile(dir / "report/stream_py.tum"), builtin_tum);
-  EXPECT_EQ(slamrig::testing::ReadFile(dir / "report/stream_cc.tum"), builtin_tum);
-  EXPECT_THAT(slamrig::testing::ReadFile(dir / "report/metrics.json"),
+  EXPECT_EQ(ReadFile(dir / "report/stream_py.tum"), builtin_tum);
+  EXPECT_EQ(ReadFile(dir / "report/stream_cc.tum"), builtin_tum);
+  EXPECT_THAT(ReadFile(dir / "report/metrics.json"),
               HasSubstr("\"failure\": \"python3: killed by signal 6"));
-  EXPECT_THAT(slamrig::testing::ReadFile(dir / "report/crash_stderr.txt"),
-              HasSubstr("lost in the corridor"));
+  EXPECT_THAT(ReadFile(dir / "report/crash_stderr.txt"), HasSubstr("lost in the corridor"));
   fs::remove_all(dir);
 }
 

@@ -15,6 +15,8 @@
 namespace slamrig::scenario {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 sim::SimulatorOptions Office(std::uint64_t seed) {
   sim::SimulatorOptions o;
   o.world = sim::LoadWorldSpec(sim::FindPresetFile("office", "worlds"));
@@ -32,13 +34,13 @@ TEST(RunWriterTest, SameSeedByteIdenticalFilesOtherSeedOtherNoise) {
   const RunSummary a = WriteRun(7, "run_a"), b = WriteRun(7, "run_b"), c = WriteRun(8, "run_c");
   ASSERT_EQ(a.files.size(), 5u);
   for (std::size_t i = 0; i < a.files.size(); ++i) {
-    const std::string bytes = slamrig::testing::ReadFile(a.files[i]);
+    const std::string bytes = ReadFile(a.files[i]);
     EXPECT_FALSE(bytes.empty()) << a.files[i];
-    EXPECT_EQ(bytes, slamrig::testing::ReadFile(b.files[i])) << a.files[i];
+    EXPECT_EQ(bytes, ReadFile(b.files[i])) << a.files[i];
   }
   // Another seed: other sensor noise in the log, but the same physics, so the same truth.
-  EXPECT_NE(slamrig::testing::ReadFile(a.files[0]), slamrig::testing::ReadFile(c.files[0]));
-  EXPECT_EQ(slamrig::testing::ReadFile(a.files[1]), slamrig::testing::ReadFile(c.files[1]));
+  EXPECT_NE(ReadFile(a.files[0]), ReadFile(c.files[0]));
+  EXPECT_EQ(ReadFile(a.files[1]), ReadFile(c.files[1]));
 }
 
 TEST(RunWriterTest, OurCarmenReaderReadsTheLogBack) {
@@ -90,9 +92,7 @@ TEST(RunWriterTest, BagsHoldTheSameRunAsTheCarmenLog) {
     EXPECT_EQ(std::filesystem::path(bag.files[0]).filename(), "run");
     // truth.tum and the yaml files do not depend on the format.
     for (std::size_t i = 1; i < bag.files.size(); ++i) {
-      EXPECT_EQ(slamrig::testing::ReadFile(bag.files[i]),
-                slamrig::testing::ReadFile(carmen.files[i]))
-          << bag.files[i];
+      EXPECT_EQ(ReadFile(bag.files[i]), ReadFile(carmen.files[i])) << bag.files[i];
     }
     EXPECT_EQ(bag.num_scans, carmen.num_scans);
     EXPECT_EQ(bag.num_odometry, carmen.num_odometry);
@@ -132,8 +132,8 @@ TEST(RunWriterTest, BagsHoldTheSameRunAsTheCarmenLog) {
   // The same seed again: the same bag bytes.
   const RunSummary again = WriteBagRun(5, "run_fmt_mcap_again", RecordingFormat::kMcap);
   const std::string mcap = "/run_0.mcap";
-  EXPECT_EQ(slamrig::testing::ReadFile(again.files[0] + mcap),
-            slamrig::testing::ReadFile(::testing::TempDir() + "/run_fmt_mcap/run" + mcap));
+  EXPECT_EQ(ReadFile(again.files[0] + mcap),
+            ReadFile(::testing::TempDir() + "/run_fmt_mcap/run" + mcap));
 }
 
 }  // namespace

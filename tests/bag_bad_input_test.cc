@@ -19,6 +19,8 @@
 namespace slamrig {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 namespace fs = std::filesystem;
 
 std::string Binary() { return SLAMRIG_BINARY; }
@@ -37,7 +39,7 @@ std::string SimulateBag(const testing::TempDir& dir, const std::string& name,
 // MCAP file, walking the records from the 8-byte magic: opcode (1 byte), length (uint64 LE),
 // content.
 void FlipByteInFirstChunk(const std::string& path) {
-  std::string bytes = slamrig::testing::ReadFile(path);
+  std::string bytes = ReadFile(path);
   std::size_t at = 8;
   while (at + 9 <= bytes.size()) {
     const auto opcode = static_cast<unsigned char>(bytes[at]);

@@ -19,6 +19,8 @@
 namespace slamrig {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 std::vector<std::vector<std::string>> Rows(const std::string& csv) {
   std::ifstream in(csv);
   std::vector<std::vector<std::string>> rows;
@@ -68,10 +70,10 @@ TEST(BenchmarkCliTest, RunsEveryPairResumesAndReproduces) {
     EXPECT_EQ(rows[i][diverged], "0") << rows[i][0];
     EXPECT_FALSE(rows[i][lost_s].empty()) << rows[i][0];
   }
-  const std::string summary = slamrig::testing::ReadFile(dir.File("a/summary.html"));
+  const std::string summary = ReadFile(dir.File("a/summary.html"));
   EXPECT_NE(summary.find("Leaderboard"), std::string::npos);
   EXPECT_NE(summary.find("runs/0000/report.html"), std::string::npos);
-  EXPECT_NE(slamrig::testing::ReadFile(dir.File("a/runs/0005/scenario.yaml")).find("max_scans: 80"),
+  EXPECT_NE(ReadFile(dir.File("a/runs/0005/scenario.yaml")).find("max_scans: 80"),
             std::string::npos);
 
   const auto again =
@@ -110,8 +112,7 @@ TEST(BenchmarkCliTest, ARunPastTheTimeoutIsKilledAndFailed) {
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[1][4], "timeout");
   EXPECT_EQ(rows[1][5], "still running after 0.5 s");
-  EXPECT_NE(slamrig::testing::ReadFile(dir.File("out/summary.html")).find("timeout"),
-            std::string::npos);
+  EXPECT_NE(ReadFile(dir.File("out/summary.html")).find("timeout"), std::string::npos);
 }
 
 // Every shipped suite loads: its logs are there, its worlds generate, its estimators resolve.

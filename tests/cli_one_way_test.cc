@@ -16,6 +16,8 @@
 namespace slamrig {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 using ::testing::HasSubstr;
 using ::testing::Not;
 using testing::RunCommand;
@@ -45,9 +47,8 @@ TEST(CliOneWayTest, SimulateQuietPrintsNothingAndWritesTheSameRun) {
       RunCommand(Slamrig("simulate office --duration 3 --quiet --out " + dir.File("b")));
   ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
   EXPECT_EQ(quiet.output, "");
-  EXPECT_GT(slamrig::testing::ReadFile(dir.File("a/run.log")).size(), 1000u);
-  EXPECT_EQ(slamrig::testing::ReadFile(dir.File("a/run.log")),
-            slamrig::testing::ReadFile(dir.File("b/run.log")));
+  EXPECT_GT(ReadFile(dir.File("a/run.log")).size(), 1000u);
+  EXPECT_EQ(ReadFile(dir.File("a/run.log")), ReadFile(dir.File("b/run.log")));
   // Errors still come through.
   const auto bad =
       RunCommand(Slamrig("simulate office --quiet --format nope --out " + dir.File("c")));
@@ -72,12 +73,11 @@ TEST(CliOneWayTest, AScenarioWithoutRobotDrivesSimulatesDefaultRobot) {
       dir.Write("named.yaml", body + "robot: " + dir.File("s/robot.yaml") + "\n");
   const auto run_named = RunCommand(Slamrig("run " + named + " --quiet --out " + dir.File("b")));
   ASSERT_EQ(run_named.exit_code, 0) << run_named.output;
-  const std::string robot = RobotSection(slamrig::testing::ReadFile(dir.File("a/config.yaml")));
+  const std::string robot = RobotSection(ReadFile(dir.File("a/config.yaml")));
   EXPECT_THAT(robot, HasSubstr("name: ece276a"));
   EXPECT_GT(robot.size(), 200u);
-  EXPECT_EQ(robot, RobotSection(slamrig::testing::ReadFile(dir.File("b/config.yaml"))));
-  EXPECT_EQ(slamrig::testing::ReadFile(dir.File("a/truth.tum")),
-            slamrig::testing::ReadFile(dir.File("b/truth.tum")));
+  EXPECT_EQ(robot, RobotSection(ReadFile(dir.File("b/config.yaml"))));
+  EXPECT_EQ(ReadFile(dir.File("a/truth.tum")), ReadFile(dir.File("b/truth.tum")));
 }
 
 // Every line whole: no carriage return, and the verdict line starts a line of its own.

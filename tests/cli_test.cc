@@ -15,6 +15,8 @@
 namespace slamrig {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 using ::testing::HasSubstr;
 using testing::RunCommand;
 using ::testing::StartsWith;
@@ -185,16 +187,15 @@ TEST(CliTest, TheReportsConfigReproducesTheRun) {
       RunCommand(Slamrig("run " + dir.File("a/config.yaml") + " --quiet --out " + dir.File("b")));
   ASSERT_EQ(again.exit_code, first.exit_code) << again.output;
   // metrics.json equal line for line, the wall-clock figures (and the expectation on one) aside.
-  const std::string a = slamrig::testing::ReadFile(dir.File("a/metrics.json"));
+  const std::string a = ReadFile(dir.File("a/metrics.json"));
   EXPECT_GT(a.size(), 500u);
   EXPECT_EQ(Without(a, {"realtime_factor", "wall_time_s", "\"value\""}),
-            Without(slamrig::testing::ReadFile(dir.File("b/metrics.json")),
+            Without(ReadFile(dir.File("b/metrics.json")),
                     {"realtime_factor", "wall_time_s", "\"value\""}));
-  EXPECT_EQ(slamrig::testing::ReadFile(dir.File("a/pf.tum")),
-            slamrig::testing::ReadFile(dir.File("b/pf.tum")));
+  EXPECT_EQ(ReadFile(dir.File("a/pf.tum")), ReadFile(dir.File("b/pf.tum")));
   // And the resolved configuration resolves to itself.
-  EXPECT_EQ(Without(slamrig::testing::ReadFile(dir.File("a/config.yaml")), {}),
-            Without(slamrig::testing::ReadFile(dir.File("b/config.yaml")), {}));
+  EXPECT_EQ(Without(ReadFile(dir.File("a/config.yaml")), {}),
+            Without(ReadFile(dir.File("b/config.yaml")), {}));
 }
 
 TEST(CliTest, BadScenarioInputNamesFileLineAndKey) {

@@ -17,13 +17,15 @@
 namespace slamrig {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 namespace fs = std::filesystem;
 
 const fs::path kRoot = SLAMRIG_SOURCE_DIR;
 
 // SLAMRIG_MODULES, bottom-up, as the top-level CMakeLists.txt lists them.
 std::vector<std::string> Modules() {
-  const std::string cmake = slamrig::testing::ReadFile(kRoot / "CMakeLists.txt");
+  const std::string cmake = ReadFile(kRoot / "CMakeLists.txt");
   const std::size_t begin = cmake.find("set(SLAMRIG_MODULES");
   const std::size_t end = cmake.find(')', begin);
   std::istringstream list(cmake.substr(begin + 19, end - begin - 19));
@@ -59,7 +61,7 @@ std::vector<Include> Includes() {
       const std::string ext = entry.path().extension().string();
       if (ext != ".h" && ext != ".cc") continue;
       const std::string file = fs::relative(entry.path(), kRoot).string();
-      std::istringstream text(slamrig::testing::ReadFile(entry.path()));
+      std::istringstream text(ReadFile(entry.path()));
       for (std::string l; std::getline(text, l);) {
         std::smatch m;
         if (std::regex_search(l, m, line)) includes.push_back({file, m[1]});

@@ -19,6 +19,8 @@
 namespace slamrig {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 using testing::RunCommand;
 
 const std::string kBinary = SLAMRIG_BINARY;
@@ -49,7 +51,7 @@ TEST(OptimizeCliTest, WritesTheLibrarysOptimumAndPrintsTheSummaryAndTheCertifica
   slam::PoseGraph expected = slam::ReadG2o(in);
   slam::InitializeChordal(&expected);
   const slam::PoseGraphSummary s = slam::PoseGraphOptimizer({}).Optimize(&expected);
-  EXPECT_EQ(slamrig::testing::ReadFile(out), slam::FormatG2o(expected));
+  EXPECT_EQ(ReadFile(out), slam::FormatG2o(expected));
   char chi2[32];
   std::snprintf(chi2, sizeof(chi2), "-> %.6g in", slam::Chi2(slam::ReadG2o(out)));
   EXPECT_NE(result.output.find(chi2), std::string::npos) << result.output << " vs " << chi2;

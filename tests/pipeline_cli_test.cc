@@ -16,6 +16,8 @@
 namespace slamrig {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 using testing::RunCommand;
 
 const std::string kBinary = SLAMRIG_BINARY;
@@ -76,8 +78,7 @@ TEST(PipelineCliTest, SlamAndALogScenarioWriteTheSameMetricsSchema) {
   const auto again = RunCommand(kBinary + " run " + dir.File("slam") +
                                 "/config.yaml --quiet --out " + dir.File("again"));
   ASSERT_EQ(again.exit_code, 0) << again.output;
-  EXPECT_EQ(slamrig::testing::ReadFile(dir.File("slam") + "/graph.tum"),
-            slamrig::testing::ReadFile(dir.File("again") + "/graph.tum"));
+  EXPECT_EQ(ReadFile(dir.File("slam") + "/graph.tum"), ReadFile(dir.File("again") + "/graph.tum"));
 }
 
 // The metric rows of a report.html: the text of each row's first cell in the metrics table.
@@ -99,7 +100,7 @@ TEST(PipelineCliTest, TheReportListsOnlyWhatApplies) {
   const auto r = RunCommand(kBinary + " slam " + log +
                             " --algorithm dead-reckoning --quiet --out " + dir.File("dr"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const std::string html = slamrig::testing::ReadFile(dir.File("dr") + "/report.html");
+  const std::string html = ReadFile(dir.File("dr") + "/report.html");
   const std::vector<std::string> rows = MetricRows(html);
   ASSERT_FALSE(rows.empty()) << html;
   for (const std::string& row : rows) {
@@ -128,7 +129,7 @@ TEST(PipelineCliTest, TheReportListsOnlyWhatApplies) {
 // claimed on the console, in metrics.json or in the report.
 TEST(PipelineCliTest, SynthesisedTimesGiveNoRealTimeFactor) {
   testing::TempDir dir;
-  std::istringstream in(slamrig::testing::ReadFile(SimulatedLog(dir)));
+  std::istringstream in(ReadFile(SimulatedLog(dir)));
   std::ofstream zeroed(dir.File("zero.log"));
   std::string line;
   while (std::getline(in, line)) {
@@ -150,10 +151,10 @@ TEST(PipelineCliTest, SynthesisedTimesGiveNoRealTimeFactor) {
   const std::string said = "times synthesised from line order; no real-time factor";
   EXPECT_NE(r.output.find(said), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("real time)"), std::string::npos) << r.output;
-  const std::string json = slamrig::testing::ReadFile(dir.File("out") + "/metrics.json");
+  const std::string json = ReadFile(dir.File("out") + "/metrics.json");
   EXPECT_NE(json.find("\"times_synthesised\": true"), std::string::npos) << json;
   EXPECT_EQ(json.find("realtime_factor"), std::string::npos) << json;
-  const std::string html = slamrig::testing::ReadFile(dir.File("out") + "/report.html");
+  const std::string html = ReadFile(dir.File("out") + "/report.html");
   EXPECT_NE(html.find(said), std::string::npos);
   EXPECT_EQ(html.find("realtime_factor"), std::string::npos);
   // The untouched log has its real-time factor.
@@ -162,8 +163,7 @@ TEST(PipelineCliTest, SynthesisedTimesGiveNoRealTimeFactor) {
                  "/run.log --algorithm dead-reckoning --quiet --out " + dir.File("real"));
   ASSERT_EQ(real.exit_code, 0) << real.output;
   EXPECT_NE(real.output.find("x real time)"), std::string::npos) << real.output;
-  EXPECT_NE(slamrig::testing::ReadFile(dir.File("real") + "/metrics.json")
-                .find("\"times_synthesised\": false"),
+  EXPECT_NE(ReadFile(dir.File("real") + "/metrics.json").find("\"times_synthesised\": false"),
             std::string::npos);
 }
 

@@ -15,6 +15,8 @@
 namespace slamrig {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 TEST(SelfDiagnosisTest, KidnappedFilterDeclaresItsLostIntervalAndLostMaxZeroFails) {
   testing::TempDir dir;
   const std::string source = SLAMRIG_SOURCE_DIR;
@@ -52,8 +54,7 @@ TEST(SelfDiagnosisTest, KidnappedFilterDeclaresItsLostIntervalAndLostMaxZeroFail
   EXPECT_TRUE(expectations["pf.lost_intervals_max"]["passed"].as<bool>());
   EXPECT_TRUE(expectations["pf.diverged_max"]["passed"].as<bool>());
   // The report lists the interval.
-  EXPECT_NE(testing::ReadFile(dir.File("out/report.html")).find("Self-diagnosis"),
-            std::string::npos);
+  EXPECT_NE(ReadFile(dir.File("out/report.html")).find("Self-diagnosis"), std::string::npos);
 }
 
 // `slamrig slam` on intel's first 200 scans, perturbed as given; the graph's metrics.

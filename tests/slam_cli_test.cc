@@ -13,6 +13,8 @@
 namespace slamrig {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 using testing::RunCommand;
 
 // The first configuration's "ate_rmse_m" in the metrics.json of `slamrig slam`.
@@ -50,16 +52,15 @@ TEST(SlamCliTest, SlamWritesEverythingAndEvalAgreesWithIt) {
                         "map.yaml", "map.png", "metrics.json"}) {
     EXPECT_TRUE(std::filesystem::exists(out + "/" + f)) << f;
   }
-  EXPECT_EQ(CountPoses(slamrig::testing::ReadFile(out + "/trajectory.tum")), 120);
-  const double slam_rmse = SlamAteRmse(slamrig::testing::ReadFile(out + "/metrics.json"));
+  EXPECT_EQ(CountPoses(ReadFile(out + "/trajectory.tum")), 120);
+  const double slam_rmse = SlamAteRmse(ReadFile(out + "/metrics.json"));
   EXPECT_GT(slam_rmse, 0.0);
   EXPECT_LT(slam_rmse, 0.5);
 
   const auto eval = RunCommand(kBinary + " eval --estimate " + out + "/trajectory.tum --truth " +
                                out + "/reference.tum --out " + dir.File("eval"));
   ASSERT_EQ(eval.exit_code, 0) << eval.output;
-  EXPECT_NEAR(AteRmse(slamrig::testing::ReadFile(dir.File("eval") + "/metrics.json")), slam_rmse,
-              1e-6);
+  EXPECT_NEAR(AteRmse(ReadFile(dir.File("eval") + "/metrics.json")), slam_rmse, 1e-6);
 
   // Relations generated from the reference, evaluated on the estimate.
   const auto relations =
@@ -79,8 +80,8 @@ TEST(SlamCliTest, SameSeedSameTrajectoryFile) {
                    " --max-scans 80 --particles 20 --seed 7 --quiet --out " + dir.File(run));
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
-  EXPECT_EQ(slamrig::testing::ReadFile(dir.File("a") + "/trajectory.tum"),
-            slamrig::testing::ReadFile(dir.File("b") + "/trajectory.tum"));
+  EXPECT_EQ(ReadFile(dir.File("a") + "/trajectory.tum"),
+            ReadFile(dir.File("b") + "/trajectory.tum"));
 }
 
 TEST(SlamCliTest, DeadReckoningOnTheEce276aEncodersAndImu) {
@@ -89,7 +90,7 @@ TEST(SlamCliTest, DeadReckoningOnTheEce276aEncodersAndImu) {
   const auto r = RunCommand(kBinary + " slam " + encoders + " --algorithm dead-reckoning --out " +
                             dir.File("dr"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(CountPoses(slamrig::testing::ReadFile(dir.File("dr") + "/trajectory.tum")), 4956);
+  EXPECT_EQ(CountPoses(ReadFile(dir.File("dr") + "/trajectory.tum")), 4956);
   const auto pf = RunCommand(kBinary + " slam " + encoders + " --out " + dir.File("pf"));
   EXPECT_EQ(pf.exit_code, 1);
   EXPECT_NE(pf.output.find("no laser scans"), std::string::npos) << pf.output;

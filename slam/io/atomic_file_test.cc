@@ -12,13 +12,15 @@
 namespace slamrig::slam {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 namespace fs = std::filesystem;
 
 TEST(AtomicFileTest, ReplacesTheFileAndLeavesNoTemporary) {
   testing::TempDir dir;
   const std::string path = dir.Write("a.txt", "old contents");
   WriteFileAtomically(path, "new");
-  EXPECT_EQ(slamrig::testing::ReadFile(path), "new");
+  EXPECT_EQ(ReadFile(path), "new");
   int files = 0;
   for ([[maybe_unused]] const auto& f : fs::directory_iterator(dir.path())) ++files;
   EXPECT_EQ(files, 1);

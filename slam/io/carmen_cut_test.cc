@@ -24,6 +24,8 @@
 namespace slamrig::slam {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 namespace fs = std::filesystem;
 using TempDir = slamrig::testing::TempDir;
 using ::testing::HasSubstr;
@@ -120,7 +122,7 @@ std::vector<std::string> Split(const std::string& text) {
 
 TEST(CarmenCutTest, EveryCutOfAPlainLogReadsItsWholeLines) {
   TempDir dir;
-  const std::string text = slamrig::testing::ReadFile(WriteTestLog(dir, 60));
+  const std::string text = ReadFile(WriteTestLog(dir, 60));
   const CarmenLog whole = ReadCarmenLog(dir.File("whole.log"));
   std::mt19937_64 rng(34);
   std::uniform_int_distribution<std::size_t> at(1, text.size() - 1);
@@ -178,7 +180,7 @@ std::string Gzip(const std::string& text, const std::string& path) {
   gzFile f = gzopen(path.c_str(), "wb");
   gzwrite(f, text.data(), static_cast<unsigned>(text.size()));
   gzclose(f);
-  return slamrig::testing::ReadFile(path);
+  return ReadFile(path);
 }
 
 // What zlib itself gets out of a cut gzip stream, independently of gzgets.
@@ -202,7 +204,7 @@ std::string Inflate(const std::string& compressed) {
 
 TEST(CarmenCutTest, EveryCutOfAGzipLogReadsWhatDecompresses) {
   TempDir dir;
-  const std::string text = slamrig::testing::ReadFile(WriteTestLog(dir, 200));
+  const std::string text = ReadFile(WriteTestLog(dir, 200));
   const CarmenLog whole = ReadCarmenLog(dir.File("whole.log"));
   const std::string gz = Gzip(text, dir.File("whole.log.gz"));
   std::mt19937_64 rng(34);
@@ -239,7 +241,7 @@ TEST(CarmenCutTest, EveryCutOfAGzipLogReadsWhatDecompresses) {
 
 TEST(CarmenCutTest, AWholeLastLineWithoutNewlineIsKept) {
   TempDir dir;
-  const std::string text = slamrig::testing::ReadFile(WriteTestLog(dir, 5));
+  const std::string text = ReadFile(WriteTestLog(dir, 5));
   const std::string path = dir.Write("no_newline.log", text.substr(0, text.size() - 1));
   const CarmenLog log = ReadCarmenLog(path);
   EXPECT_EQ(log.truncated, "");
@@ -251,7 +253,7 @@ TEST(CarmenCutTest, AWholeLastLineWithoutNewlineIsKept) {
 // `slamrig simulate --out DIR` writes DIR/run.log (or the bag DIR/run): DIR names its run.
 TEST(LogFolderTest, AFolderWithOneRunReadsIt) {
   TempDir dir;
-  const std::string text = slamrig::testing::ReadFile(WriteTestLog(dir, 5));
+  const std::string text = ReadFile(WriteTestLog(dir, 5));
   fs::create_directories(dir.File("sim"));
   WriteAll(dir.File("sim/run.log"), text);
   WriteAll(dir.File("sim/truth.tum"), "1000 0 0 0 0 0 0 1\n");
@@ -277,7 +279,7 @@ TEST(LogFolderTest, AFolderWithOneRunReadsIt) {
 
 TEST(LogFolderTest, StrictReadingRefusesACutLog) {
   TempDir dir;
-  const std::string text = slamrig::testing::ReadFile(WriteTestLog(dir, 5));
+  const std::string text = ReadFile(WriteTestLog(dir, 5));
   const std::string path = dir.Write("cut.log", text.substr(0, text.size() - 20));
   LogReadOptions strict;
   strict.strict = true;

@@ -52,15 +52,14 @@ double NisWindow::ratio() const {
 void HealthRecord::Add(bool lost) {
   if (lost) {
     ++lost_scans_;
-    if (!lost_now_) loss_scans_.emplace_back(scans_, scans_);
+    if (!lost_at_end()) loss_scans_.emplace_back(scans_, scans_);
     loss_scans_.back().second = scans_;
   }
-  lost_now_ = lost;
   ++scans_;
 }
 
 bool HealthRecord::Diverged() const {
-  return lost_now_ || static_cast<double>(lost_scans_) > kDivergedLostShare * scans_;
+  return lost_at_end() || static_cast<double>(lost_scans_) > kDivergedLostShare * scans_;
 }
 
 FrontEndHealth::FrontEndHealth() : score_ratio_(0.3, 0.02, 10, kLostRatio) {}

@@ -87,7 +87,10 @@ class HealthRecord {
   int losses() const { return static_cast<int>(loss_scans_.size()); }
   /// Each loss's first and last scan, counted from 0 in Add order.
   const std::vector<std::pair<int, int>>& loss_scans() const { return loss_scans_; }
-  bool lost_at_end() const { return lost_now_; }
+  /// Lost at the last scan: the last loss runs to it.
+  bool lost_at_end() const {
+    return !loss_scans_.empty() && loss_scans_.back().second == scans_ - 1;
+  }
   /// Lost at the last scan, or on more than kDivergedLostShare of the scans.
   bool Diverged() const;
 
@@ -95,7 +98,6 @@ class HealthRecord {
   int scans_ = 0;
   int lost_scans_ = 0;
   std::vector<std::pair<int, int>> loss_scans_;
-  bool lost_now_ = false;
 };
 
 /// The health of a scan-to-local-map front end (IcpOdometry: the graph's and icp-odometry's) at

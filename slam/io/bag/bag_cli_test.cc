@@ -17,6 +17,8 @@
 namespace slamrig::slam {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 namespace fs = std::filesystem;
 
 std::string Simulate(const slamrig::testing::TempDir& dir, const std::string& name,
@@ -72,10 +74,8 @@ TEST(BagCliTest, SimulatedBagsMatchTheCarmenLog) {
   }
   // Same arguments, same bytes.
   const std::string again = Simulate(dir, "m2", "mcap");
-  EXPECT_EQ(slamrig::testing::ReadFile(again + "/run/run_0.mcap"),
-            slamrig::testing::ReadFile(mcap + "/run/run_0.mcap"));
-  EXPECT_EQ(slamrig::testing::ReadFile(again + "/run/metadata.yaml"),
-            slamrig::testing::ReadFile(mcap + "/run/metadata.yaml"));
+  EXPECT_EQ(ReadFile(again + "/run/run_0.mcap"), ReadFile(mcap + "/run/run_0.mcap"));
+  EXPECT_EQ(ReadFile(again + "/run/metadata.yaml"), ReadFile(mcap + "/run/metadata.yaml"));
 }
 
 TEST(BagCliTest, SlamReadsABagAndRejectsADamagedOne) {
@@ -85,8 +85,7 @@ TEST(BagCliTest, SlamReadsABagAndRejectsADamagedOne) {
   auto r = slamrig::testing::RunCommand(std::string(SLAMRIG_BINARY) + " slam " + sim +
                                         "/run --algorithm dead-reckoning --quiet --out " + out);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(slamrig::testing::ReadFile(out + "/metrics.json").find("\"log_format\": \"ros2bag\""),
-            std::string::npos);
+  EXPECT_NE(ReadFile(out + "/metrics.json").find("\"log_format\": \"ros2bag\""), std::string::npos);
   EXPECT_TRUE(fs::exists(out + "/trajectory.tum"));
 
   // Cut the file, as a recording killed mid-way leaves it: the run scores the messages before
@@ -104,8 +103,7 @@ TEST(BagCliTest, SlamReadsABagAndRejectsADamagedOne) {
   EXPECT_TRUE(r.output.starts_with(note)) << r.output;
   EXPECT_TRUE(r.output.ends_with(" scans of an unknown total; the rest is lost\n")) << r.output;
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
-  EXPECT_NE(slamrig::testing::ReadFile(cut_out + "/metrics.json").find(note.substr(6)),
-            std::string::npos);
+  EXPECT_NE(ReadFile(cut_out + "/metrics.json").find(note.substr(6)), std::string::npos);
   EXPECT_TRUE(fs::exists(cut_out + "/trajectory.tum"));
 
   const std::string bad_out = dir.File("bad");
@@ -170,8 +168,8 @@ TEST(BagCliTest, SlamOnASimulateFolderFindsItsRun) {
     ASSERT_EQ(r.exit_code, 0) << r.output;
     r = slamrig::testing::RunCommand(slam + run + " --out " + dir.File(format + "_run"));
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    EXPECT_EQ(slamrig::testing::ReadFile(dir.File(format + "_dir/trajectory.tum")),
-              slamrig::testing::ReadFile(dir.File(format + "_run/trajectory.tum")));
+    EXPECT_EQ(ReadFile(dir.File(format + "_dir/trajectory.tum")),
+              ReadFile(dir.File(format + "_run/trajectory.tum")));
   }
   fs::copy(dir.File("mcap/run"), dir.File("carmen/run"), fs::copy_options::recursive);
   const auto r = slamrig::testing::RunCommand(std::string(SLAMRIG_BINARY) + " slam " +

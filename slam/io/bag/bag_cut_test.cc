@@ -25,6 +25,8 @@
 namespace slamrig::slam {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 namespace fs = std::filesystem;
 using TempDir = slamrig::testing::TempDir;
 using ::testing::HasSubstr;
@@ -162,7 +164,7 @@ class CutMcapTest : public ::testing::TestWithParam<McapCompression> {};
 TEST_P(CutMcapTest, EveryCutReadsTheMessagesOfTheWholeChunksBeforeIt) {
   TempDir dir;
   const std::string file = WriteTestBag(dir, BagStorage::kMcap, GetParam());
-  const std::string bytes = slamrig::testing::ReadFile(file);
+  const std::string bytes = ReadFile(file);
   const RawBag whole = ReadMcapFile(file);
   const Dataset whole_data = ReadBag(CutBag(dir, "run_0.mcap", bytes));
   std::size_t data_end = 0;
@@ -223,7 +225,7 @@ INSTANTIATE_TEST_SUITE_P(Compressions, CutMcapTest,
 TEST(CutMcapTest, DamageBeforeTheCutIsStillAnError) {
   TempDir dir;
   const std::string file = WriteTestBag(dir, BagStorage::kMcap, McapCompression::kNone);
-  std::string bytes = slamrig::testing::ReadFile(file);
+  std::string bytes = ReadFile(file);
   bytes.resize(bytes.size() * 3 / 4);
   const std::size_t at = bytes.find(std::string("laser\0", 6));
   bytes[at] = static_cast<char>(bytes[at] ^ 0x10);
@@ -234,7 +236,7 @@ TEST(CutMcapTest, DamageBeforeTheCutIsStillAnError) {
 TEST(CutMcapTest, OnlyTheLastFileOfABagMayBeCut) {
   TempDir dir;
   const std::string file = WriteTestBag(dir, BagStorage::kMcap, McapCompression::kZstd);
-  const std::string bytes = slamrig::testing::ReadFile(file);
+  const std::string bytes = ReadFile(file);
   const std::string folder = dir.File("split");
   fs::create_directories(folder);
   WriteAll(folder + "/a_0.mcap", bytes.substr(0, bytes.size() / 2));
@@ -253,7 +255,7 @@ TEST(CutMcapTest, OnlyTheLastFileOfABagMayBeCut) {
 TEST(CutSqliteTest, EveryCutReadsAPrefixOfTheRows) {
   TempDir dir;
   const std::string file = WriteTestBag(dir, BagStorage::kSqlite3, McapCompression::kNone);
-  const std::string bytes = slamrig::testing::ReadFile(file);
+  const std::string bytes = ReadFile(file);
   const RawBag whole = ReadSqliteBagFile(file);
   const Dataset whole_data = ReadBag(CutBag(dir, "run_0.db3", bytes));
   const std::size_t page = 4096;

@@ -22,6 +22,8 @@
 namespace slamrig::slam {
 namespace {
 
+using slamrig::testing::ReadFile;
+
 namespace fs = std::filesystem;
 using TempDir = slamrig::testing::TempDir;
 
@@ -161,8 +163,7 @@ TEST(BagTest, EmptyBagsAreValid) {
     const Dataset back = ReadBag(folder);
     EXPECT_TRUE(back.records.empty());
     EXPECT_TRUE(back.reference.empty());
-    EXPECT_NE(slamrig::testing::ReadFile(folder + "/metadata.yaml").find("  message_count: 0\n"),
-              std::string::npos);
+    EXPECT_NE(ReadFile(folder + "/metadata.yaml").find("  message_count: 0\n"), std::string::npos);
   }
 }
 
@@ -194,7 +195,7 @@ TEST(BagTest, MetadataListsTopicsAndCounts) {
   // 0.1 s: 10 IMU samples and 4 each of ticks, odometry, scans and truth; 4 /tf, 1 /tf_static
   // and 10 /clock (100 Hz) messages: 41 in all.
   WriteBag(testing::SyntheticRun(0.1, 1, 8), dir.File("m"), {});
-  const std::string yaml = slamrig::testing::ReadFile(dir.File("m/metadata.yaml"));
+  const std::string yaml = ReadFile(dir.File("m/metadata.yaml"));
   for (const char* key :
        {"rosbag2_bagfile_information:\n  version: 6\n  storage_identifier: mcap\n",
         "  custom_data:\n    slamrig.ticks_per_revolution: \"360\"\n", "  message_count: 41\n",
@@ -285,7 +286,7 @@ class CorruptMcapTest : public ::testing::Test {
     options.chunk_size_bytes = 4096;
     WriteBag(testing::SyntheticRun(0.5, 5, 64), dir_.File("b"), options);
     file_ = dir_.File("b/b_0.mcap");
-    bytes_ = slamrig::testing::ReadFile(file_);
+    bytes_ = ReadFile(file_);
   }
   std::string ErrorAfter(const std::string& bytes, bool strict = false) {
     WriteAll(file_, bytes);
@@ -354,7 +355,7 @@ TEST(CorruptBagTest, ChunkThatDoesNotDecompress) {
     options.compression = c;
     WriteBag(testing::SyntheticRun(0.2, 5, 64), dir.File("b"), options);
     const std::string file = dir.File("b/b_0.mcap");
-    std::string b = slamrig::testing::ReadFile(file);
+    std::string b = ReadFile(file);
     // Overwrite the start of the compressed records, just after the compression name.
     const std::string name(McapCompressionName(c));
     const std::string field = std::string(1, static_cast<char>(name.size())) +
@@ -464,7 +465,7 @@ TEST(CorruptBagTest, RandomDamageIsAParseErrorOrHarmless) {
     WriteBag(testing::SyntheticRun(0.1, 9, 32), folder, options);
     const std::string file = folder + "/" + fs::path(folder).filename().string() +
                              (storage == BagStorage::kMcap ? "_0.mcap" : "_0.db3");
-    const std::string good = slamrig::testing::ReadFile(file);
+    const std::string good = ReadFile(file);
     int errors = 0;
     const int trials = 45;
     for (int trial = 0; trial < trials; ++trial) {
