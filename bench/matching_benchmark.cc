@@ -105,7 +105,8 @@ void BM_CorrelativePrecompute(benchmark::State& state) {
     const CorrelativeMatcher matcher(options, TheOffice().grid);
     benchmark::DoNotOptimize(&matcher);
   }
-  state.counters["cells"] = static_cast<double>(TheOffice().grid.log_odds().size());
+  state.counters["cells"] =
+      static_cast<double>(TheOffice().grid.width()) * TheOffice().grid.height();
 }
 BENCHMARK(BM_CorrelativePrecompute)->Arg(7)->Unit(benchmark::kMillisecond);
 

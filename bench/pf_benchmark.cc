@@ -63,7 +63,7 @@ void RunWhole(benchmark::State& state, ParticleFilterOptions options) {
     Trajectory trajectory;
     for (const SyncedScan& s : run.scans) trajectory.Append(s.scan.time, estimator.AddScan(s).pose);
     rmse = PositionRmse(trajectory, run.truth);
-    benchmark::DoNotOptimize(estimator.map().log_odds().data());
+    benchmark::DoNotOptimize(estimator.map().DenseLogOdds().data());
   }
   state.counters["scans"] = static_cast<double>(run.scans.size());
   state.counters["beams"] = static_cast<double>(run.scans.front().scan.ranges_m.size());
@@ -101,8 +101,10 @@ void BM_Correlate9x9(benchmark::State& state) {
   const std::vector<Eigen::Vector2d> points = ScanToBasePoints(run.scans[200].scan, point_options);
   const MapCorrelator correlator(MapCorrelatorOptions{});
   const Pose2 pose = anchor_inverse * run.truth[200].map_from_base;
+  const std::vector<float> values = grid.DenseLogOdds();
+  const GridView view{values.data(), grid.width(), grid.height(), grid.origin(), grid.resolution()};
   for (auto _ : state) {
-    benchmark::DoNotOptimize(correlator.Correlate(GridView::Of(grid), points, pose));
+    benchmark::DoNotOptimize(correlator.Correlate(view, points, pose));
   }
   state.counters["points"] = static_cast<double>(points.size());
 }

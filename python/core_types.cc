@@ -169,7 +169,7 @@ void DefineTrajectoryAndGrid(py::module_& m) {
       .def_readwrite("track_width_m", &slam::DiffDriveParams::track_width_m);
 
   py::class_<OccupancyGrid>(m, "OccupancyGrid",
-                            "A log-odds grid; `log_odds` is an (H, W) view, row 0 at the lowest y.")
+                            "A log-odds grid; `log_odds` is an (H, W) copy, row 0 at the lowest y.")
       .def(py::init([](double resolution) {
              OccupancyGridOptions o;
              o.resolution_m = resolution;
@@ -191,12 +191,14 @@ void DefineTrajectoryAndGrid(py::module_& m) {
       .def_property_readonly("height", &OccupancyGrid::height)
       .def_property_readonly(
           "log_odds",
-          [](py::object self) {
-            const auto& g = self.cast<const OccupancyGrid&>();
-            return View(g.log_odds().data(), {g.height(), g.width()},
-                        {static_cast<py::ssize_t>(g.width() * sizeof(float)), sizeof(float)}, self);
+          [](const OccupancyGrid& g) {
+            // The grid is tiles, not one array: a dense copy, read-only like the other records.
+            py::array_t<float> a({g.height(), g.width()});
+            g.CopyLogOdds({0, 0}, {g.width(), g.height()}, a.mutable_data(), g.width());
+            a.attr("flags").attr("writeable") = false;
+            return a;
           },
-          "(H, W) float32, read-only view; invalid after the grid grows (insert_scan)")
+          "(H, W) float32, read-only copy (the grid's cells at the time of the call)")
       .def(
           "probability",
           [](const OccupancyGrid& g) {

@@ -114,28 +114,18 @@ std::vector<RosMarker> LandmarkMarkers(const std::vector<slam::LandmarkEstimate>
 slam::RosOccupancyGrid ToRosGrid(const slam::OccupancyGrid& grid, Time time,
                                  const std::string& frame_id, const Pose2& frame_from_grid) {
   // The smallest box of observed cells: a grid grows in margins it never observes.
-  const std::vector<float>& log_odds = grid.log_odds();
-  const int w = grid.width(), h = grid.height();
-  int x0 = w, x1 = -1, y0 = h, y1 = -1;
-  for (int y = 0; y < h; ++y) {
-    const float* row = log_odds.data() + static_cast<std::size_t>(y) * w;
-    int first = 0;
-    while (first < w && row[first] == 0.0f) ++first;
-    if (first == w) continue;
-    int last = w - 1;
-    while (row[last] == 0.0f) --last;
-    x0 = std::min(x0, first);
-    x1 = std::max(x1, last);
-    y0 = std::min(y0, y);
-    y1 = y;
+  const Eigen::AlignedBox2i observed = grid.ObservedCells();
+  int x0 = 0, x1 = 0, y0 = 0, y1 = 0;  // nothing observed yet: one unknown cell
+  if (!observed.isEmpty()) {
+    x0 = observed.min().x();
+    y0 = observed.min().y();
+    x1 = observed.max().x();
+    y1 = observed.max().y();
   }
   slam::RosOccupancyGrid out;
   out.time = time;
   out.frame_id = frame_id;
   out.resolution_m = static_cast<float>(grid.resolution());
-  if (x1 < 0) {  // nothing observed yet: one unknown cell
-    x0 = x1 = y0 = y1 = 0;
-  }
   out.width = static_cast<std::uint32_t>(x1 - x0 + 1);
   out.height = static_cast<std::uint32_t>(y1 - y0 + 1);
   const Eigen::Vector2d corner = grid.origin() + Eigen::Vector2d(x0, y0) * grid.resolution();
@@ -161,17 +151,16 @@ slam::RosOccupancyGrid ToRosGrid(const slam::OccupancyGrid& grid, Time time,
   };
   float last_l = 0.0f;
   std::int8_t last_value = -1;
-  std::size_t i = 0;
-  for (int y = y0; y <= y1; ++y) {
-    const float* row = log_odds.data() + static_cast<std::size_t>(y) * w;
-    for (int x = x0; x <= x1; ++x, ++i) {
-      const float l = row[x];
-      if (l != last_l) {
-        last_l = l;
-        last_value = l == 0.0f ? std::int8_t{-1} : percent(l);
-      }
-      out.data[i] = last_value;
+  std::vector<float> log_odds(out.data.size());
+  grid.CopyLogOdds({x0, y0}, {static_cast<int>(out.width), static_cast<int>(out.height)},
+                   log_odds.data(), out.width);
+  for (std::size_t i = 0; i < log_odds.size(); ++i) {
+    const float l = log_odds[i];
+    if (l != last_l) {
+      last_l = l;
+      last_value = l == 0.0f ? std::int8_t{-1} : percent(l);
     }
+    out.data[i] = last_value;
   }
   return out;
 }

@@ -127,7 +127,7 @@ TEST_P(BagReplayTest, ReplayedBagGivesBitIdenticalSlamOutput) {
     // The same map, cell for cell.
     EXPECT_EQ(x.map.width(), y.map.width());
     EXPECT_EQ(x.map.height(), y.map.height());
-    EXPECT_TRUE(x.map.log_odds() == y.map.log_odds());
+    EXPECT_TRUE(x.map.DenseLogOdds() == y.map.DenseLogOdds());
   }
   // The PF did real work: a trajectory that moved, not an empty comparison.
   EXPECT_GT(a.configs[1].run.online.size(), 1000u);

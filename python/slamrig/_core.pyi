@@ -112,7 +112,7 @@ class OccupancyGrid:
     height: int
     @property
     def log_odds(self) -> npt.NDArray[np.float32]:
-        """(H, W) read-only view; take a new one after the grid grows (insert_scan)."""
+        """(H, W) read-only copy of the cells at the time of the call."""
     def probability(self) -> npt.NDArray[np.float64]: ...
     def insert_scan(self, scan: LaserScan, world_from_base: Pose2) -> int: ...
 

@@ -29,11 +29,11 @@ OccupancyGrid::OccupancyGrid(const OccupancyGridOptions& options, const Eigen::V
                              int width, int height)
     : OccupancyGrid(options) {
   SLAMRIG_CHECK(width >= 0 && height >= 0, "grid size must not be negative");
+  SLAMRIG_CHECK(static_cast<double>(width) * height < 2e9, "occupancy grid too large");
   origin_ = origin;
   width_ = width;
   height_ = height;
-  log_odds_.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0.0f);
-  last_update_.assign(log_odds_.size(), 0);
+  CoverBoundingBox();
 }
 
 CellState OccupancyGrid::State(const Eigen::Array2i& cell, double occupied_probability,
@@ -44,6 +44,39 @@ CellState OccupancyGrid::State(const Eigen::Array2i& cell, double occupied_proba
   if (p > occupied_probability) return CellState::kOccupied;
   if (p < free_probability) return CellState::kFree;
   return CellState::kUnknown;
+}
+
+void OccupancyGrid::Set(const Eigen::Array2i& cell, float value) {
+  // Setting an unwritten cell to unknown needs no tile (loading a map sets every cell).
+  if (value == 0.0f && FindTile(cell.x(), cell.y()) == nullptr) return;
+  Assign(cell.x(), cell.y(), MutableTile(cell.x(), cell.y()).log_odds[Offset(cell.x(), cell.y())],
+         value);
+}
+
+std::int32_t OccupancyGrid::AllocateTile() {
+  SLAMRIG_CHECK(tiles_.size() < static_cast<std::size_t>(INT32_MAX), "occupancy grid too large");
+  tiles_.emplace_back();
+  return static_cast<std::int32_t>(tiles_.size() - 1);
+}
+
+void OccupancyGrid::CoverBoundingBox() {
+  if (width_ <= 0 || height_ <= 0) return;
+  const Eigen::Array2i lo(shift_.x() >> kTileBits, shift_.y() >> kTileBits);
+  const Eigen::Array2i hi((width_ - 1 + shift_.x()) >> kTileBits,
+                          (height_ - 1 + shift_.y()) >> kTileBits);
+  const Eigen::Array2i size = hi - lo + 1;
+  // The grid only grows: every old tile has a place in the new table.
+  std::vector<std::int32_t> table(static_cast<std::size_t>(size.x()) * size.y(), -1);
+  for (int row = 0; row < table_size_.y(); ++row) {
+    for (int col = 0; col < table_size_.x(); ++col) {
+      const Eigen::Array2i to = table_lo_ + Eigen::Array2i(col, row) - lo;
+      table[static_cast<std::size_t>(to.y()) * size.x() + to.x()] =
+          table_[static_cast<std::size_t>(row) * table_size_.x() + col];
+    }
+  }
+  table_ = std::move(table);
+  table_lo_ = lo;
+  table_size_ = size;
 }
 
 void OccupancyGrid::EnsureContains(const Eigen::AlignedBox2d& box) {
@@ -69,23 +102,72 @@ void OccupancyGrid::EnsureContains(const Eigen::AlignedBox2d& box) {
   const int new_height = static_cast<int>(hi_cells.y() - lo_cells.y());
   SLAMRIG_CHECK(static_cast<double>(new_width) * new_height < 2e9, "occupancy grid too large");
 
-  std::vector<float> grown(static_cast<std::size_t>(new_width) * new_height, 0.0f);
-  std::vector<std::uint32_t> grown_updates(grown.size(), 0);
-  const int shift_x = static_cast<int>(-lo_cells.x());
-  const int shift_y = static_cast<int>(-lo_cells.y());
-  for (int iy = 0; iy < height_; ++iy) {
-    const std::size_t dst = static_cast<std::size_t>(iy + shift_y) * new_width + shift_x;
-    std::copy_n(log_odds_.begin() + static_cast<std::ptrdiff_t>(Index(0, iy)), width_,
-                grown.begin() + static_cast<std::ptrdiff_t>(dst));
-    std::copy_n(last_update_.begin() + static_cast<std::ptrdiff_t>(Index(0, iy)), width_,
-                grown_updates.begin() + static_cast<std::ptrdiff_t>(dst));
-  }
-  log_odds_ = std::move(grown);
-  last_update_ = std::move(grown_updates);
-  for (Eigen::Array2i& cell : flips_) cell += Eigen::Array2i(shift_x, shift_y);
+  // Old cell (ix, iy) is new cell (ix, iy) + shift; the tiles stay where they are on the lattice.
+  const Eigen::Array2i shift(static_cast<int>(-lo_cells.x()), static_cast<int>(-lo_cells.y()));
+  if (width_ > 0) shift_ -= shift;
+  for (Eigen::Array2i& cell : flips_) cell += shift;
   origin_ = new_origin;
   width_ = new_width;
   height_ = new_height;
+  CoverBoundingBox();
+}
+
+void OccupancyGrid::CopyLogOdds(const Eigen::Array2i& lo, const Eigen::Array2i& size, float* out,
+                                std::ptrdiff_t stride) const {
+  for (int row = 0; row < size.y(); ++row) {
+    float* dst = out + static_cast<std::ptrdiff_t>(row) * stride;
+    const int y = lo.y() + row;
+    if (y < 0 || y >= height_) {
+      std::fill_n(dst, size.x(), 0.0f);
+      continue;
+    }
+    int x = lo.x();
+    const int end = lo.x() + size.x();
+    while (x < end) {
+      if (x < 0 || x >= width_) {  // outside the grid, up to its edge or the window's end
+        const int stop = x < 0 ? std::min(end, 0) : end;
+        std::fill_n(dst + (x - lo.x()), stop - x, 0.0f);
+        x = stop;
+        continue;
+      }
+      // Up to the end of this tile's row, the grid or the window.
+      const int in_tile = kTileSize - ((x + shift_.x()) & (kTileSize - 1));
+      const int stop = std::min({end, width_, x + in_tile});
+      const Tile* tile = FindTile(x, y);
+      if (tile != nullptr) {
+        std::copy_n(tile->log_odds + Offset(x, y), stop - x, dst + (x - lo.x()));
+      } else {
+        std::fill_n(dst + (x - lo.x()), stop - x, 0.0f);
+      }
+      x = stop;
+    }
+  }
+}
+
+std::vector<float> OccupancyGrid::DenseLogOdds() const {
+  std::vector<float> values(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_));
+  CopyLogOdds({0, 0}, {width_, height_}, values.data(), width_);
+  return values;
+}
+
+Eigen::AlignedBox2i OccupancyGrid::ObservedCells() const {
+  Eigen::AlignedBox2i box;  // empty
+  for (int row = 0; row < table_size_.y(); ++row) {
+    for (int col = 0; col < table_size_.x(); ++col) {
+      const std::int32_t t = table_[static_cast<std::size_t>(row) * table_size_.x() + col];
+      if (t < 0) continue;
+      const Tile& tile = tiles_[static_cast<std::size_t>(t)];
+      // Grid cell of the tile's cell (0, 0).
+      const Eigen::Array2i corner = (table_lo_ + Eigen::Array2i(col, row)) * kTileSize - shift_;
+      for (int cy = 0; cy < kTileSize; ++cy) {
+        for (int cx = 0; cx < kTileSize; ++cx) {
+          if (tile.log_odds[cy * kTileSize + cx] == 0.0f) continue;
+          box.extend(Eigen::Vector2i(corner.x() + cx, corner.y() + cy));
+        }
+      }
+    }
+  }
+  return box;
 }
 
 void OccupancyGrid::RecordWallFlips(float threshold) {
@@ -93,11 +175,6 @@ void OccupancyGrid::RecordWallFlips(float threshold) {
                 "a grid records wall flips for one threshold");
   records_flips_ = true;
   wall_threshold_ = threshold;
-}
-
-void OccupancyGrid::RecordFlip(std::size_t index) {
-  flips_.push_back({static_cast<int>(index % static_cast<std::size_t>(width_)),
-                    static_cast<int>(index / static_cast<std::size_t>(width_))});
 }
 
 std::vector<Eigen::Array2i> OccupancyGrid::TakeWallFlips() {
@@ -144,32 +221,31 @@ int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_bas
     if (!hit) continue;
     const Eigen::Array2i cell = cells[j];
     ++hits;
-    std::uint32_t& stamp = last_update_[Index(cell.x(), cell.y())];
+    Tile& tile = MutableTile(cell.x(), cell.y());
+    const std::size_t offset = Offset(cell.x(), cell.y());
+    std::uint32_t& stamp = tile.stamps[offset];
     if (once && stamp == scan_count_) continue;
     stamp = scan_count_;
-    const std::size_t index = Index(cell.x(), cell.y());
-    Assign(index, std::clamp(log_odds_[index] + options_.hit_log_odds, options_.min_log_odds,
-                             options_.max_log_odds));
+    float& l = tile.log_odds[offset];
+    Assign(cell.x(), cell.y(), l,
+           std::clamp(l + options_.hit_log_odds, options_.min_log_odds, options_.max_log_odds));
   }
   for (std::size_t j = 0; j < ends.size(); ++j) {
     const bool hit = ends[j].second;
     const Eigen::Array2i cell = cells[j];
-    TraceRay(start, cell, [&](int x, int y) {
-      const std::size_t index = Index(x, y);
+    auto clear = [&](int x, int y) {
+      Tile& tile = MutableTile(x, y);
+      const std::size_t offset = Offset(x, y);
       if (once) {
-        if (last_update_[index] == scan_count_) return;
-        last_update_[index] = scan_count_;
+        if (tile.stamps[offset] == scan_count_) return;
+        tile.stamps[offset] = scan_count_;
       }
-      Assign(index, std::max(log_odds_[index] + options_.miss_log_odds, options_.min_log_odds));
-    });
+      float& l = tile.log_odds[offset];
+      Assign(x, y, l, std::max(l + options_.miss_log_odds, options_.min_log_odds));
+    };
+    TraceRay(start, cell, clear);
     // A no-return beam's last cell is free too.
-    if (!hit) {
-      const std::size_t index = Index(cell.x(), cell.y());
-      if (!once || last_update_[index] != scan_count_) {
-        last_update_[index] = scan_count_;
-        Assign(index, std::max(log_odds_[index] + options_.miss_log_odds, options_.min_log_odds));
-      }
-    }
+    if (!hit) clear(cell.x(), cell.y());
   }
   return hits;
 }

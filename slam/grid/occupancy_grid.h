@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <deque>
 #include <string>
 #include <vector>
 
@@ -68,8 +69,13 @@ enum class CellState : std::int8_t { kUnknown = -1, kFree = 0, kOccupied = 100 }
 
 /// A 2D log-odds occupancy grid (Thrun, Burgard, Fox, "Probabilistic Robotics", Table 9.1)
 /// that grows to fit the data. Cell (ix, iy) covers
-/// [origin.x + ix*res, origin.x + (ix+1)*res) x [origin.y + iy*res, ...); storage is row-major
-/// with row 0 at the lowest y. Cells outside the grid read as log-odds 0 (unknown).
+/// [origin.x + ix*res, origin.x + (ix+1)*res) x [origin.y + iy*res, ...), 0 <= ix < width(),
+/// 0 <= iy < height(); cells outside the grid read as log-odds 0 (unknown).
+/// Storage is tiles of 64 x 64 cells, allocated when a cell in them is first written: the
+/// bounding box (width() x height()) may grow to hundreds of metres while memory and the cost of
+/// growing follow the ground the scans covered (a dense array was copied whole at every growth:
+/// docs/studies/large-maps.md). Readers take cells one by one (LogOdds) or a window as a dense
+/// raster (CopyLogOdds).
 class OccupancyGrid {
  public:
   /// An empty grid; it takes its size from the first scan.
@@ -85,8 +91,19 @@ class OccupancyGrid {
   const Eigen::Vector2d& origin() const { return origin_; }
   int width() const { return width_; }
   int height() const { return height_; }
-  /// Raw log-odds, row-major, width() * height() values.
-  const std::vector<float>& log_odds() const { return log_odds_; }
+  /// Copies the log-odds of the `size.x()` x `size.y()` cells from `lo` into `out`, row-major with
+  /// rows `stride` floats apart; cells outside the grid or never written read 0. Costs the
+  /// window's area, whatever the grid's size.
+  void CopyLogOdds(const Eigen::Array2i& lo, const Eigen::Array2i& size, float* out,
+                   std::ptrdiff_t stride) const;
+  /// The whole grid's log-odds, row-major, width() * height() values (row 0 at the lowest y).
+  /// Costs the bounding box: for outputs and tests, not for per-scan work.
+  std::vector<float> DenseLogOdds() const;
+  /// The smallest box of cells whose log-odds is not 0 (empty when none): what the scans observed
+  /// of the bounding box, found tile by tile.
+  Eigen::AlignedBox2i ObservedCells() const;
+  /// Tiles allocated (written at least once); each costs kTileBytes.
+  int num_tiles() const { return static_cast<int>(tiles_.size()); }
 
   /// The cell containing world point `p` (may be outside the grid).
   Eigen::Array2i WorldToCell(const Eigen::Vector2d& p) const {
@@ -102,7 +119,9 @@ class OccupancyGrid {
   }
   /// Log-odds of `cell`, 0 outside the grid.
   float LogOdds(const Eigen::Array2i& cell) const {
-    return Contains(cell) ? log_odds_[Index(cell.x(), cell.y())] : 0.0f;
+    if (!Contains(cell)) return 0.0f;
+    const Tile* tile = FindTile(cell.x(), cell.y());
+    return tile != nullptr ? tile->log_odds[Offset(cell.x(), cell.y())] : 0.0f;
   }
   /// Occupancy probability of `cell`, 0.5 outside the grid.
   double Probability(const Eigen::Array2i& cell) const {
@@ -123,12 +142,12 @@ class OccupancyGrid {
 
   /// Adds `delta` to `cell` with clamping; the grid must contain the cell.
   void Update(const Eigen::Array2i& cell, float delta) {
-    const std::size_t index = Index(cell.x(), cell.y());
-    Assign(index,
-           std::clamp(log_odds_[index] + delta, options_.min_log_odds, options_.max_log_odds));
+    float& l = MutableTile(cell.x(), cell.y()).log_odds[Offset(cell.x(), cell.y())];
+    Assign(cell.x(), cell.y(), l,
+           std::clamp(l + delta, options_.min_log_odds, options_.max_log_odds));
   }
   /// Sets `cell` to `value` unclamped (map loading); the grid must contain the cell.
-  void Set(const Eigen::Array2i& cell, float value) { Assign(Index(cell.x(), cell.y()), value); }
+  void Set(const Eigen::Array2i& cell, float value);
 
   /// From now on, records every cell whose wall state (log-odds > `threshold`) flips, so that a
   /// raster derived from the walls (LikelihoodField::Follow) can be redone only where they
@@ -141,29 +160,63 @@ class OccupancyGrid {
   std::vector<Eigen::Array2i> TakeWallFlips();
 
  private:
-  // Stores `value` into cell `index`, recording a wall flip.
-  void Assign(std::size_t index, float value) {
-    float& l = log_odds_[index];
+  static constexpr int kTileBits = 6;
+  static constexpr int kTileSize = 1 << kTileBits;
+  // A tile's cells, row-major, and the scan number that last touched each (update_once_per_scan).
+  struct Tile {
+    float log_odds[kTileSize * kTileSize] = {};
+    std::uint32_t stamps[kTileSize * kTileSize] = {};
+  };
+
+ public:
+  static constexpr std::size_t kTileBytes = sizeof(Tile);
+
+ private:
+  // Tiles sit on a lattice fixed at the first origin: grid cell (ix, iy) is lattice cell
+  // (ix, iy) + shift_, so growing the grid down or left re-indexes the table, never the tiles.
+  int TableIndex(int ix, int iy) const {
+    const int tx = ((ix + shift_.x()) >> kTileBits) - table_lo_.x();
+    const int ty = ((iy + shift_.y()) >> kTileBits) - table_lo_.y();
+    return ty * table_size_.x() + tx;
+  }
+  std::size_t Offset(int ix, int iy) const {
+    return static_cast<std::size_t>((iy + shift_.y()) & (kTileSize - 1)) * kTileSize +
+           static_cast<std::size_t>((ix + shift_.x()) & (kTileSize - 1));
+  }
+  // The tile of grid cell (ix, iy), which the grid contains; null if never written.
+  const Tile* FindTile(int ix, int iy) const {
+    const std::int32_t t = table_[static_cast<std::size_t>(TableIndex(ix, iy))];
+    return t >= 0 ? &tiles_[static_cast<std::size_t>(t)] : nullptr;
+  }
+  // The tile of grid cell (ix, iy), which the grid contains, allocated if need be.
+  Tile& MutableTile(int ix, int iy) {
+    std::int32_t& t = table_[static_cast<std::size_t>(TableIndex(ix, iy))];
+    if (t < 0) [[unlikely]]
+      t = AllocateTile();
+    return tiles_[static_cast<std::size_t>(t)];
+  }
+  std::int32_t AllocateTile();
+  // Resizes the table to cover the grid's bounding box.
+  void CoverBoundingBox();
+
+  // Stores `value` into `l`, the log-odds of cell (ix, iy), recording a wall flip.
+  void Assign(int ix, int iy, float& l, float value) {
     if (records_flips_ && (l > wall_threshold_) != (value > wall_threshold_)) [[unlikely]] {
-      RecordFlip(index);
+      flips_.push_back({ix, iy});
     }
     l = value;
-  }
-  // Out of line: flips are rare, the update loops stay small.
-  void RecordFlip(std::size_t index);
-
-  std::size_t Index(int ix, int iy) const {
-    return static_cast<std::size_t>(iy) * static_cast<std::size_t>(width_) +
-           static_cast<std::size_t>(ix);
   }
 
   OccupancyGridOptions options_;
   Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
   int width_ = 0;
   int height_ = 0;
-  std::vector<float> log_odds_;
-  // Scan number that last touched each cell, for update_once_per_scan.
-  std::vector<std::uint32_t> last_update_;
+  Eigen::Array2i shift_ = Eigen::Array2i::Zero();
+  // The table: one entry per tile of the bounding box, the tile's index in tiles_ or -1.
+  Eigen::Array2i table_lo_ = Eigen::Array2i::Zero();
+  Eigen::Array2i table_size_ = Eigen::Array2i::Zero();
+  std::vector<std::int32_t> table_;
+  std::deque<Tile> tiles_;  // a deque: growing never moves a tile
   std::uint32_t scan_count_ = 0;
   // Wall flips since the last TakeWallFlips, when recording.
   bool records_flips_ = false;

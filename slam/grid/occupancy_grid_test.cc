@@ -52,7 +52,7 @@ TEST(OccupancyGridTest, NoReturnBeamsClearWithoutHit) {
   EXPECT_EQ(grid.InsertScan(scan, Pose2(0.05, 0.05, 0.0)), 0);
   EXPECT_LT(grid.LogOdds(grid.WorldToCell({2.95, 0.05})), 0.0f);
   EXPECT_EQ(grid.LogOdds(grid.WorldToCell({3.25, 0.05})), 0.0f);
-  for (const float l : grid.log_odds()) EXPECT_LE(l, 0.0f);
+  for (const float l : grid.DenseLogOdds()) EXPECT_LE(l, 0.0f);
 }
 
 TEST(OccupancyGridTest, RespectsPoseAndLaserMount) {
@@ -114,7 +114,7 @@ TEST(OccupancyGridTest, OncePerScanKeepsGrazedWallCells) {
   const LaserScan scan = FanScan(200, 3.0f);
   once.InsertScan(scan, Pose2());
   every.InsertScan(scan, Pose2());
-  for (const float l : once.log_odds()) {
+  for (const float l : once.DenseLogOdds()) {
     EXPECT_TRUE(l == 0.0f || l == options.hit_log_odds || l == options.miss_log_odds) << l;
   }
   EXPECT_FLOAT_EQ(every.LogOdds(every.WorldToCell({1.0, 0.0})), options.min_log_odds);
@@ -141,6 +141,90 @@ TEST(OccupancyGridTest, GrowingKeepsContentsAligned) {
   }
   EXPECT_TRUE(grid.Contains(grid.WorldToCell({-40, -30})));
   EXPECT_TRUE(grid.Contains(grid.WorldToCell({25, 50})));
+}
+
+// A robot driving from the centre out along a diagonal one way, then the other way along a
+// parallel line, a scan every metre: the grid grows right, down, left and up many times. Cell sizes
+// and margins are powers of two, so every lattice origin is exact and a grid sized up front sees
+// the same cells.
+std::vector<std::pair<LaserScan, Pose2>> DiagonalRoute() {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<std::pair<LaserScan, Pose2>> scans;
+  for (int k = 0; k < 160; ++k) {
+    const double s = k < 80 ? k : 80 - k;  // out one way, then the other
+    const double offset = k < 80 ? 0.0 : 6.0;
+    const double heading = 2.0 * std::numbers::pi * u(rng);
+    const Pose2 pose(0.5 * s, -0.4 * s + offset, heading);
+    LaserScan scan = FanScan(90, 0.0f, 12.0);
+    scan.angle_min_rad = -1.5;
+    scan.angle_increment_rad = 3.0 / 89.0;
+    for (float& r : scan.ranges_m) {
+      const double kind = u(rng);
+      r = kind < 0.1 ? 12.0f : static_cast<float>(0.3 + 9.0 * u(rng));
+    }
+    scans.emplace_back(std::move(scan), pose);
+  }
+  return scans;
+}
+
+TEST(OccupancyGridTest, GrownGridHoldsTheCellsOfAGridSizedUpFrontInTilesItWrote) {
+  OccupancyGridOptions options;
+  options.resolution_m = 0.0625;
+  options.grow_margin_m = 2.0;
+  const std::vector<std::pair<LaserScan, Pose2>> route = DiagonalRoute();
+  OccupancyGrid grown(options);
+  int growths = 0;
+  for (const auto& [scan, pose] : route) {
+    const int width = grown.width(), height = grown.height();
+    grown.InsertScan(scan, pose);
+    growths += grown.width() != width || grown.height() != height;
+  }
+  ASSERT_GE(growths, 16);
+  OccupancyGrid sized(options, grown.origin(), grown.width(), grown.height());
+  for (const auto& [scan, pose] : route) sized.InsertScan(scan, pose);
+  ASSERT_EQ(sized.width(), grown.width());  // it never grew
+
+  const std::vector<float> dense = grown.DenseLogOdds();
+  ASSERT_EQ(dense, sized.DenseLogOdds());
+  // The dense copy against cell-by-cell reads, and the observed box against a brute-force one.
+  Eigen::AlignedBox2i observed;
+  int nonzero = 0;
+  for (int y = 0; y < grown.height(); ++y) {
+    for (int x = 0; x < grown.width(); ++x) {
+      const float l = grown.LogOdds({x, y});
+      ASSERT_EQ(dense[static_cast<std::size_t>(y) * grown.width() + x], l);
+      if (l != 0.0f) {
+        observed.extend(Eigen::Vector2i(x, y));
+        ++nonzero;
+      }
+    }
+  }
+  ASSERT_GT(nonzero, 50000);
+  EXPECT_EQ(grown.ObservedCells().min(), observed.min());
+  EXPECT_EQ(grown.ObservedCells().max(), observed.max());
+  // Windows anywhere, partly or wholly outside the grid, with a wider stride.
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> corner(-300, grown.width() + 100);
+  std::uniform_int_distribution<int> side(1, 250);
+  for (int trial = 0; trial < 100; ++trial) {
+    const Eigen::Array2i lo(corner(rng), corner(rng) * grown.height() / grown.width());
+    const Eigen::Array2i size(side(rng), side(rng));
+    const int stride = size.x() + 3;
+    std::vector<float> window(static_cast<std::size_t>(stride) * size.y(), -7.0f);
+    grown.CopyLogOdds(lo, size, window.data(), stride);
+    for (int y = 0; y < size.y(); ++y) {
+      for (int x = 0; x < size.x(); ++x) {
+        ASSERT_EQ(window[static_cast<std::size_t>(y) * stride + x],
+                  grown.LogOdds(lo + Eigen::Array2i(x, y)))
+            << trial;
+      }
+      ASSERT_EQ(window[static_cast<std::size_t>(y) * stride + size.x()], -7.0f);  // padding kept
+    }
+  }
+  // Memory follows the ground covered, not the bounding box: the route's band of the box.
+  const double box_tiles = static_cast<double>(grown.width()) * grown.height() / (64.0 * 64.0);
+  EXPECT_LT(grown.num_tiles(), 0.5 * box_tiles);
 }
 
 TEST(OccupancyGridTest, WorldCellRoundTripWithinHalfCell) {

@@ -64,9 +64,11 @@ CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
   const int d = decimation;
   const int width = (grid.width() + d - 1) / d, height = (grid.height() + d - 1) / d;
   std::vector<float> values(static_cast<std::size_t>(width) * height, 0.0f);
+  std::vector<float> row(static_cast<std::size_t>(grid.width()));
   for (int y = 0; y < grid.height(); ++y) {
+    grid.CopyLogOdds({0, y}, {grid.width(), 1}, row.data(), 0);
     for (int x = 0; x < grid.width(); ++x) {
-      const double l = grid.log_odds()[static_cast<std::size_t>(y) * grid.width() + x];
+      const double l = row[static_cast<std::size_t>(x)];
       if (!(l > 0.0)) continue;
       float& coarse = values[static_cast<std::size_t>(y / d) * width + x / d];
       coarse = std::max(coarse, static_cast<float>(1.0 - 1.0 / (1.0 + std::exp(l))));

@@ -236,6 +236,7 @@ TEST(CorrelativeMatcherTest, ADecimatedGridIsSearchedAsItsMaxPooledRaster) {
   const OccupancyGrid grid = MapFromScans(world, OfficeLoopPoses(), rng);
   ScanPointsOptions points;
   points.voxel_size_m = 0.15;
+  const std::vector<float> dense = grid.DenseLogOdds();
   for (const int d : {2, 3, 4}) {
     const int width = (grid.width() + d - 1) / d, height = (grid.height() + d - 1) / d;
     std::vector<float> pooled(static_cast<std::size_t>(width) * height, 0.0f);
@@ -244,7 +245,7 @@ TEST(CorrelativeMatcherTest, ADecimatedGridIsSearchedAsItsMaxPooledRaster) {
         float& v = pooled[static_cast<std::size_t>(cy) * width + cx];
         for (int y = cy * d; y < std::min((cy + 1) * d, grid.height()); ++y) {
           for (int x = cx * d; x < std::min((cx + 1) * d, grid.width()); ++x) {
-            const float l = grid.log_odds()[static_cast<std::size_t>(y) * grid.width() + x];
+            const float l = dense[static_cast<std::size_t>(y) * grid.width() + x];
             if (l > 0.0f) v = std::max(v, static_cast<float>(1.0 - 1.0 / (1.0 + std::exp(l))));
           }
         }

@@ -22,10 +22,11 @@ struct GridView {
 
   /// Floats from one row to the next.
   int row_stride() const { return stride > 0 ? stride : width; }
-  /// The log-odds raster of `grid`.
-  static GridView Of(const OccupancyGrid& grid) {
-    return GridView{grid.log_odds().data(), grid.width(), grid.height(), grid.origin(),
-                    grid.resolution()};
+  /// The lattice of `grid` without its values (`values` null): for readers that take the values
+  /// elsewhere (MapCorrelator with an OccupiedMask). A grid's log-odds are tiles, not one raster:
+  /// a window of them is OccupancyGrid::CopyLogOdds.
+  static GridView LatticeOf(const OccupancyGrid& grid) {
+    return GridView{nullptr, grid.width(), grid.height(), grid.origin(), grid.resolution()};
   }
   /// Value of cell (ix, iy), 0 outside.
   float At(int ix, int iy) const {

@@ -74,13 +74,15 @@ void LikelihoodField::Fill(const OccupancyGrid& grid, const Eigen::Array2i& lo,
   // order-free, so any box gives its cells the values of a whole-grid pass.
   const int r = radius_cells_;
   const int side = 2 * r + 1;
-  const std::vector<float>& log_odds = grid.log_odds();
   const int y_begin = std::max(0, lo.y() - r), y_end = std::min(grid.height(), hi.y() + r + 1);
   const int x_begin = std::max(0, lo.x() - r), x_end = std::min(grid.width(), hi.x() + r + 1);
+  if (x_end <= x_begin) return;
+  thread_local std::vector<float> row;
+  row.resize(static_cast<std::size_t>(x_end - x_begin));
   for (int gy = y_begin; gy < y_end; ++gy) {
-    const float* row = log_odds.data() + static_cast<std::ptrdiff_t>(gy) * grid.width();
+    grid.CopyLogOdds({x_begin, gy}, {x_end - x_begin, 1}, row.data(), 0);
     for (int gx = x_begin; gx < x_end; ++gx) {
-      if (!(row[gx] > options_.occupied_threshold)) continue;
+      if (!(row[static_cast<std::size_t>(gx - x_begin)] > options_.occupied_threshold)) continue;
       const int wx = gx - lo.x(), wy = gy - lo.y();
       const int dy0 = std::max(-r, -wy), dy1 = std::min(r, height - 1 - wy);
       const int dx0 = std::max(-r, -wx), dx1 = std::min(r, width - 1 - wx);
@@ -168,9 +170,8 @@ void LikelihoodField::Follow(OccupancyGrid& grid) {
   // recomputed from the walls now in reach.
   const int r = radius_cells_;
   const int side = 2 * r + 1;
-  const std::vector<float>& log_odds = grid.log_odds();
   for (const Eigen::Array2i& cell : grid.TakeWallFlips()) {
-    const float l = log_odds[static_cast<std::size_t>(cell.y()) * width_ + cell.x()];
+    const float l = grid.LogOdds(cell);
     if (!(l > options_.occupied_threshold)) {
       Refill(grid, cell - r, cell + r);
       continue;

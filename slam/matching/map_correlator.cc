@@ -257,13 +257,22 @@ CorrelationResult MapCorrelator::CorrelateImpl(const GridView& grid, const Occup
                            scratch.sums.data());
       }
     }
-    // Points near the edge: cell by cell, outside reads as 0.
+    // Points near the edge: cell by cell, outside reads as 0 (with a mask, the grid's values
+    // may be absent: the mask holds their indicator).
     for (const Eigen::Array2i& corner : scratch.border) {
       for (int r = 0; r < side; ++r) {
         for (int col = 0; col < side; ++col) {
-          const float v = grid.At(corner.x() + col, corner.y() + r);
-          scratch.sums[static_cast<std::size_t>(r * padded + col)] +=
-              options_.value == CorrelationValue::kOccupiedIndicator ? indicator(v) : v;
+          const int x = corner.x() + col, y = corner.y() + r;
+          float contribution = 0.0f;
+          if (mask != nullptr) {
+            const bool inside = x >= 0 && y >= 0 && x < mask->width() && y < mask->height();
+            contribution = inside && mask->Get(x, y) ? 1.0f : 0.0f;
+          } else {
+            const float v = grid.At(x, y);
+            contribution =
+                options_.value == CorrelationValue::kOccupiedIndicator ? indicator(v) : v;
+          }
+          scratch.sums[static_cast<std::size_t>(r * padded + col)] += contribution;
         }
       }
     }

@@ -6,9 +6,9 @@ void OccupiedMask::Reread(const OccupancyGrid& grid) {
   width_ = grid.width();
   height_ = grid.height();
   bytes_.assign(static_cast<std::size_t>(stride()) * height_, 0);
-  const std::vector<float>& log_odds = grid.log_odds();
+  std::vector<float> cells(static_cast<std::size_t>(width_));
   for (int y = 0; y < height_; ++y) {
-    const float* cells = log_odds.data() + static_cast<std::ptrdiff_t>(y) * width_;
+    grid.CopyLogOdds({0, y}, {width_, 1}, cells.data(), 0);
     std::uint8_t* out = bytes_.data() + static_cast<std::ptrdiff_t>(y) * stride();
     for (int x = 0; x < width_; ++x) out[x] = cells[x] > threshold_ ? 1 : 0;
   }

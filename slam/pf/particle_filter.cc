@@ -80,35 +80,52 @@ void ParticleFilter::Predict(const Pose2& odometry_increment) {
   }
 }
 
+GridView ParticleFilter::MapWindow(const Eigen::AlignedBox2d& region) {
+  const Eigen::Array2i lo = map_.WorldToCell(region.min()).max(Eigen::Array2i(0, 0));
+  const Eigen::Array2i hi =
+      map_.WorldToCell(region.max()).min(Eigen::Array2i(map_.width() - 1, map_.height() - 1));
+  const Eigen::Array2i size = (hi - lo + 1).max(Eigen::Array2i(0, 0));
+  map_window_.resize(static_cast<std::size_t>(size.x()) * static_cast<std::size_t>(size.y()));
+  map_.CopyLogOdds(lo, size, map_window_.data(), size.x());
+  return GridView{map_window_.data(), size.x(), size.y(),
+                  map_.origin() + lo.cast<double>().matrix() * map_.resolution(),
+                  map_.resolution()};
+}
+
 std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& points,
                                           const MatchConstraints& constraints,
                                           const Pose2& predicted_mean, float* best_score) {
   const int n = options_.num_particles;
   const bool use_field = options_.observation == ObservationModel::kLikelihoodField;
+  // The field (or the map's window) only needs to cover where this scan can land for some
+  // particle and shift.
+  Eigen::AlignedBox2d particles_box;
+  for (const Particle& p : particles_) particles_box.extend(p.pose.translation());
+  double reach = 0.0;
+  for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
+  const double margin = reach + (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
+                        options_.likelihood_field.cutoff_sigmas * likelihood_field_.sigma_m();
+  const Eigen::Vector2d m = Eigen::Vector2d::Constant(margin);
+  const Eigen::AlignedBox2d region(particles_box.min() - m, particles_box.max() + m);
   GridView field_view;
   if (use_field || options_.refine) {
-    // The field only needs to cover where this scan can land for some particle and shift.
-    Eigen::AlignedBox2d particles_box;
-    for (const Particle& p : particles_) particles_box.extend(p.pose.translation());
-    double reach = 0.0;
-    for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
-    const double margin = reach +
-                          (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
-                          options_.likelihood_field.cutoff_sigmas * likelihood_field_.sigma_m();
-    const Eigen::Vector2d m = Eigen::Vector2d::Constant(margin);
     // Kept up to date where the map changed; the window keeps reads outside it at 0.
     likelihood_field_.Follow(map_);
-    field_view = likelihood_field_.view(
-        Eigen::AlignedBox2d(particles_box.min() - m, particles_box.max() + m));
+    field_view = likelihood_field_.view(region);
   }
-  const GridView view = use_field ? field_view : GridView::Of(map_);
   // The occupied indicator on the map itself reads a bit raster kept up to date where the map
-  // changed (only when the field does not follow the map: one follower per grid).
+  // changed (only when the field does not follow the map: one follower per grid); other values
+  // on the map read a copy of its window.
   const OccupiedMask* walls = nullptr;
-  if (!use_field && !options_.refine &&
-      options_.correlation.value == CorrelationValue::kOccupiedIndicator) {
-    occupied_mask_.Follow(map_);
-    walls = &occupied_mask_;
+  GridView view = field_view;
+  if (!use_field) {
+    if (!options_.refine && options_.correlation.value == CorrelationValue::kOccupiedIndicator) {
+      occupied_mask_.Follow(map_);
+      walls = &occupied_mask_;
+      view = GridView::LatticeOf(map_);
+    } else {
+      view = MapWindow(region);
+    }
   }
   const float field_max = static_cast<float>(likelihood_field_.Score(0.0));
   std::vector<CorrelationResult> results(static_cast<std::size_t>(n));

@@ -174,13 +174,17 @@ class ParticleFilter {
   std::vector<double> Score(const std::vector<Eigen::Vector2d>& points,
                             const MatchConstraints& constraints, const Pose2& predicted_mean,
                             float* best_score);
+  // The map's log-odds over `region` (clipped to the map) as a raster of its own, valid until the
+  // next call: the map is tiles, the correlator reads rasters.
+  GridView MapWindow(const Eigen::AlignedBox2d& region);
 
   ParticleFilterOptions options_;
   OccupancyGrid map_;
   MapCorrelator correlator_;
   LikelihoodField likelihood_field_;
   AdaptiveFieldSigma field_sigma_;
-  OccupiedMask occupied_mask_;  // the map's walls for the occupied-indicator correlation
+  OccupiedMask occupied_mask_;     // the map's walls for the occupied-indicator correlation
+  std::vector<float> map_window_;  // MapWindow's raster
   ScanRefiner refiner_;
   RandomEngine rng_;
   std::unique_ptr<ThreadPool> pool_;

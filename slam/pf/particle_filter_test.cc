@@ -106,7 +106,7 @@ TEST(ParticleFilterTest, SameSeedSameTrajectoryWhateverTheThreadCount) {
     ASSERT_EQ(a.trajectory[i].pose, c.trajectory[i].pose) << i;
     ASSERT_EQ(a.mean_trajectory[i].pose, c.mean_trajectory[i].pose) << i;
   }
-  EXPECT_EQ(a.map.log_odds(), c.map.log_odds());
+  EXPECT_EQ(a.map.DenseLogOdds(), c.map.DenseLogOdds());
   ASSERT_EQ(a.clouds.size(), 2u);
   EXPECT_EQ(a.clouds[1].size(), 30u);
   options.seed = 18;
@@ -167,10 +167,10 @@ TEST(ParticleFilterTest, FindsItselfLostAfterAKidnappingAndRelocalises) {
     step = filter.AddScan(run.scans[i].scan, i == back_to ? Pose2() : run.scans[i].increment);
     const int k = static_cast<int>(i - back_to);
     if (step.lost && lost_at < 0) lost_at = k;
-    if (step.lost && !was_lost) map_while_lost = filter.map().log_odds();
+    if (step.lost && !was_lost) map_while_lost = filter.map().DenseLogOdds();
     was_lost = step.lost;
     if (step.lost) {
-      EXPECT_EQ(filter.map().log_odds(), map_while_lost) << k;
+      EXPECT_EQ(filter.map().DenseLogOdds(), map_while_lost) << k;
     }
     if (step.relocalised && relocalised_at < 0) relocalised_at = k;
   }

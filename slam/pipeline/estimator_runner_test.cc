@@ -32,7 +32,7 @@ TEST(EstimatorRunnerTest, StreamingEqualsTheWholeLogByHand) {
     ASSERT_EQ(streamed.online[i].pose, e.pose) << i;
     ASSERT_EQ(streamed.online[i].time, synced.scans[i].scan.time) << i;
   }
-  EXPECT_EQ(streamed.map.log_odds(), estimator->map().log_odds());
+  EXPECT_EQ(streamed.map.DenseLogOdds(), estimator->map().DenseLogOdds());
   EXPECT_EQ(streamed.traces.at("neff").size(), synced.scans.size());
   EXPECT_EQ(streamed.statistics.count("mean_neff"), 1u);
 }

@@ -24,7 +24,7 @@ TEST(RbpfEstimatorTest, RevisesOnePosePerScanEndingAtTheOnlinePose) {
   EXPECT_GT(run.statistics.at("map_tiles"), 0.0);
   // The map is the best particle's, converted: walls were seen.
   int occupied = 0;
-  for (const float l : run.map.log_odds()) occupied += l > 0.0f;
+  for (const float l : run.map.DenseLogOdds()) occupied += l > 0.0f;
   EXPECT_GT(occupied, 100);
 }
 
