@@ -5,7 +5,8 @@
 //  - BM_FieldUpdate/AREA/MODE: one map update (insert the scan at its true pose) plus bringing
 //    the likelihood field up to date over the scan's reach, on a map loaded at AREA m^2 around
 //    the office. MODE 0 recomputes the window (LikelihoodField::Update, the filter's method before
-//    Follow), MODE 1 follows the map's changes (LikelihoodField::Follow + view(window)).
+//    Follow), MODE 1 follows the map's changes over a window that slides with the robot
+//    (LikelihoodField::Follow(grid, window) + view(window)).
 //  - BM_PfUpdate/AREA: the default particle filter (100 particles, one thread) through the
 //    Estimator interface, its map given room (map.grow_margin_m) to reach about AREA m^2; time per
 //    filter update (the scans it scored), map area reached as a counter.
@@ -76,7 +77,7 @@ void BM_FieldUpdate(benchmark::State& state) {
       const Eigen::AlignedBox2d window(run.truth[i].translation() - m,
                                        run.truth[i].translation() + m);
       if (follow) {
-        field.Follow(grid);
+        field.Follow(grid, window);
         benchmark::DoNotOptimize(field.view(window).values);
       } else {
         field.Update(grid, window);

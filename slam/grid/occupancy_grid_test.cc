@@ -208,8 +208,10 @@ TEST(OccupancyGridTest, GrownGridHoldsTheCellsOfAGridSizedUpFrontInTilesItWrote)
   std::uniform_int_distribution<int> corner(-300, grown.width() + 100);
   std::uniform_int_distribution<int> side(1, 250);
   for (int trial = 0; trial < 100; ++trial) {
-    const Eigen::Array2i lo(corner(rng), corner(rng) * grown.height() / grown.width());
-    const Eigen::Array2i size(side(rng), side(rng));
+    const int lo_x = corner(rng);
+    const Eigen::Array2i lo(lo_x, corner(rng) * grown.height() / grown.width());
+    const int size_x = side(rng);
+    const Eigen::Array2i size(size_x, side(rng));
     const int stride = size.x() + 3;
     std::vector<float> window(static_cast<std::size_t>(stride) * size.y(), -7.0f);
     grown.CopyLogOdds(lo, size, window.data(), stride);

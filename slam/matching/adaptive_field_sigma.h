@@ -69,7 +69,7 @@ class AdaptiveFieldSigma {
   explicit AdaptiveFieldSigma(const AdaptiveSigmaOptions& options);
 
   /// The median distance to the nearest wall of `points_base` seen from `pose`, read off
-  /// `field` (its whole raster, view()) as the scan refiner samples it, over the points within
+  /// `field` (its followed window, view()) as the scan refiner samples it, over the points within
   /// window_m of a wall; nullopt when fewer than min_points are.
   std::optional<double> MedianWallDistance(const LikelihoodField& field,
                                            std::span<const Eigen::Vector2d> points_base,

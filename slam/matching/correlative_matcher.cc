@@ -57,17 +57,26 @@ CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
 }
 
 CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
-                                       const OccupancyGrid& grid, int decimation)
-    : options_(options), origin_(grid.origin()), resolution_(grid.resolution() * decimation) {
+                                       const OccupancyGrid& grid, int decimation,
+                                       const std::optional<Eigen::AlignedBox2d>& region)
+    : options_(options), resolution_(grid.resolution() * decimation) {
   SLAMRIG_CHECK_VALID(options_, "CorrelativeMatcherOptions");
   SLAMRIG_CHECK(decimation >= 1, "CorrelativeMatcher: decimation must be >= 1");
+  // The grid cells searched: all, or those of the region.
+  Eigen::Array2i lo(0, 0), hi(grid.width() - 1, grid.height() - 1);
+  if (region) {
+    lo = grid.WorldToCell(region->min()).max(lo);
+    hi = grid.WorldToCell(region->max()).min(hi);
+  }
+  const Eigen::Array2i cells = (hi - lo + 1).max(Eigen::Array2i(0, 0));
+  origin_ = grid.origin() + lo.cast<double>().matrix() * grid.resolution();
   const int d = decimation;
-  const int width = (grid.width() + d - 1) / d, height = (grid.height() + d - 1) / d;
+  const int width = (cells.x() + d - 1) / d, height = (cells.y() + d - 1) / d;
   std::vector<float> values(static_cast<std::size_t>(width) * height, 0.0f);
-  std::vector<float> row(static_cast<std::size_t>(grid.width()));
-  for (int y = 0; y < grid.height(); ++y) {
-    grid.CopyLogOdds({0, y}, {grid.width(), 1}, row.data(), 0);
-    for (int x = 0; x < grid.width(); ++x) {
+  std::vector<float> row(static_cast<std::size_t>(cells.x()));
+  for (int y = 0; y < cells.y(); ++y) {
+    grid.CopyLogOdds({lo.x(), lo.y() + y}, {cells.x(), 1}, row.data(), 0);
+    for (int x = 0; x < cells.x(); ++x) {
       const double l = row[static_cast<std::size_t>(x)];
       if (!(l > 0.0)) continue;
       float& coarse = values[static_cast<std::size_t>(y / d) * width + x / d];

@@ -70,8 +70,11 @@ class CorrelativeMatcher {
   /// largest value of its block, so no wall is lost): d^2 fewer translations and, with the yaw
   /// step derived from the resolution, d times fewer headings; for a global search whose poses
   /// are refined at the grid's resolution afterwards.
+  /// With `region` (world coordinates), only the grid's cells in it count (the rest read 0): the
+  /// precomputation then costs the region's area, not the map's.
   CorrelativeMatcher(const CorrelativeMatcherOptions& options, const OccupancyGrid& grid,
-                     int decimation = 1);
+                     int decimation = 1,
+                     const std::optional<Eigen::AlignedBox2d>& region = std::nullopt);
 
   const CorrelativeMatcherOptions& options() const { return options_; }
 

@@ -95,11 +95,6 @@ void LikelihoodField::Fill(const OccupancyGrid& grid, const Eigen::Array2i& lo,
   }
 }
 
-Eigen::Array2i LikelihoodField::WorldToCell(const Eigen::Vector2d& p) const {
-  return {static_cast<int>(std::floor((p.x() - origin_.x()) / resolution_)),
-          static_cast<int>(std::floor((p.y() - origin_.y()) / resolution_))};
-}
-
 void LikelihoodField::Update(const OccupancyGrid& grid, const Eigen::AlignedBox2d& region) {
   followed_ = nullptr;
   EnsureKernel(grid.resolution());
@@ -118,37 +113,64 @@ void LikelihoodField::Refill(const OccupancyGrid& grid, Eigen::Array2i lo, Eigen
   lo = lo.max(Eigen::Array2i(0, 0));
   hi = hi.min(Eigen::Array2i(width_ - 1, height_ - 1));
   if ((lo > hi).any()) return;
-  Fill(grid, lo, hi, values_.data() + static_cast<std::ptrdiff_t>(lo.y()) * width_ + lo.x(),
-       width_);
+  Fill(grid, lo + window_lo_, hi + window_lo_,
+       values_.data() + static_cast<std::ptrdiff_t>(lo.y()) * width_ + lo.x(), width_);
 }
 
-void LikelihoodField::Regrow(const OccupancyGrid& grid) {
-  // The grid grows on its own lattice: the old cell (0, 0) is now cell `shift`.
-  const Eigen::Vector2d shift_cells = (origin_ - grid.origin()) / resolution_;
-  const Eigen::Array2i shift(static_cast<int>(std::lround(shift_cells.x())),
-                             static_cast<int>(std::lround(shift_cells.y())));
-  const int old_width = width_, old_height = height_;
-  std::vector<float> grown(static_cast<std::size_t>(grid.width()) * grid.height(), 0.0f);
-  for (int y = 0; y < old_height; ++y) {
-    std::copy_n(
-        values_.begin() + static_cast<std::ptrdiff_t>(y) * old_width, old_width,
-        grown.begin() + static_cast<std::ptrdiff_t>(y + shift.y()) * grid.width() + shift.x());
-  }
-  values_ = std::move(grown);
-  width_ = grid.width();
-  height_ = grid.height();
-  origin_ = grid.origin();
-  // The new cells, and the old ones within reach of them (unknown cells are walls when the
-  // threshold is below 0): four strips around the old area.
+std::pair<Eigen::Array2i, Eigen::Array2i> LikelihoodField::GridCells(
+    const Eigen::AlignedBox2d& region) const {
+  // OccupancyGrid::WorldToCell on the followed grid's lattice.
+  const auto cell = [&](const Eigen::Vector2d& p) {
+    return Eigen::Array2i(static_cast<int>(std::floor((p.x() - grid_origin_.x()) / resolution_)),
+                          static_cast<int>(std::floor((p.y() - grid_origin_.y()) / resolution_)));
+  };
+  return {cell(region.min()).max(Eigen::Array2i(0, 0)),
+          cell(region.max()).min(grid_size_ - Eigen::Array2i(1, 1))};
+}
+
+void LikelihoodField::Recompute(const OccupancyGrid& grid, const Eigen::AlignedBox2d& region) {
+  grid_origin_ = grid.origin();
+  grid_size_ = {grid.width(), grid.height()};
+  auto [lo, hi] = GridCells(region);
+  // Slack: a quarter of the region's side (at least 64 cells) on every side, so that a robot
+  // moving on redoes the window every few metres, not every scan.
+  const int slack = std::max(64, ((hi - lo).maxCoeff() + 1) / 4);
+  lo = (lo - slack).max(Eigen::Array2i(0, 0));
+  hi = (hi + slack).min(grid_size_ - Eigen::Array2i(1, 1));
+  window_lo_ = lo;
+  width_ = std::max(0, hi.x() - lo.x() + 1);
+  height_ = std::max(0, hi.y() - lo.y() + 1);
+  origin_ = grid_origin_ + window_lo_.cast<double>().matrix() * resolution_;
+  values_.assign(static_cast<std::size_t>(width_) * height_, 0.0f);
+  Refill(grid, {0, 0}, {width_ - 1, height_ - 1});
+}
+
+void LikelihoodField::ApplyFlip(const OccupancyGrid& grid, const Eigen::Array2i& cell) {
   const int r = radius_cells_;
-  const Eigen::Array2i old_lo = shift, old_hi = shift + Eigen::Array2i(old_width, old_height) - 1;
-  Refill(grid, {0, 0}, {width_ - 1, old_lo.y() + r - 1});
-  Refill(grid, {0, old_hi.y() - r + 1}, {width_ - 1, height_ - 1});
-  Refill(grid, {0, old_lo.y()}, {old_lo.x() + r - 1, old_hi.y()});
-  Refill(grid, {old_hi.x() - r + 1, old_lo.y()}, {width_ - 1, old_hi.y()});
+  const Eigen::Array2i w = cell - window_lo_;  // in window cells; may lie outside, within reach
+  if (!(grid.LogOdds(cell) > options_.occupied_threshold)) {
+    // A wall that went can lower the cells around it: recomputed from the walls now in reach.
+    Refill(grid, w - r, w + r);
+    return;
+  }
+  // A new wall only raises the cells around it.
+  const int side = 2 * r + 1;
+  const int dy0 = std::max(-r, -w.y()), dy1 = std::min(r, height_ - 1 - w.y());
+  const int dx0 = std::max(-r, -w.x()), dx1 = std::min(r, width_ - 1 - w.x());
+  if (dy0 > dy1 || dx0 > dx1) return;  // out of the window's reach
+  for (int dy = dy0; dy <= dy1; ++dy) {
+    float* o = values_.data() + static_cast<std::ptrdiff_t>(w.y() + dy) * width_ + w.x();
+    const float* k = kernel_.data() + static_cast<std::ptrdiff_t>(dy + r) * side + r;
+    for (int dx = dx0; dx <= dx1; ++dx) o[dx] = std::max(o[dx], k[dx]);
+  }
 }
 
 void LikelihoodField::Follow(OccupancyGrid& grid) {
+  const Eigen::Vector2d extent = Eigen::Vector2d(grid.width(), grid.height()) * grid.resolution();
+  Follow(grid, Eigen::AlignedBox2d(grid.origin(), grid.origin() + extent));
+}
+
+void LikelihoodField::Follow(OccupancyGrid& grid, const Eigen::AlignedBox2d& region) {
   EnsureKernel(grid.resolution());
   const bool following = followed_ == &grid && grid.records_wall_flips() &&
                          grid.wall_threshold() == options_.occupied_threshold;
@@ -156,34 +178,31 @@ void LikelihoodField::Follow(OccupancyGrid& grid) {
     grid.RecordWallFlips(options_.occupied_threshold);
     grid.TakeWallFlips();
     followed_ = &grid;
-    width_ = grid.width();
-    height_ = grid.height();
-    origin_ = grid.origin();
-    values_.assign(static_cast<std::size_t>(width_) * height_, 0.0f);
-    Refill(grid, {0, 0}, {width_ - 1, height_ - 1});
+    Recompute(grid, region);
     return;
   }
-  if (grid.width() != width_ || grid.height() != height_ || grid.origin() != origin_) {
-    Regrow(grid);
-  }
-  // A new wall only raises the cells around it; a wall that went can lower them, so they are
-  // recomputed from the walls now in reach.
-  const int r = radius_cells_;
-  const int side = 2 * r + 1;
-  for (const Eigen::Array2i& cell : grid.TakeWallFlips()) {
-    const float l = grid.LogOdds(cell);
-    if (!(l > options_.occupied_threshold)) {
-      Refill(grid, cell - r, cell + r);
-      continue;
-    }
-    const int dy0 = std::max(-r, -cell.y()), dy1 = std::min(r, height_ - 1 - cell.y());
-    const int dx0 = std::max(-r, -cell.x()), dx1 = std::min(r, width_ - 1 - cell.x());
-    for (int dy = dy0; dy <= dy1; ++dy) {
-      float* o = values_.data() + static_cast<std::ptrdiff_t>(cell.y() + dy) * width_ + cell.x();
-      const float* k = kernel_.data() + static_cast<std::ptrdiff_t>(dy + r) * side + r;
-      for (int dx = dx0; dx <= dx1; ++dx) o[dx] = std::max(o[dx], k[dx]);
+  if (grid.origin() != grid_origin_ || grid.width() != grid_size_.x() ||
+      grid.height() != grid_size_.y()) {
+    // The grid grows on its own lattice: the window's old cell (0, 0) is now `shift` further.
+    const Eigen::Vector2d shift_cells = (grid_origin_ - grid.origin()) / resolution_;
+    window_lo_ += Eigen::Array2i(static_cast<int>(std::lround(shift_cells.x())),
+                                 static_cast<int>(std::lround(shift_cells.y())));
+    grid_origin_ = grid.origin();
+    grid_size_ = {grid.width(), grid.height()};
+    origin_ = grid_origin_ + window_lo_.cast<double>().matrix() * resolution_;
+    // New cells are unknown: walls only when the threshold is below 0, and then the cells within
+    // reach of them change too.
+    if (options_.occupied_threshold < 0.0f) {
+      grid.TakeWallFlips();
+      Recompute(grid, region);
+      return;
     }
   }
+  for (const Eigen::Array2i& cell : grid.TakeWallFlips()) ApplyFlip(grid, cell);
+  const auto [lo, hi] = GridCells(region);
+  const bool inside =
+      (lo >= window_lo_).all() && (hi < window_lo_ + Eigen::Array2i(width_, height_)).all();
+  if ((lo <= hi).all() && !inside) Recompute(grid, region);
 }
 
 GridView LikelihoodField::view() const {
@@ -192,18 +211,22 @@ GridView LikelihoodField::view() const {
 
 GridView LikelihoodField::view(const Eigen::AlignedBox2d& region) const {
   SLAMRIG_CHECK(followed_ != nullptr, "LikelihoodField::view(region) needs Follow()");
-  // The window Update(grid, region) would compute, as a view into the whole field.
-  const Eigen::Array2i lo = WorldToCell(region.min()).max(Eigen::Array2i(0, 0));
-  const Eigen::Array2i hi = WorldToCell(region.max()).min(Eigen::Array2i(width_ - 1, height_ - 1));
+  // The window Update(grid, region) would compute, as a view into the followed one.
+  const auto [lo, hi] = GridCells(region);
   GridView view;
   view.width = std::max(0, hi.x() - lo.x() + 1);
   view.height = std::max(0, hi.y() - lo.y() + 1);
-  view.origin = origin_ + lo.cast<double>().matrix() * resolution_;
+  view.origin = grid_origin_ + lo.cast<double>().matrix() * resolution_;
   view.resolution = resolution_;
   view.stride = width_;
-  view.values = view.width > 0 && view.height > 0
-                    ? values_.data() + static_cast<std::ptrdiff_t>(lo.y()) * width_ + lo.x()
-                    : values_.data();
+  view.values = values_.data();
+  if (view.width > 0 && view.height > 0) {
+    SLAMRIG_CHECK(
+        (lo >= window_lo_).all() && (hi < window_lo_ + Eigen::Array2i(width_, height_)).all(),
+        "LikelihoodField::view(region): the region leaves the followed window");
+    view.values +=
+        static_cast<std::ptrdiff_t>(lo.y() - window_lo_.y()) * width_ + (lo.x() - window_lo_.x());
+  }
   return view;
 }
 

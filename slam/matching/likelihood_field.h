@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "slam/grid/occupancy_grid.h"
@@ -45,18 +46,23 @@ class LikelihoodField {
   /// on the grid's own cell lattice.
   void Update(const OccupancyGrid& grid, const Eigen::AlignedBox2d& region);
 
-  /// Keeps the field over the whole of `grid` up to date, at a cost that follows what changed, not
-  /// the map's size: the first call (or the first after Update, or with another grid) computes it
-  /// everywhere and starts the grid's wall-flip record; later calls redo only the cells within
-  /// reach of a wall that appeared or went, and when the grid grew only its new border. Every
-  /// value is exactly what Update would compute. One follower per grid (it takes the flips).
+  /// Keeps the field up to date over at least the part of `grid` that overlaps `region`, at a cost
+  /// that follows what changed and where the robot went, not the map's size: the field is a
+  /// window of the grid (`region` with some slack), redone whole only when a region leaves it (or
+  /// on the first call, after Update, with another grid, after SetSigma); between, only the cells
+  /// within reach of a wall that appeared or went are redone, and a grid that grew re-bases the
+  /// window. Every value is exactly what Update would compute. One follower per grid (it takes
+  /// the grid's wall flips).
+  void Follow(OccupancyGrid& grid, const Eigen::AlignedBox2d& region);
+  /// Follow over the whole grid (tests, small maps).
   void Follow(OccupancyGrid& grid);
 
-  /// The field as a raster (valid until the next Update or Follow): Update's window, or the whole
-  /// followed grid.
+  /// The field as a raster (valid until the next Update or Follow): Update's window, or the
+  /// followed window.
   GridView view() const;
   /// After Follow: the field over the part of the grid that overlaps `region`, 0 outside it, cell
-  /// for cell the raster that Update(grid, region) would give (a window, no copy).
+  /// for cell the raster that Update(grid, region) would give (a window, no copy). `region` must
+  /// lie in the followed window (a region given to the last Follow does).
   GridView view(const Eigen::AlignedBox2d& region) const;
   /// Value of a cell at distance `distance_m` from the nearest wall.
   double Score(double distance_m) const;
@@ -74,12 +80,14 @@ class LikelihoodField {
   // at out[0] and rows `stride` floats apart.
   void Fill(const OccupancyGrid& grid, const Eigen::Array2i& lo, const Eigen::Array2i& hi,
             float* out, int stride) const;
-  // Fill() on the followed lattice, for the cells of [lo, hi] inside it.
+  // Fill() on the followed window, for the cells of [lo, hi] (window cells) inside it.
   void Refill(const OccupancyGrid& grid, Eigen::Array2i lo, Eigen::Array2i hi);
-  // Moves the followed field onto the grid's grown lattice and fills the new border.
-  void Regrow(const OccupancyGrid& grid);
-  // The grid cell of world point `p` on the lattice in use (as OccupancyGrid::WorldToCell).
-  Eigen::Array2i WorldToCell(const Eigen::Vector2d& p) const;
+  // Makes the followed window `region` (clipped to the grid) plus slack and computes it whole.
+  void Recompute(const OccupancyGrid& grid, const Eigen::AlignedBox2d& region);
+  // Brings the window's cells within reach of grid cell `cell` up to date after its wall flip.
+  void ApplyFlip(const OccupancyGrid& grid, const Eigen::Array2i& cell);
+  // The grid cells [lo, hi] that `region` overlaps on the followed grid (empty if hi < lo).
+  std::pair<Eigen::Array2i, Eigen::Array2i> GridCells(const Eigen::AlignedBox2d& region) const;
 
   LikelihoodFieldOptions options_;
   int radius_cells_ = 0;
@@ -88,10 +96,14 @@ class LikelihoodField {
   std::vector<float> values_;
   int width_ = 0;
   int height_ = 0;
-  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();  // world corner of values_'s cell (0, 0)
   double resolution_ = 1.0;
-  // The grid Follow keeps up with (nullptr after Update); width_, height_, origin_ are its lattice.
+  // The grid Follow keeps up with (nullptr after Update), its lattice when last seen, and the
+  // grid cell of the window's cell (0, 0).
   const OccupancyGrid* followed_ = nullptr;
+  Eigen::Vector2d grid_origin_ = Eigen::Vector2d::Zero();
+  Eigen::Array2i grid_size_ = Eigen::Array2i::Zero();
+  Eigen::Array2i window_lo_ = Eigen::Array2i::Zero();
 };
 
 }  // namespace slamrig::slam

@@ -117,6 +117,55 @@ TEST(LikelihoodFieldTest, FollowEqualsAWholeRecomputeBitForBit) {
   }
 }
 
+// Property: following a window that slides with a robot on a long walk (the grid grows past it,
+// the window is redone when the region leaves it, walls change in and just outside it), every
+// region given to Follow reads bit for bit what a recompute of that region gives, and the field
+// stays a window, not the whole map.
+TEST(LikelihoodFieldTest, FollowingASlidingRegionEqualsARecomputeOfThatRegion) {
+  for (const float threshold : {0.0f, -0.2f}) {
+    std::mt19937 rng(3);
+    OccupancyGridOptions grid_options;
+    grid_options.resolution_m = 0.05;
+    grid_options.grow_margin_m = 0.5;
+    OccupancyGrid grid(grid_options);
+    LikelihoodFieldOptions options;
+    options.sigma_m = 0.06;
+    options.occupied_threshold = threshold;
+    LikelihoodField followed(options);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Pose2 pose;
+    int narrower = 0;
+    // Below 0 the unknown cells are walls: every growth redoes the window, fewer rounds do.
+    const int rounds = threshold < 0.0f ? 30 : 80;
+    for (int round = 0; round < rounds; ++round) {
+      // Mostly ahead along +x and +y, so the walk leaves the window and the grid grows.
+      const double theta = 3.0 * u(rng), dy = 0.3 + 0.5 * u(rng), dx = 0.55 + 0.4 * u(rng);
+      pose = Pose2(pose.x() + dx, pose.y() + dy, theta);
+      grid.InsertScan(RandomScan(rng, 90), pose);
+      // Walls set by hand near the robot, some beyond the region's edge.
+      for (int k = 0; k < 10; ++k) {
+        const double y = 6.0 * u(rng);
+        const Eigen::Array2i cell =
+            grid.WorldToCell(pose.translation() + Eigen::Vector2d(6.0 * u(rng), y));
+        if (grid.Contains(cell)) grid.Set(cell, static_cast<float>(2.0 * u(rng)));
+      }
+      const Eigen::Vector2d reach = Eigen::Vector2d::Constant(4.5);
+      const Eigen::AlignedBox2d region(pose.translation() - reach, pose.translation() + reach);
+      followed.Follow(grid, region);
+      LikelihoodField fresh(options);
+      fresh.Update(grid, region);
+      ASSERT_TRUE(SameBits(followed.view(region), fresh.view())) << threshold << " " << round;
+      const Eigen::AlignedBox2d inner(pose.translation() - 0.5 * reach,
+                                      pose.translation() + 0.3 * reach);
+      fresh.Update(grid, inner);
+      ASSERT_TRUE(SameBits(followed.view(inner), fresh.view())) << threshold << " " << round;
+      narrower += followed.view().width < grid.width() || followed.view().height < grid.height();
+    }
+    EXPECT_GT(grid.width() * grid_options.resolution_m, 0.5 * rounds);
+    EXPECT_GT(narrower, rounds / 2);
+  }
+}
+
 // The flips the field follows: each recorded once per change, re-based when the grid grows.
 TEST(LikelihoodFieldTest, GridRecordsWallFlipsOnItsCurrentLattice) {
   OccupancyGridOptions grid_options;

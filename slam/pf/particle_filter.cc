@@ -80,6 +80,16 @@ void ParticleFilter::Predict(const Pose2& odometry_increment) {
   }
 }
 
+Eigen::AlignedBox2d ParticleFilter::ScanRegion(const Eigen::AlignedBox2d& poses,
+                                               const std::vector<Eigen::Vector2d>& points) const {
+  double reach = 0.0;
+  for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
+  const double margin = reach + (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
+                        options_.likelihood_field.cutoff_sigmas * likelihood_field_.sigma_m();
+  const Eigen::Vector2d m = Eigen::Vector2d::Constant(margin);
+  return Eigen::AlignedBox2d(poses.min() - m, poses.max() + m);
+}
+
 GridView ParticleFilter::MapWindow(const Eigen::AlignedBox2d& region) {
   const Eigen::Array2i lo = map_.WorldToCell(region.min()).max(Eigen::Array2i(0, 0));
   const Eigen::Array2i hi =
@@ -101,16 +111,11 @@ std::vector<double> ParticleFilter::Score(const std::vector<Eigen::Vector2d>& po
   // particle and shift.
   Eigen::AlignedBox2d particles_box;
   for (const Particle& p : particles_) particles_box.extend(p.pose.translation());
-  double reach = 0.0;
-  for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
-  const double margin = reach + (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
-                        options_.likelihood_field.cutoff_sigmas * likelihood_field_.sigma_m();
-  const Eigen::Vector2d m = Eigen::Vector2d::Constant(margin);
-  const Eigen::AlignedBox2d region(particles_box.min() - m, particles_box.max() + m);
+  const Eigen::AlignedBox2d region = ScanRegion(particles_box, points);
   GridView field_view;
   if (use_field || options_.refine) {
     // Kept up to date where the map changed; the window keeps reads outside it at 0.
-    likelihood_field_.Follow(map_);
+    likelihood_field_.Follow(map_, region);
     field_view = likelihood_field_.view(region);
   }
   // The occupied indicator on the map itself reads a bit raster kept up to date where the map
@@ -454,14 +459,10 @@ void ParticleFilter::GiveUpWhenLostTooLong(const LaserScan& scan, ParticleFilter
 
 ParticleFilter::ScoredPose ParticleFilter::LocalMatch(const std::vector<Eigen::Vector2d>& points,
                                                       const Pose2& pose) {
-  double reach = 0.0;
-  for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
-  const Eigen::Vector2d margin = Eigen::Vector2d::Constant(
-      reach + (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
-      options_.likelihood_field.cutoff_sigmas * likelihood_field_.sigma_m());
-  likelihood_field_.Follow(map_);
-  const GridView view = likelihood_field_.view(
-      Eigen::AlignedBox2d(pose.translation() - margin, pose.translation() + margin));
+  const Eigen::AlignedBox2d region =
+      ScanRegion(Eigen::AlignedBox2d(pose.translation(), pose.translation()), points);
+  likelihood_field_.Follow(map_, region);
+  const GridView view = likelihood_field_.view(region);
   const float field_max = static_cast<float>(likelihood_field_.Score(0.0));
   const CorrelationResult shifted = correlator_.Correlate(view, points, pose);
   const RefineResult refined = refiner_.Refine(view, field_max, points, shifted.pose);
@@ -486,7 +487,12 @@ std::vector<ParticleFilter::ScoredPose> ParticleFilter::GlobalMatches(
     m.min_score = 0.0;
     const int decimation =
         std::max(1, static_cast<int>(std::lround(o.search_resolution_m / map_.resolution())));
-    global_matcher_ = std::make_unique<CorrelativeMatcher>(m, map_, decimation);
+    // Only the map within reach of the window counts: the precomputation costs that, not the
+    // map (the global search's points reach search_max_range_m).
+    const Eigen::Vector2d reach =
+        Eigen::Vector2d::Constant(o.search_max_range_m + (decimation + 1) * map_.resolution());
+    global_matcher_ = std::make_unique<CorrelativeMatcher>(
+        m, map_, decimation, Eigen::AlignedBox2d(a - reach, b + reach));
   }
   std::vector<ScoredPose> places;
   for (const MatchResult& match : global_matcher_->MatchDistinct(
@@ -503,13 +509,23 @@ std::vector<ParticleFilter::ScoredPose> ParticleFilter::GlobalMatches(
 std::optional<ParticleFilter::ScoredPose> ParticleFilter::NearMatch(
     const std::vector<Eigen::Vector2d>& points, const Pose2& pose) {
   const RelocalisationOptions& o = options_.relocalisation;
-  if (!near_matcher_) {
-    // The map is frozen while lost: one set of precomputation grids serves every search.
+  // The map is frozen while lost: one set of precomputation grids serves every search from near
+  // where it was built, over the map within reach of the search (never the whole map).
+  double reach = 0.0;
+  for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
+  const double needed = o.slip_radius_m + reach + 2.0 * map_.resolution();
+  if (!near_matcher_ ||
+      (pose.translation() - near_centre_).cwiseAbs().maxCoeff() + needed > near_half_side_m_) {
+    constexpr double kSlackM = 5.0;  // the robot may move this far, lost, before a rebuild
+    near_centre_ = pose.translation();
+    near_half_side_m_ = needed + kSlackM;
+    const Eigen::Vector2d half = Eigen::Vector2d::Constant(near_half_side_m_);
     CorrelativeMatcherOptions m;
     m.linear_window_m = o.slip_radius_m;
     m.angular_window_rad = o.slip_angle_rad;
     m.min_score = 0.0;
-    near_matcher_ = std::make_unique<CorrelativeMatcher>(m, map_);
+    near_matcher_ = std::make_unique<CorrelativeMatcher>(
+        m, map_, 1, Eigen::AlignedBox2d(near_centre_ - half, near_centre_ + half));
   }
   const std::optional<MatchResult> match = near_matcher_->Match(points, pose);
   if (!match) return std::nullopt;
@@ -519,9 +535,12 @@ std::optional<ParticleFilter::ScoredPose> ParticleFilter::NearMatch(
 std::optional<ParticleFilter::ScoredPose> ParticleFilter::AcceptedPlace(
     const std::vector<Eigen::Vector2d>& points, const Pose2& pose) {
   // Judged as the tracking judges itself: refined on the likelihood field, all points.
-  likelihood_field_.Follow(map_);
+  const Eigen::AlignedBox2d region =
+      ScanRegion(Eigen::AlignedBox2d(pose.translation(), pose.translation()), points);
+  likelihood_field_.Follow(map_, region);
   const float field_max = static_cast<float>(likelihood_field_.Score(0.0));
-  const RefineResult refined = refiner_.Refine(likelihood_field_.view(), field_max, points, pose);
+  const RefineResult refined =
+      refiner_.Refine(likelihood_field_.view(region), field_max, points, pose);
   const double quality = Quality(static_cast<float>(refined.score), points.size());
   if (!FitsAsPlace(quality)) return std::nullopt;
   return ScoredPose{refined.pose, quality};
@@ -671,7 +690,8 @@ bool ParticleFilter::UpdateMapAndLostState(const LaserScan& scan,
   std::optional<double> wall_distance;
   if (judged && options_.observation == ObservationModel::kLikelihoodField &&
       options_.adaptive_sigma.enabled) {
-    likelihood_field_.Follow(map_);
+    const Eigen::Vector2d at = step->best_pose.translation();
+    likelihood_field_.Follow(map_, ScanRegion(Eigen::AlignedBox2d(at, at), points));
     wall_distance = field_sigma_.MedianWallDistance(likelihood_field_, points, step->best_pose);
   }
   // A scan that matches the map much worse than usual is not inserted: after a kidnapping it

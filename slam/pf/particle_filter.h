@@ -174,6 +174,10 @@ class ParticleFilter {
   std::vector<double> Score(const std::vector<Eigen::Vector2d>& points,
                             const MatchConstraints& constraints, const Pose2& predicted_mean,
                             float* best_score);
+  // Where a scan of `points` can land from a pose in `poses`, with the shift search and the
+  // field's cutoff: the part of the map the field must cover for it.
+  Eigen::AlignedBox2d ScanRegion(const Eigen::AlignedBox2d& poses,
+                                 const std::vector<Eigen::Vector2d>& points) const;
   // The map's log-odds over `region` (clipped to the map) as a raster of its own, valid until the
   // next call: the map is tiles, the correlator reads rasters.
   GridView MapWindow(const Eigen::AlignedBox2d& region);
@@ -206,7 +210,9 @@ class ParticleFilter {
   std::vector<Candidate> candidates_;  // distinct places, followed while lost
   int unsupported_updates_ = 0;        // lost updates in a row with no place elsewhere winning
   std::unique_ptr<CorrelativeMatcher> global_matcher_;
-  std::unique_ptr<CorrelativeMatcher> near_matcher_;  // within slip_radius_m of the filter
+  std::unique_ptr<CorrelativeMatcher> near_matcher_;       // within slip_radius_m of the filter
+  Eigen::Vector2d near_centre_ = Eigen::Vector2d::Zero();  // near_matcher_'s map: a square
+  double near_half_side_m_ = 0.0;                          // around near_centre_
   int lost_count_ = 0;
   int relocalisation_count_ = 0;
   int resumed_count_ = 0;
