@@ -149,7 +149,9 @@ std::string ArgParser::Help() const {
   out += "\nOptions:\n";
   for (const auto& o : options_) {
     const std::string left = "--" + o.name + (o.value_name.empty() ? "" : " " + o.value_name);
-    const bool show_default = !o.value_name.empty() && !o.default_text.empty();
+    // Not where the help says its own default ("until the drive is done" reads better than 0).
+    const bool show_default = !o.value_name.empty() && !o.default_text.empty() &&
+                              o.help.find("default") == std::string::npos;
     row(left, o.help + (show_default ? " [default: " + o.default_text + "]" : ""));
   }
   row("-h, --help", "show this help and exit");

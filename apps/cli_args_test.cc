@@ -9,6 +9,7 @@ namespace slamrig::app {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 struct Parsed {
   std::string log, out = "default";
@@ -78,6 +79,17 @@ TEST(ArgParserTest, HelpListsEverythingWithDefaults) {
   EXPECT_THAT(help, HasSubstr("--resolution M"));
   EXPECT_THAT(help, HasSubstr("[default: 0.05]"));
   EXPECT_THAT(help, HasSubstr("-h, --help"));
+}
+
+// An option whose help states its default is not given a second, raw one ("[default: 0]" after
+// "until the drive is done", or the robot's name twice).
+TEST(ArgParserTest, HelpThatStatesItsDefaultIsNotRepeated) {
+  Parsed p;
+  ArgParser parser("slamrig test", "[options]", "A test command.");
+  parser.AddOption("resolution", "M", "cell size (default: the map's own)", &p.resolution);
+  const std::string help = parser.Help();
+  EXPECT_THAT(help, HasSubstr("cell size (default: the map's own)\n"));
+  EXPECT_THAT(help, Not(HasSubstr("[default: 0.05]")));
 }
 
 }  // namespace

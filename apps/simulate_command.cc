@@ -43,9 +43,7 @@ int RunSimulateCommand(const std::vector<std::string>& args) {
       "data (N from --dataset). truth.tum and the yaml files are written for every format.");
   parser.AddPositional("WORLD", "world file, or a name in worlds/ (office, corridor, ...)",
                        &world_arg);
-  parser.AddOption("robot", "R",
-                   "robot file, or a name in robots/ (ece276a, small_diff) [default: " +
-                       std::string(sim::kDefaultRobot) + "]",
+  parser.AddOption("robot", "R", "robot file, or a name in robots/ (ece276a, small_diff)",
                    &robot_arg);
   parser.AddOption("duration", "S", "simulated seconds (default: until the drive is done)",
                    &duration_s);
