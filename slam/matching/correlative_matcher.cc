@@ -12,6 +12,59 @@
 namespace slamrig::slam {
 namespace {
 
+// The search grids of matchers that are gone, for the next matcher built on the same thread.
+// Graph SLAM and the ICP front end build a matcher for every scan they search, over megabytes of
+// levels: fresh vectors cost a memset and the kernel's page faults each time (half of graph's time
+// on acapulco; docs/studies/large-maps.md). Every cell of a taken raster is written before it is
+// read, so the values are as before.
+class RasterPool {
+ public:
+  ~RasterPool() { gone = true; }
+  // A vector of `size` floats, contents unspecified: the smallest spare that holds them, else the
+  // largest, grown.
+  std::vector<float> Take(std::size_t size) {
+    std::vector<float> v;
+    if (!spare_.empty()) {
+      std::size_t pick = 0;
+      for (std::size_t k = 1; k < spare_.size(); ++k) {
+        const std::size_t c = spare_[k].capacity(), best = spare_[pick].capacity();
+        const bool fits = c >= size, best_fits = best >= size;
+        if (fits != best_fits ? fits : (fits ? c < best : c > best)) pick = k;
+      }
+      v = std::move(spare_[pick]);
+      spare_.erase(spare_.begin() + static_cast<std::ptrdiff_t>(pick));
+      bytes_ -= v.capacity() * sizeof(float);
+    }
+    v.resize(size);
+    return v;
+  }
+  void Give(std::vector<float>&& v) {
+    const std::size_t bytes = v.capacity() * sizeof(float);
+    if (bytes == 0 || bytes_ + bytes > kMaxBytes) return;
+    bytes_ += bytes;
+    spare_.push_back(std::move(v));
+  }
+  // Set when this thread's pool is destroyed (a matcher may outlive it at exit).
+  static thread_local bool gone;
+
+ private:
+  static constexpr std::size_t kMaxBytes = std::size_t{128} << 20;
+  std::vector<std::vector<float>> spare_;
+  std::size_t bytes_ = 0;
+};
+
+thread_local bool RasterPool::gone = false;
+thread_local RasterPool raster_pool;
+
+std::vector<float> TakeRaster(std::size_t size) {
+  if (RasterPool::gone) return std::vector<float>(size);
+  return raster_pool.Take(size);
+}
+
+}  // namespace
+
+namespace {
+
 // A block of 2^level x 2^level translations at one yaw, by its lowest corner (i, j).
 struct Node {
   int k = 0;
@@ -47,7 +100,7 @@ CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
                                        const GridView& raster)
     : options_(options), origin_(raster.origin), resolution_(raster.resolution) {
   SLAMRIG_CHECK_VALID(options_, "CorrelativeMatcherOptions");
-  std::vector<float> values(static_cast<std::size_t>(raster.width) * raster.height);
+  std::vector<float> values = TakeRaster(static_cast<std::size_t>(raster.width) * raster.height);
   for (int y = 0; y < raster.height; ++y) {
     for (int x = 0; x < raster.width; ++x) {
       values[static_cast<std::size_t>(y) * raster.width + x] = raster.At(x, y);
@@ -72,7 +125,8 @@ CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
   origin_ = grid.origin() + lo.cast<double>().matrix() * grid.resolution();
   const int d = decimation;
   const int width = (cells.x() + d - 1) / d, height = (cells.y() + d - 1) / d;
-  std::vector<float> values(static_cast<std::size_t>(width) * height, 0.0f);
+  std::vector<float> values = TakeRaster(static_cast<std::size_t>(width) * height);
+  std::fill(values.begin(), values.end(), 0.0f);
   std::vector<float> row(static_cast<std::size_t>(cells.x()));
   for (int y = 0; y < cells.y(); ++y) {
     grid.CopyLogOdds({lo.x(), lo.y() + y}, {cells.x(), 1}, row.data(), 0);
@@ -86,6 +140,11 @@ CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
   Precompute(std::move(values), width, height);
 }
 
+CorrelativeMatcher::~CorrelativeMatcher() {
+  if (RasterPool::gone) return;
+  for (Level& level : levels_) raster_pool.Give(std::move(level.values));
+}
+
 void CorrelativeMatcher::Precompute(std::vector<float> values, int width, int height) {
   levels_.resize(static_cast<std::size_t>(options_.branch_and_bound_depth));
   levels_[0] = Level{0, width, height, std::move(values)};
@@ -97,7 +156,7 @@ void CorrelativeMatcher::Precompute(std::vector<float> values, int width, int he
     level.offset = (1 << h) - 1;
     level.width = width + level.offset;
     level.height = height + level.offset;
-    level.values.assign(static_cast<std::size_t>(level.width) * level.height, 0.0f);
+    level.values = TakeRaster(static_cast<std::size_t>(level.width) * level.height);
     auto prev_at = [&](int x, int y) {  // raster cell coordinates
       const int px = x + prev.offset, py = y + prev.offset;
       if (px < 0 || py < 0 || px >= prev.width || py >= prev.height) return 0.0f;

@@ -64,6 +64,12 @@ class CorrelativeMatcher {
  public:
   /// Precomputes the search grids of `raster`.
   CorrelativeMatcher(const CorrelativeMatcherOptions& options, const GridView& raster);
+  CorrelativeMatcher(const CorrelativeMatcher&) = default;
+  CorrelativeMatcher(CorrelativeMatcher&&) = default;
+  CorrelativeMatcher& operator=(const CorrelativeMatcher&) = default;
+  CorrelativeMatcher& operator=(CorrelativeMatcher&&) = default;
+  /// Hands its search grids to the next matcher built on this thread (RasterPool).
+  ~CorrelativeMatcher();
   /// Searches an occupancy grid: a cell's value is its occupancy probability when it is more
   /// likely occupied than not (log-odds > 0), else 0. With `decimation` d > 1 the search runs on
   /// a raster d times coarser (cells of d x d grid cells from the grid's origin, each holding the
