@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <deque>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "slam/types/pose2.h"
@@ -116,6 +117,12 @@ class OccupancyGrid {
   }
   bool Contains(const Eigen::Array2i& cell) const {
     return cell.x() >= 0 && cell.y() >= 0 && cell.x() < width_ && cell.y() < height_;
+  }
+  /// The cells [lo, hi] (inclusive) of the grid that world box `region` overlaps, clipped to the
+  /// grid; empty when some coordinate of hi is below lo's.
+  std::pair<Eigen::Array2i, Eigen::Array2i> CellsIn(const Eigen::AlignedBox2d& region) const {
+    return {WorldToCell(region.min()).max(Eigen::Array2i(0, 0)),
+            WorldToCell(region.max()).min(Eigen::Array2i(width_ - 1, height_ - 1))};
   }
   /// Log-odds of `cell`, 0 outside the grid.
   float LogOdds(const Eigen::Array2i& cell) const {

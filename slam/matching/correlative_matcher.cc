@@ -61,10 +61,6 @@ std::vector<float> TakeRaster(std::size_t size) {
   return raster_pool.Take(size);
 }
 
-}  // namespace
-
-namespace {
-
 // A block of 2^level x 2^level translations at one yaw, by its lowest corner (i, j).
 struct Node {
   int k = 0;
@@ -117,10 +113,7 @@ CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,
   SLAMRIG_CHECK(decimation >= 1, "CorrelativeMatcher: decimation must be >= 1");
   // The grid cells searched: all, or those of the region.
   Eigen::Array2i lo(0, 0), hi(grid.width() - 1, grid.height() - 1);
-  if (region) {
-    lo = grid.WorldToCell(region->min()).max(lo);
-    hi = grid.WorldToCell(region->max()).min(hi);
-  }
+  if (region) std::tie(lo, hi) = grid.CellsIn(*region);
   const Eigen::Array2i cells = (hi - lo + 1).max(Eigen::Array2i(0, 0));
   origin_ = grid.origin() + lo.cast<double>().matrix() * grid.resolution();
   const int d = decimation;

@@ -99,9 +99,7 @@ void LikelihoodField::Update(const OccupancyGrid& grid, const Eigen::AlignedBox2
   followed_ = nullptr;
   EnsureKernel(grid.resolution());
   // Window on the grid lattice, clipped to the grid.
-  const Eigen::Array2i lo = grid.WorldToCell(region.min()).max(Eigen::Array2i(0, 0));
-  const Eigen::Array2i hi =
-      grid.WorldToCell(region.max()).min(Eigen::Array2i(grid.width() - 1, grid.height() - 1));
+  const auto [lo, hi] = grid.CellsIn(region);
   width_ = std::max(0, hi.x() - lo.x() + 1);
   height_ = std::max(0, hi.y() - lo.y() + 1);
   origin_ = grid.origin() + lo.cast<double>().matrix() * resolution_;
@@ -200,9 +198,7 @@ void LikelihoodField::Follow(OccupancyGrid& grid, const Eigen::AlignedBox2d& reg
   }
   for (const Eigen::Array2i& cell : grid.TakeWallFlips()) ApplyFlip(grid, cell);
   const auto [lo, hi] = GridCells(region);
-  const bool inside =
-      (lo >= window_lo_).all() && (hi < window_lo_ + Eigen::Array2i(width_, height_)).all();
-  if ((lo <= hi).all() && !inside) Recompute(grid, region);
+  if ((lo <= hi).all() && !WindowHolds(lo, hi)) Recompute(grid, region);
 }
 
 GridView LikelihoodField::view() const {
@@ -221,9 +217,8 @@ GridView LikelihoodField::view(const Eigen::AlignedBox2d& region) const {
   view.stride = width_;
   view.values = values_.data();
   if (view.width > 0 && view.height > 0) {
-    SLAMRIG_CHECK(
-        (lo >= window_lo_).all() && (hi < window_lo_ + Eigen::Array2i(width_, height_)).all(),
-        "LikelihoodField::view(region): the region leaves the followed window");
+    SLAMRIG_CHECK(WindowHolds(lo, hi),
+                  "LikelihoodField::view(region): the region leaves the followed window");
     view.values +=
         static_cast<std::ptrdiff_t>(lo.y() - window_lo_.y()) * width_ + (lo.x() - window_lo_.x());
   }

@@ -88,6 +88,10 @@ class LikelihoodField {
   void ApplyFlip(const OccupancyGrid& grid, const Eigen::Array2i& cell);
   // The grid cells [lo, hi] that `region` overlaps on the followed grid (empty if hi < lo).
   std::pair<Eigen::Array2i, Eigen::Array2i> GridCells(const Eigen::AlignedBox2d& region) const;
+  // Whether the followed window holds the grid cells [lo, hi].
+  bool WindowHolds(const Eigen::Array2i& lo, const Eigen::Array2i& hi) const {
+    return (lo >= window_lo_).all() && (hi < window_lo_ + Eigen::Array2i(width_, height_)).all();
+  }
 
   LikelihoodFieldOptions options_;
   int radius_cells_ = 0;

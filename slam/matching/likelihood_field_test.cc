@@ -70,19 +70,30 @@ LaserScan RandomScan(std::mt19937& rng, int beams) {
   return scan;
 }
 
+// A 5 cm grid that grows by `grow_margin_m`, and the field of sigma 0.06 m at `threshold`, as
+// the follow properties below use them.
+OccupancyGridOptions GrowingGrid(double grow_margin_m) {
+  OccupancyGridOptions o;
+  o.resolution_m = 0.05;
+  o.grow_margin_m = grow_margin_m;
+  return o;
+}
+LikelihoodFieldOptions FieldAt(float threshold) {
+  LikelihoodFieldOptions o;
+  o.sigma_m = 0.06;
+  o.occupied_threshold = threshold;
+  return o;
+}
+
 // Property: after random scans (the grid grows), random walls set and erased, the followed
 // field equals a whole recompute bit for bit, everywhere and in every window; for thresholds
 // above and below 0 (below 0 the unknown cells the grid grows into are walls).
 TEST(LikelihoodFieldTest, FollowEqualsAWholeRecomputeBitForBit) {
   for (const float threshold : {0.0f, 0.5f, -0.2f}) {
     std::mt19937 rng(7);
-    OccupancyGridOptions grid_options;
-    grid_options.resolution_m = 0.05;
-    grid_options.grow_margin_m = 0.3;
+    const OccupancyGridOptions grid_options = GrowingGrid(0.3);
     OccupancyGrid grid(grid_options);
-    LikelihoodFieldOptions options;
-    options.sigma_m = 0.06;
-    options.occupied_threshold = threshold;
+    const LikelihoodFieldOptions options = FieldAt(threshold);
     LikelihoodField followed(options);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     Pose2 pose;
@@ -124,13 +135,9 @@ TEST(LikelihoodFieldTest, FollowEqualsAWholeRecomputeBitForBit) {
 TEST(LikelihoodFieldTest, FollowingASlidingRegionEqualsARecomputeOfThatRegion) {
   for (const float threshold : {0.0f, -0.2f}) {
     std::mt19937 rng(3);
-    OccupancyGridOptions grid_options;
-    grid_options.resolution_m = 0.05;
-    grid_options.grow_margin_m = 0.5;
+    const OccupancyGridOptions grid_options = GrowingGrid(0.5);
     OccupancyGrid grid(grid_options);
-    LikelihoodFieldOptions options;
-    options.sigma_m = 0.06;
-    options.occupied_threshold = threshold;
+    const LikelihoodFieldOptions options = FieldAt(threshold);
     LikelihoodField followed(options);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     Pose2 pose;

@@ -33,6 +33,13 @@ constexpr double kJudgedFraction = 0.5;
 constexpr std::size_t kMinGlobalSearchPoints = 10;
 // The global search's yaw window: every heading.
 constexpr double kEveryHeadingRad = 3.14159265358979;
+
+// The farthest point of a scan from the robot.
+double Reach(const std::vector<Eigen::Vector2d>& points) {
+  double reach = 0.0;
+  for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
+  return reach;
+}
 }  // namespace
 
 Pose2 WeightedMeanPose(const std::vector<Particle>& particles) {
@@ -82,18 +89,20 @@ void ParticleFilter::Predict(const Pose2& odometry_increment) {
 
 Eigen::AlignedBox2d ParticleFilter::ScanRegion(const Eigen::AlignedBox2d& poses,
                                                const std::vector<Eigen::Vector2d>& points) const {
-  double reach = 0.0;
-  for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
-  const double margin = reach + (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
+  const double margin = Reach(points) +
+                        (options_.correlation.xy_half_width_cells + 2) * map_.resolution() +
                         options_.likelihood_field.cutoff_sigmas * likelihood_field_.sigma_m();
   const Eigen::Vector2d m = Eigen::Vector2d::Constant(margin);
   return Eigen::AlignedBox2d(poses.min() - m, poses.max() + m);
 }
 
+Eigen::AlignedBox2d ParticleFilter::ScanRegion(const Eigen::Vector2d& position,
+                                               const std::vector<Eigen::Vector2d>& points) const {
+  return ScanRegion(Eigen::AlignedBox2d(position, position), points);
+}
+
 GridView ParticleFilter::MapWindow(const Eigen::AlignedBox2d& region) {
-  const Eigen::Array2i lo = map_.WorldToCell(region.min()).max(Eigen::Array2i(0, 0));
-  const Eigen::Array2i hi =
-      map_.WorldToCell(region.max()).min(Eigen::Array2i(map_.width() - 1, map_.height() - 1));
+  const auto [lo, hi] = map_.CellsIn(region);
   const Eigen::Array2i size = (hi - lo + 1).max(Eigen::Array2i(0, 0));
   map_window_.resize(static_cast<std::size_t>(size.x()) * static_cast<std::size_t>(size.y()));
   map_.CopyLogOdds(lo, size, map_window_.data(), size.x());
@@ -459,8 +468,7 @@ void ParticleFilter::GiveUpWhenLostTooLong(const LaserScan& scan, ParticleFilter
 
 ParticleFilter::ScoredPose ParticleFilter::LocalMatch(const std::vector<Eigen::Vector2d>& points,
                                                       const Pose2& pose) {
-  const Eigen::AlignedBox2d region =
-      ScanRegion(Eigen::AlignedBox2d(pose.translation(), pose.translation()), points);
+  const Eigen::AlignedBox2d region = ScanRegion(pose.translation(), points);
   likelihood_field_.Follow(map_, region);
   const GridView view = likelihood_field_.view(region);
   const float field_max = static_cast<float>(likelihood_field_.Score(0.0));
@@ -511,9 +519,7 @@ std::optional<ParticleFilter::ScoredPose> ParticleFilter::NearMatch(
   const RelocalisationOptions& o = options_.relocalisation;
   // The map is frozen while lost: one set of precomputation grids serves every search from near
   // where it was built, over the map within reach of the search (never the whole map).
-  double reach = 0.0;
-  for (const Eigen::Vector2d& q : points) reach = std::max(reach, q.norm());
-  const double needed = o.slip_radius_m + reach + 2.0 * map_.resolution();
+  const double needed = o.slip_radius_m + Reach(points) + 2.0 * map_.resolution();
   if (!near_matcher_ ||
       (pose.translation() - near_centre_).cwiseAbs().maxCoeff() + needed > near_half_side_m_) {
     constexpr double kSlackM = 5.0;  // the robot may move this far, lost, before a rebuild
@@ -535,8 +541,7 @@ std::optional<ParticleFilter::ScoredPose> ParticleFilter::NearMatch(
 std::optional<ParticleFilter::ScoredPose> ParticleFilter::AcceptedPlace(
     const std::vector<Eigen::Vector2d>& points, const Pose2& pose) {
   // Judged as the tracking judges itself: refined on the likelihood field, all points.
-  const Eigen::AlignedBox2d region =
-      ScanRegion(Eigen::AlignedBox2d(pose.translation(), pose.translation()), points);
+  const Eigen::AlignedBox2d region = ScanRegion(pose.translation(), points);
   likelihood_field_.Follow(map_, region);
   const float field_max = static_cast<float>(likelihood_field_.Score(0.0));
   const RefineResult refined =
@@ -690,8 +695,7 @@ bool ParticleFilter::UpdateMapAndLostState(const LaserScan& scan,
   std::optional<double> wall_distance;
   if (judged && options_.observation == ObservationModel::kLikelihoodField &&
       options_.adaptive_sigma.enabled) {
-    const Eigen::Vector2d at = step->best_pose.translation();
-    likelihood_field_.Follow(map_, ScanRegion(Eigen::AlignedBox2d(at, at), points));
+    likelihood_field_.Follow(map_, ScanRegion(step->best_pose.translation(), points));
     wall_distance = field_sigma_.MedianWallDistance(likelihood_field_, points, step->best_pose);
   }
   // A scan that matches the map much worse than usual is not inserted: after a kidnapping it

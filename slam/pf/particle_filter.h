@@ -178,6 +178,9 @@ class ParticleFilter {
   // field's cutoff: the part of the map the field must cover for it.
   Eigen::AlignedBox2d ScanRegion(const Eigen::AlignedBox2d& poses,
                                  const std::vector<Eigen::Vector2d>& points) const;
+  // ScanRegion from one pose's position.
+  Eigen::AlignedBox2d ScanRegion(const Eigen::Vector2d& position,
+                                 const std::vector<Eigen::Vector2d>& points) const;
   // The map's log-odds over `region` (clipped to the map) as a raster of its own, valid until the
   // next call: the map is tiles, the correlator reads rasters.
   GridView MapWindow(const Eigen::AlignedBox2d& region);
