@@ -52,8 +52,12 @@ for a in "${algos[@]}"; do
     for ((i = 0; i < runs; i++)); do
       rm -rf "$out/slam"
       TIMEFORMAT='%R'
-      t=$( { time "$slamrig" slam "$out/run$s/run.log" --algorithm "$a" --quiet \
-               --out "$out/slam" >/dev/null; } 2>&1)
+      if ! t=$( { time "$slamrig" slam "$out/run$s/run.log" --algorithm "$a" --quiet \
+                    --out "$out/slam" >/dev/null 2>"$out/slam.err"; } 2>&1); then
+        echo "map_size_timing: slamrig slam --algorithm $a on the ${s} m office failed:" \
+          "$(tail -n 1 "$out/slam.err")" >&2
+        exit 1
+      fi
       wall=$(sed -n 's/^ *"wall_time_s": \([0-9.eE+-]*\),*$/\1/p' "$out/slam/metrics.json" | head -n 1)
       [[ -n "$wall" ]] || { echo "map_size_timing: no wall_time_s in metrics.json ($a, $s m)" >&2; exit 1; }
       scans=$(grep -c '^ROBOTLASER1' "$out/run$s/run.log")
