@@ -141,30 +141,54 @@ CorrelativeMatcher::~CorrelativeMatcher() {
 void CorrelativeMatcher::Precompute(std::vector<float> values, int width, int height) {
   levels_.resize(static_cast<std::size_t>(options_.branch_and_bound_depth));
   levels_[0] = Level{0, width, height, std::move(values)};
-  // Level h from level h-1: the max of four blocks of 2^(h-1) (Hess 2016, Sec. V-C, by doubling).
+  // Level h from level h-1 by doubling (Hess 2016, Sec. V-C): the max of four blocks of 2^(h-1),
+  // max(max(P(x, y), P(x + half, y)), max(P(x, y + half), P(x + half, y + half))) with cells
+  // outside P reading 0. It is taken in two passes with the same operands in the same order (so
+  // the same bits): R = the max along x of each of P's rows, padded to the level's width, then the
+  // level = the max along y of R's rows, one row of zeros standing for the rows outside P.
+  std::vector<float> rows, zeros;
   for (std::size_t h = 1; h < levels_.size(); ++h) {
     const Level& prev = levels_[h - 1];
     const int half = 1 << (h - 1);
     Level& level = levels_[h];
     level.offset = (1 << h) - 1;
-    level.width = width + level.offset;
-    level.height = height + level.offset;
+    level.width = width + level.offset;    // = prev.width + half
+    level.height = height + level.offset;  // = prev.height + half
     level.values = TakeRaster(static_cast<std::size_t>(level.width) * level.height);
-    auto prev_at = [&](int x, int y) {  // raster cell coordinates
-      const int px = x + prev.offset, py = y + prev.offset;
-      if (px < 0 || py < 0 || px >= prev.width || py >= prev.height) return 0.0f;
-      return prev.values[static_cast<std::size_t>(py) * prev.width + px];
-    };
+    const int pw = prev.width, lw = level.width;
+    // Column lx of the level is x = lx - level.offset: P(x, .) is prev's column lx - half and
+    // P(x + half, .) its column lx.
+    rows.resize(static_cast<std::size_t>(lw) * prev.height);
+    for (int py = 0; py < prev.height; ++py) {
+      const float* p = prev.values.data() + static_cast<std::size_t>(py) * pw;
+      float* r = rows.data() + static_cast<std::size_t>(py) * lw;
+      int lx = 0;
+      for (; lx < std::min(half, pw); ++lx) r[lx] = std::max(0.0f, p[lx]);
+      for (; lx < half; ++lx) r[lx] = 0.0f;  // only for a level narrower than half a block
+      for (; lx < pw; ++lx) r[lx] = std::max(p[lx - half], p[lx]);
+      for (; lx < lw; ++lx) r[lx] = std::max(p[lx - half], 0.0f);
+    }
+    // Row ly of the level is y = ly - level.offset: R(., y) is R's row ly - half and R(., y + half)
+    // its row ly.
+    zeros.assign(static_cast<std::size_t>(lw), 0.0f);
     for (int ly = 0; ly < level.height; ++ly) {
-      const int y = ly - level.offset;
-      for (int lx = 0; lx < level.width; ++lx) {
-        const int x = lx - level.offset;
-        level.values[static_cast<std::size_t>(ly) * level.width + lx] =
-            std::max(std::max(prev_at(x, y), prev_at(x + half, y)),
-                     std::max(prev_at(x, y + half), prev_at(x + half, y + half)));
-      }
+      const int a = ly - half, b = ly;
+      const float* ra = a >= 0 ? rows.data() + static_cast<std::size_t>(a) * lw : zeros.data();
+      const float* rb =
+          b < prev.height ? rows.data() + static_cast<std::size_t>(b) * lw : zeros.data();
+      float* out = level.values.data() + static_cast<std::size_t>(ly) * lw;
+      for (int lx = 0; lx < lw; ++lx) out[lx] = std::max(ra[lx], rb[lx]);
     }
   }
+}
+
+float CorrelativeMatcher::LevelBound(int level, int x, int y) const {
+  SLAMRIG_CHECK(level >= 0 && level < static_cast<int>(levels_.size()),
+                "CorrelativeMatcher::LevelBound: no such level");
+  const Level& l = levels_[static_cast<std::size_t>(level)];
+  const int lx = x + l.offset, ly = y + l.offset;
+  if (lx < 0 || ly < 0 || lx >= l.width || ly >= l.height) return 0.0f;
+  return l.values[static_cast<std::size_t>(ly) * l.width + lx];
 }
 
 double CorrelativeMatcher::AngularStep(std::span<const Eigen::Vector2d> points_base) const {

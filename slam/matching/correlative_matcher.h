@@ -101,6 +101,11 @@ class CorrelativeMatcher {
   /// The yaw step Match uses for `points_base`.
   double AngularStep(std::span<const Eigen::Vector2d> points_base) const;
 
+  /// The bound of precomputation level `level` (0 to depth - 1) at raster cell (x, y): the
+  /// largest raster value in cells [x, x + 2^level) x [y, y + 2^level), cells outside the raster
+  /// reading 0; 0 outside the level itself (x or y below 1 - 2^level or past the raster).
+  float LevelBound(int level, int x, int y) const;
+
  private:
   // One precomputation grid: covers cells [-offset, width - offset) of the raster in x (and y).
   struct Level {

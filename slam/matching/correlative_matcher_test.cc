@@ -128,6 +128,42 @@ TEST(CorrelativeMatcherTest, BranchAndBoundEqualsExhaustiveSearch) {
   EXPECT_GT(found, 30);
 }
 
+// Each level's bound is the brute-force maximum of its block (Hess 2016, Sec. V-C), on random
+// rasters of every shape down to a single row or column, at every depth.
+TEST(CorrelativeMatcherTest, EachLevelHoldsTheMaximumOfItsBlock) {
+  RandomEngine rng(23);
+  for (int trial = 0; trial < 40; ++trial) {
+    const int width = 1 + static_cast<int>(40 * Uniform01(rng));
+    const int height = 1 + static_cast<int>(40 * Uniform01(rng));
+    std::vector<float> values(static_cast<std::size_t>(width) * height);
+    for (float& v : values) {
+      const double u = Uniform01(rng);
+      v = static_cast<float>(u * Uniform01(rng));
+    }
+    const GridView raster{values.data(), width, height, Eigen::Vector2d::Zero(), 0.1};
+    CorrelativeMatcherOptions options;
+    options.branch_and_bound_depth = 1 + trial % 8;
+    const CorrelativeMatcher matcher(options, raster);
+    for (int level = 0; level < options.branch_and_bound_depth; ++level) {
+      const int side = 1 << level;
+      for (int y = -side - 1; y <= height + 1; ++y) {
+        for (int x = -side - 1; x <= width + 1; ++x) {
+          float expected = 0.0f;
+          if (x > -side && y > -side && x < width && y < height) {
+            for (int by = std::max(y, 0); by < std::min(y + side, height); ++by) {
+              for (int bx = std::max(x, 0); bx < std::min(x + side, width); ++bx) {
+                expected = std::max(expected, values[static_cast<std::size_t>(by) * width + bx]);
+              }
+            }
+          }
+          ASSERT_EQ(matcher.LevelBound(level, x, y), expected)
+              << "trial " << trial << " level " << level << " at (" << x << ", " << y << ")";
+        }
+      }
+    }
+  }
+}
+
 // The distinct places are the greedy non-maximum suppression of the exhaustive search: each is
 // the best pose outside the neighbourhoods of those before it, on random rasters, at every depth.
 TEST(CorrelativeMatcherTest, DistinctPlacesAreTheExhaustiveSearchsSuppressedMaxima) {

@@ -77,7 +77,7 @@ int Associate(const Reference& reference, std::span<const Eigen::Vector2d> sourc
     pair.rotated = Eigen::Vector2d(c * p.x() - s * p.y(), s * p.x() + c * p.y());
     pair.world = pair.rotated + pose.translation();
     double d2 = 0.0;
-    if (!reference.tree.Nearest(pair.world, &pair.ref, &d2) || d2 > max_d2) continue;
+    if (!reference.tree.Nearest(pair.world, &pair.ref, &d2, max_d2)) continue;
     if (reference.to_line()) {
       const Eigen::Vector2d& n = reference.normals[pair.ref];
       if (n.isZero()) continue;

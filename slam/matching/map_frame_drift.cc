@@ -41,7 +41,7 @@ std::vector<Eigen::Matrix3d> KeyframeInformations(const LocalMapPoints& map,
   for (const Eigen::Vector2d& q : scan) {
     std::uint32_t i = 0;
     double distance2 = 0.0;
-    if (!matcher.tree().Nearest(q, &i, &distance2) || distance2 > max_distance_m * max_distance_m) {
+    if (!matcher.tree().Nearest(q, &i, &distance2, max_distance_m * max_distance_m)) {
       continue;
     }
     informations[static_cast<std::size_t>(map.keyframe[i])] +=

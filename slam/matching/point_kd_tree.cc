@@ -1,6 +1,8 @@
 #include "slam/matching/point_kd_tree.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <nanoflann.hpp>
 
 namespace slamrig::slam {
@@ -49,14 +51,42 @@ PointKdTree& PointKdTree::operator=(PointKdTree&& other) noexcept {
   return *this;
 }
 
-bool PointKdTree::Nearest(const Eigen::Vector2d& query, std::uint32_t* index,
-                          double* distance2) const {
-  if (points_.empty()) return false;
-  nanoflann::KNNResultSet<double, std::uint32_t> result(1);
-  result.init(index, distance2);
+// nanoflann's result-set interface for the one nearest point closer than a bound: the search
+// visits only branches that may hold a point closer than worstDist(), and a leaf offers a point
+// only when it is closer than that (KNNResultSet of capacity 1, started at the bound).
+class NearestWithin {
+ public:
+  explicit NearestWithin(double bound) : worst_(bound) {}
+  double worstDist() const { return worst_; }
+  bool addPoint(double distance2, std::uint32_t index) {
+    if (distance2 < worst_) {
+      worst_ = distance2;
+      index_ = index;
+      found_ = true;
+    }
+    return true;
+  }
+  bool full() const { return found_; }
+  std::uint32_t index() const { return index_; }
+
+ private:
+  double worst_;
+  std::uint32_t index_ = 0;
+  bool found_ = false;
+};
+
+bool PointKdTree::Nearest(const Eigen::Vector2d& query, std::uint32_t* index, double* distance2,
+                          double max_distance2) const {
+  if (points_.empty() || !(max_distance2 >= 0.0)) return false;
+  // A point at exactly the bound is within it: offered points must be strictly closer than the
+  // next double up.
+  NearestWithin result(std::nextafter(max_distance2, std::numeric_limits<double>::infinity()));
   const double q[2] = {query.x(), query.y()};
   index_->tree.findNeighbors(result, q, nanoflann::SearchParams());
-  return result.size() == 1;
+  if (!result.full()) return false;
+  *index = result.index();
+  *distance2 = result.worstDist();
+  return true;
 }
 
 void PointKdTree::KNearest(const Eigen::Vector2d& query, int k, std::vector<std::uint32_t>* indices,

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -24,8 +25,10 @@ class PointKdTree {
   std::size_t size() const { return points_.size(); }
 
   /// Index of the point nearest to `query` and its squared distance, through `index` and
-  /// `distance2`; false when the set is empty.
-  bool Nearest(const Eigen::Vector2d& query, std::uint32_t* index, double* distance2) const;
+  /// `distance2`; false when no point lies within `max_distance2` (squared, inclusive) of it. The
+  /// bound prunes the search; the point found within it is the unbounded search's.
+  bool Nearest(const Eigen::Vector2d& query, std::uint32_t* index, double* distance2,
+               double max_distance2 = std::numeric_limits<double>::infinity()) const;
 
   /// Up to `k` nearest points to `query`, nearest first, into `indices` and `distances2`
   /// (resized to the number found).

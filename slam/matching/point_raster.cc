@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -22,19 +23,27 @@ PointRaster RasterOf(const std::vector<Eigen::Vector2d>& points, double resoluti
   hi += Eigen::Vector2d::Constant(margin);
   const int width = static_cast<int>(std::ceil((hi.x() - lo.x()) / resolution_m));
   const int height = static_cast<int>(std::ceil((hi.y() - lo.y()) / resolution_m));
-  raster.values.assign(static_cast<std::size_t>(width) * height, 0.0f);
-  const double inv_two_var = 1.0 / (2.0 * sigma_m * sigma_m);
+  // A cell's value is the largest exp(-d^2 / (2 sigma^2)) over the points within reach, d the
+  // distance from the cell's centre: the exp (monotone) of the smallest d^2, taken once per cell
+  // rather than once per point and cell.
+  std::vector<double> nearest(static_cast<std::size_t>(width) * height,
+                              std::numeric_limits<double>::infinity());
   for (const Eigen::Vector2d& p : points) {
     const int cx = static_cast<int>(std::floor((p.x() - lo.x()) / resolution_m));
     const int cy = static_cast<int>(std::floor((p.y() - lo.y()) / resolution_m));
     for (int iy = std::max(0, cy - reach); iy <= std::min(height - 1, cy + reach); ++iy) {
       for (int ix = std::max(0, cx - reach); ix <= std::min(width - 1, cx + reach); ++ix) {
         const Eigen::Vector2d center = lo + resolution_m * Eigen::Vector2d(ix + 0.5, iy + 0.5);
-        const auto value = static_cast<float>(std::exp(-(center - p).squaredNorm() * inv_two_var));
-        float& cell = raster.values[static_cast<std::size_t>(iy) * width + ix];
-        cell = std::max(cell, value);
+        double& d2 = nearest[static_cast<std::size_t>(iy) * width + ix];
+        d2 = std::min(d2, (center - p).squaredNorm());
       }
     }
+  }
+  const double inv_two_var = 1.0 / (2.0 * sigma_m * sigma_m);
+  raster.values.assign(nearest.size(), 0.0f);
+  for (std::size_t c = 0; c < nearest.size(); ++c) {
+    if (nearest[c] == std::numeric_limits<double>::infinity()) continue;
+    raster.values[c] = std::max(0.0f, static_cast<float>(std::exp(-nearest[c] * inv_two_var)));
   }
   raster.view = GridView{raster.values.data(), width, height, lo, resolution_m};
   return raster;
