@@ -16,6 +16,7 @@
 #include <initializer_list>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
 #include <thread>
 
 #include "slam/types/interrupt.h"
@@ -143,6 +144,23 @@ Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& optio
   std::vector<char*> argv;
   for (auto& a : argv_text) argv.push_back(a.data());
   argv.push_back(nullptr);
+  // The child's environment: this process's, with `options.environment` on top.
+  std::vector<std::string> env_text = options.environment;
+  std::vector<char*> envp;
+  if (!options.environment.empty()) {
+    auto overridden = [&](std::string_view entry) {
+      const std::string_view name = entry.substr(0, entry.find('='));
+      return std::any_of(
+          options.environment.begin(), options.environment.end(),
+          [&](const std::string& e) { return std::string_view(e).substr(0, e.find('=')) == name; });
+    };
+    for (char** e = environ; *e != nullptr; ++e) {
+      if (!overridden(*e)) envp.push_back(*e);
+    }
+    for (auto& e : env_text) envp.push_back(e.data());
+    envp.push_back(nullptr);
+  }
+  char** const child_environ = options.environment.empty() ? environ : envp.data();
   const std::string exec_failed =
       "cannot start " + (args.empty() ? std::string() : args.front()) + ": exec failed\n";
   const std::string chdir_failed = "cannot enter " + options.working_dir + "\n";
@@ -192,9 +210,9 @@ Child SpawnChild(const std::vector<std::string>& args, const SpawnOptions& optio
     if (!options.working_dir.empty() && ::chdir(options.working_dir.c_str()) != 0)
       fail(chdir_failed);
     if (options.search_path) {
-      ::execvp(argv[0], argv.data());
+      ::execvpe(argv[0], argv.data(), child_environ);
     } else {
-      ::execv(argv[0], argv.data());
+      ::execve(argv[0], argv.data(), child_environ);
     }
     fail(exec_failed);
   }

@@ -73,6 +73,9 @@ struct SpawnOptions {
   /// Its stdin and stdout are pipes to this process (Child::stdin_fd, Child::stdout_fd; the
   /// caller closes them); stdout_path and null_stdin are then unused.
   bool pipe_stdio = false;
+  /// "NAME=value" entries that the child's environment has on top of this process's (replacing
+  /// a variable of the same name).
+  std::vector<std::string> environment;
 };
 
 /// SpawnChild with the choices of `options`. A program that cannot be started exits with code

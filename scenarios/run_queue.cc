@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -15,11 +16,13 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "scenarios/child_process.h"
 #include "scenarios/slurm_sweep.h"
 #include "scenarios/sweep_summary.h"
 #include "slam/io/atomic_file.h"
+#include "slam/pf/thread_pool.h"
 #include "slam/types/error.h"
 #include "slam/types/interrupt.h"
 
@@ -49,14 +52,23 @@ void AppendLine(int fd, const std::string& line, const std::string& path) {
 }
 
 // Starts run `index` with its stdout in its folder's log.txt (stderr through a pipe, see Child).
-Child SpawnRun(const RunQueueSpec& spec, const RunQueueOptions& options, std::size_t index) {
+Child SpawnRun(const RunQueueSpec& spec, const RunQueueOptions& options, std::size_t index,
+               int jobs) {
   namespace fs = std::filesystem;
   const QueuedRun& run = spec.runs[index];
   fs::create_directories(run.dir);
   fs::remove(fs::path(run.dir) / "metrics.json");
   std::vector<std::string> args = {options.slamrig_binary};
   args.insert(args.end(), run.args.begin(), run.args.end());
-  Child child = SpawnChild(args, run.dir + "/log.txt", index);
+  SpawnOptions spawn;
+  spawn.stdout_path = run.dir + "/log.txt";
+  // Parallel runs share the processors: each estimator's default thread count is its share,
+  // unless the user chose one for all (the same results either way).
+  if (std::getenv("SLAMRIG_THREADS") == nullptr) {
+    spawn.environment = {"SLAMRIG_THREADS=" +
+                         std::to_string(std::max(1, slam::AvailableProcessors() / jobs))};
+  }
+  Child child = SpawnChild(args, spawn, index);
   if (options.timeout_s > 0.0) {
     child.deadline = child.start + std::chrono::duration_cast<Clock::duration>(
                                        std::chrono::duration<double>(options.timeout_s));
@@ -222,9 +234,7 @@ RunQueueSummary RunQueue(const RunQueueSpec& spec, const RunQueueOptions& option
     return summary;
   }
 
-  const int jobs = options.jobs > 0
-                       ? options.jobs
-                       : std::max(1, static_cast<int>(::sysconf(_SC_NPROCESSORS_ONLN)));
+  const int jobs = options.jobs > 0 ? options.jobs : slam::AvailableProcessors();
   Children running;
   std::size_t next = 0;
   int finished_now = 0;
@@ -232,7 +242,7 @@ RunQueueSummary RunQueue(const RunQueueSpec& spec, const RunQueueOptions& option
   progress.Report(finished_now, running.size(), summary.failed);
   while (next < todo.size() || !running.empty()) {
     while (next < todo.size() && static_cast<int>(running.size()) < jobs && InterruptSignal() == 0)
-      running.Add(SpawnRun(spec, options, todo[next++]));
+      running.Add(SpawnRun(spec, options, todo[next++], jobs));
     const auto ended = running.WaitAny();
     // SIGINT/SIGTERM: `running` stops the children on the way out, and their rows stay missing.
     ThrowIfInterrupted();
@@ -267,7 +277,7 @@ RunQueueSummary RunQueue(const RunQueueSpec& spec, const RunQueueOptions& option
 
 bool RunQueueRow(const RunQueueSpec& spec, const RunQueueOptions& options, std::size_t row) {
   Children running;
-  running.Add(SpawnRun(spec, options, row));
+  running.Add(SpawnRun(spec, options, row, /*jobs=*/1));
   const auto ended = running.WaitAny();
   // scancel: SIGTERM to the task and its child; no row file, so a resumed study runs it again.
   ThrowIfInterrupted();

@@ -4,11 +4,16 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <set>
+#include <string>
+#include <vector>
 
+#include "slam/pf/thread_pool.h"
 #include "slam/types/error.h"
 #include "tests/util/temp_dir.h"
 
@@ -103,6 +108,50 @@ TEST(SweepTest, RunsEveryRunOnceAndResumesAfterAKill) {
   const std::string html{std::istreambuf_iterator<char>(summary), std::istreambuf_iterator<char>()};
   EXPECT_THAT(html, ::testing::HasSubstr("<table class=\"heat\">"));
   EXPECT_FALSE(std::filesystem::exists(resumed.dir.File("out/summary_pf.ate_rmse_m__a.noise.png")));
+}
+
+// Runs in parallel share the processors: each child's SLAMRIG_THREADS is its share (the default
+// thread count of its estimators), unless the user set one; the rest of the environment passes.
+TEST(SweepTest, ParallelRunsGetTheirShareOfTheProcessors) {
+  const char* saved = std::getenv("SLAMRIG_THREADS");
+  const std::string restore = saved != nullptr ? saved : "";
+  ::setenv("SLAMRIG_SWEEP_TEST_MARK", "0.5", 1);
+  for (const bool user_set : {false, true}) {
+    if (user_set) {
+      ::setenv("SLAMRIG_THREADS", "7", 1);
+    } else {
+      ::unsetenv("SLAMRIG_THREADS");
+    }
+    Fixture f;
+    const std::string runner = f.dir.Write("threads_runner.sh", R"sh(#!/bin/sh
+out=""
+while [ $# -gt 0 ]; do
+  case "$1" in --out) out="$2"; shift 2;; *) shift;; esac
+done
+printf '{"passed": true, "configs": {"pf": {"ate_rmse_m": %s, "name": "pf"}}}\n' \
+  "$(awk "BEGIN { print $SLAMRIG_THREADS + $SLAMRIG_SWEEP_TEST_MARK }")" > "$out/metrics.json"
+)sh");
+    ::chmod(runner.c_str(), 0755);
+    f.options.slamrig_binary = runner;
+    f.options.jobs = 2;
+    f.spec = LoadSweepSpec(f.dir.Write("two_runs.yaml",
+                                       "scenario: scenario.yaml\nseeds: 2\nparameters:\n"
+                                       "  a.noise: [1]\nmetrics: [pf.ate_rmse_m]\n"));
+    EXPECT_EQ(RunSweep(f.spec, f.options).failed, 0);
+    const int threads = user_set ? 7 : std::max(1, slam::AvailableProcessors() / 2);
+    const std::vector<std::string> lines = f.Lines();
+    ASSERT_EQ(lines.size(), 3u);
+    for (std::size_t k = 1; k < lines.size(); ++k) {
+      EXPECT_THAT(lines[k], ::testing::HasSubstr(",pass," + std::to_string(threads) + ".5,"))
+          << lines[k];
+    }
+  }
+  ::unsetenv("SLAMRIG_SWEEP_TEST_MARK");
+  if (saved != nullptr) {
+    ::setenv("SLAMRIG_THREADS", restore.c_str(), 1);
+  } else {
+    ::unsetenv("SLAMRIG_THREADS");
+  }
 }
 
 // A sweep run again over a complete results.csv runs nothing and still counts the runs that

@@ -66,7 +66,9 @@ ParticleFilter::ParticleFilter(const ParticleFilterOptions& options)
       rng_(options.seed),
       calibration_(options.odometry_calibration) {
   SLAMRIG_CHECK_VALID(options_, "ParticleFilterOptions");
-  if (options_.num_threads > 1) pool_ = std::make_unique<ThreadPool>(options_.num_threads);
+  if (const int threads = ThreadCount(options_.num_threads); threads > 1) {
+    pool_ = std::make_unique<ThreadPool>(threads);
+  }
   const int n = options_.num_particles;
   particles_.assign(static_cast<std::size_t>(n), Particle{Pose2(), 1.0 / n});
   log_weights_.assign(static_cast<std::size_t>(n), 0.0);

@@ -79,7 +79,7 @@ std::vector<std::string> ParticleFilterOptions::Validate() const {
                degeneracy_ratio, "must be in [0, 1)")
       .Require(max_incidence_rad > 0.0 && max_incidence_rad <= 1.5707963267948966,
                "max_incidence_rad", max_incidence_rad, "must be in (0, pi/2]")
-      .AtLeast("threads", num_threads, 1);
+      .InRange("threads", num_threads, 0, 1024);
   rules.Nested("rot_trans_rot", rot_trans_rot.Validate())
       .Nested("odometry_calibration", odometry_calibration.Validate())
       .Nested("points", points.Validate())

@@ -216,8 +216,9 @@ struct ParticleFilterOptions {
   double min_update_distance_m = 0.25;
   double min_update_angle_rad = 0.1;
 
-  /// Worker threads for the per-particle scoring (results do not depend on it).
-  int num_threads = 1;
+  /// Worker threads for the per-particle scoring (results do not depend on it); 0: one per
+  /// processor this process may use, or SLAMRIG_THREADS (DefaultThreadCount).
+  int num_threads = 0;
 
   /// The ECE276A reports' method: Gaussian prediction noise, all beams, 9x9 x/y shifts, no yaw
   /// shift, softmax of correlations, stratified resampling at Neff < N/2, particles not moved,

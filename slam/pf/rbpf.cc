@@ -29,7 +29,9 @@ RbpfPoseNode::~RbpfPoseNode() {
 Rbpf::Rbpf(const RbpfOptions& options)
     : options_(options), matcher_(options.matcher), rng_(options.seed) {
   SLAMRIG_CHECK_VALID(options_, "RbpfOptions");
-  if (options_.num_threads > 1) pool_ = std::make_unique<ThreadPool>(options_.num_threads);
+  if (const int threads = ThreadCount(options_.num_threads); threads > 1) {
+    pool_ = std::make_unique<ThreadPool>(threads);
+  }
 }
 
 void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,

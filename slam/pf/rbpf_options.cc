@@ -42,7 +42,7 @@ std::vector<std::string> RbpfOptions::Validate() const {
                "must be 0 for the rbpf")
       .NonNegative("min_update_distance_m", min_update_distance_m)
       .NonNegative("min_update_angle_rad", min_update_angle_rad)
-      .AtLeast("threads", num_threads, 1);
+      .InRange("threads", num_threads, 0, 1024);
   return rules.errors();
 }
 

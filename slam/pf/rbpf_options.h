@@ -121,7 +121,9 @@ struct RbpfOptions {
   double min_update_distance_m = 0.25;
   double min_update_angle_rad = 0.1;
 
-  int num_threads = 1;  ///< worker threads for the per-particle work (results do not depend on it)
+  /// Worker threads for the per-particle work (results do not depend on it); 0: one per
+  /// processor this process may use, or SLAMRIG_THREADS (DefaultThreadCount).
+  int num_threads = 0;
 
   /// One message per broken rule, e.g. "particles = 0; must be > 0".
   std::vector<std::string> Validate() const;

@@ -1,6 +1,15 @@
 #include "slam/pf/thread_pool.h"
 
+#include <sched.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
 #include "slam/types/check.h"
+#include "slam/types/error.h"
 
 namespace slamrig::slam {
 namespace {
@@ -13,6 +22,29 @@ std::pair<int, int> Block(int n, int parts, int k) {
 }
 
 }  // namespace
+
+int AvailableProcessors() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (::sched_getaffinity(0, sizeof(set), &set) == 0) return std::max(1, CPU_COUNT(&set));
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+int DefaultThreadCount() {
+  if (const char* text = std::getenv("SLAMRIG_THREADS"); text != nullptr) {
+    int value = 0;
+    const char* end = text + std::strlen(text);
+    const auto [ptr, error] = std::from_chars(text, end, value);
+    if (error != std::errc() || ptr != end || value < 1 || value > 1024) {
+      throw ConfigError(std::string("SLAMRIG_THREADS=") + text +
+                        ": must be a whole number from 1 to 1024 (the threads of threads: 0)");
+    }
+    return value;
+  }
+  return AvailableProcessors();
+}
+
+int ThreadCount(int requested) { return requested >= 1 ? requested : DefaultThreadCount(); }
 
 ThreadPool::ThreadPool(int num_threads) {
   SLAMRIG_CHECK(num_threads >= 1, "ThreadPool needs at least one thread");

@@ -9,6 +9,19 @@
 
 namespace slamrig::slam {
 
+/// The processors this process may run on: its CPU affinity (all of a workstation's, a Slurm
+/// task's allocation, a taskset's), at least 1.
+int AvailableProcessors();
+
+/// The threads that a `threads: 0` setting (the pf's and the rbpf's default) runs on:
+/// SLAMRIG_THREADS when it is set (a whole number from 1 to 1024; the run queue sets it so that
+/// its parallel runs share the machine), else AvailableProcessors(). Throws ConfigError
+/// naming SLAMRIG_THREADS when its value is not such a number.
+int DefaultThreadCount();
+
+/// `requested` when it is >= 1, else DefaultThreadCount().
+int ThreadCount(int requested);
+
 /// A fixed set of worker threads for data-parallel loops. `ParallelFor` splits [0, n) into one
 /// contiguous block per thread (the caller runs the first) and returns when all are done. Which
 /// thread runs which index never changes a result as long as iterations are independent.

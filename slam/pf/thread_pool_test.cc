@@ -1,8 +1,13 @@
 #include "slam/pf/thread_pool.h"
 
 #include <gtest/gtest.h>
+#include <sched.h>
 
 #include <atomic>
+#include <cstdlib>
+#include <string>
+
+#include "slam/types/error.h"
 
 namespace slamrig::slam {
 namespace {
@@ -20,6 +25,39 @@ TEST(ThreadPoolTest, ParallelForVisitsEveryIndexExactlyOnce) {
       for (int i = 0; i < n; ++i)
         ASSERT_EQ(hits[static_cast<std::size_t>(i)].load(), 3) << threads << " " << n;
     }
+  }
+}
+
+// The default thread count: the processors of this process's affinity, or SLAMRIG_THREADS when
+// set; a bad SLAMRIG_THREADS is a ConfigError that names it.
+TEST(ThreadPoolTest, ThreadsZeroMeansTheProcessorsOrSlamrigThreads) {
+  const char* saved = std::getenv("SLAMRIG_THREADS");
+  const std::string restore = saved != nullptr ? saved : "";
+  ::unsetenv("SLAMRIG_THREADS");
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  ASSERT_EQ(::sched_getaffinity(0, sizeof(set), &set), 0);
+  EXPECT_EQ(AvailableProcessors(), CPU_COUNT(&set));
+  EXPECT_EQ(ThreadCount(0), CPU_COUNT(&set));
+  EXPECT_EQ(ThreadCount(3), 3);
+  ::setenv("SLAMRIG_THREADS", "5", 1);
+  EXPECT_EQ(ThreadCount(0), 5);
+  EXPECT_EQ(ThreadCount(2), 2);
+  for (const char* bad : {"0", "-1", "abc", "5x", "", "1025", "99999999999"}) {
+    ::setenv("SLAMRIG_THREADS", bad, 1);
+    try {
+      ThreadCount(0);
+      ADD_FAILURE() << "accepted SLAMRIG_THREADS=" << bad;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("SLAMRIG_THREADS=") + bad + ":"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  if (saved != nullptr) {
+    ::setenv("SLAMRIG_THREADS", restore.c_str(), 1);
+  } else {
+    ::unsetenv("SLAMRIG_THREADS");
   }
 }
 
