@@ -12,13 +12,13 @@ namespace slamrig::slam {
 namespace {
 
 constexpr int kP = EkfSlam::kPoseDim;
-constexpr int kBias = 3;
+constexpr int kStateBias = 3;
 
 // PoseEkf's state: clone (0-2), pose (3-5), gyro bias (6), gyro scale error (7), matcher frame
 // (8-10); EKF-SLAM uses the pose and gyro block (3-7) and leaves the others at zero.
-constexpr int kN = PoseEkf::kStateSize;
-using MatrixNd = Eigen::Matrix<double, kN, kN>;
-using VectorNd = Eigen::Matrix<double, kN, 1>;
+constexpr int kMotionN = PoseEkf::kStateSize;
+using MotionMatrix = Eigen::Matrix<double, kMotionN, kMotionN>;
+using MotionVector = Eigen::Matrix<double, kMotionN, 1>;
 
 int LandmarkRow(int j) { return kP + 2 * j; }
 
@@ -71,8 +71,10 @@ EkfSlam::EkfSlam(const EkfSlamOptions& options)
       probe_gyro_(options.motion) {
   SLAMRIG_CHECK_VALID(options, "EkfSlamOptions");
   // PoseEkf's prior on the gyro states.
-  p_(kBias, kBias) = options.motion.gyro_bias_sigma_rad_s * options.motion.gyro_bias_sigma_rad_s;
-  p_(kBias + 1, kBias + 1) = options.motion.gyro_scale_sigma * options.motion.gyro_scale_sigma;
+  p_(kStateBias, kStateBias) =
+      options.motion.gyro_bias_sigma_rad_s * options.motion.gyro_bias_sigma_rad_s;
+  p_(kStateBias + 1, kStateBias + 1) =
+      options.motion.gyro_scale_sigma * options.motion.gyro_scale_sigma;
 }
 
 void EkfSlam::ResetPose(const Pose2& pose) {
@@ -83,21 +85,21 @@ void EkfSlam::ResetPose(const Pose2& pose) {
 
 template <typename Step>
 void EkfSlam::Predict(const Step& step) {
-  VectorNd x = VectorNd::Zero();
-  x.head<8>() << x_.head<3>(), x_.head<3>(), x_(kBias), x_(kBias + 1);
+  MotionVector x = MotionVector::Zero();
+  x.head<8>() << x_.head<3>(), x_.head<3>(), x_(kStateBias), x_(kStateBias + 1);
   // The filter proper: no clone, the pose and gyro states' covariance.
-  MatrixNd p = MatrixNd::Zero();
+  MotionMatrix p = MotionMatrix::Zero();
   p.block<5, 5>(3, 3) = p_.topLeftCorner<5, 5>();
   motion_.SetState(x, p);
   // Probe 1: clone == pose with unit covariance, so cov(pose', clone) = F[:, pose].
-  MatrixNd a = MatrixNd::Zero();
+  MotionMatrix a = MotionMatrix::Zero();
   a.topLeftCorner<3, 3>().setIdentity();
   a.block<3, 3>(0, 3).setIdentity();
   a.block<3, 3>(3, 0).setIdentity();
   a.block<3, 3>(3, 3).setIdentity();
   probe_pose_.SetState(x, a);
   // Probe 2: clone x == bias, clone y == scale, so cov(state', clone xy) = F[:, bias, scale].
-  MatrixNd b = MatrixNd::Zero();
+  MotionMatrix b = MotionMatrix::Zero();
   b(0, 0) = b(0, 6) = b(6, 0) = b(6, 6) = 1.0;
   b(1, 1) = b(1, 7) = b(7, 1) = b(7, 7) = 1.0;
   probe_gyro_.SetState(x, b);
@@ -134,12 +136,12 @@ void EkfSlam::PredictIncrement(const Pose2& increment, double distance_m, double
 double EkfSlam::UpdateZeroRate(double rate_rad_s) {
   const int n = static_cast<int>(x_.size());
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(1, n);
-  h(0, kBias) = 1.0;
+  h(0, kStateBias) = 1.0;
   Eigen::MatrixXd r(1, 1);
   r << options_.motion.gyro_sigma_rad_s * options_.motion.gyro_sigma_rad_s;
-  const double innovation = rate_rad_s - x_(kBias);
-  const double s = p_(kBias, kBias) + r(0, 0);
-  const Eigen::MatrixXd k = p_.col(kBias) / s;
+  const double innovation = rate_rad_s - x_(kStateBias);
+  const double s = p_(kStateBias, kStateBias) + r(0, 0);
+  const Eigen::MatrixXd k = p_.col(kStateBias) / s;
   x_ += k * innovation;
   x_(2) = NormalizeAngle(x_(2));
   p_ = JosephUpdate(p_, k, h, r);

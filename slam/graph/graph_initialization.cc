@@ -59,8 +59,6 @@ class BlockLeastSquares {
   std::vector<Eigen::Triplet<double>> triplets_;
 };
 
-Eigen::Matrix2d Rotation(double theta) { return Eigen::Rotation2Dd(theta).toRotationMatrix(); }
-
 // Vertices reachable from an anchor through edges (either direction).
 std::vector<bool> ReachableFromAnchors(const PoseGraph& graph) {
   const std::size_t n = graph.vertices().size();
@@ -152,7 +150,7 @@ InitializationSummary InitializeChordal(PoseGraph* graph) {
     const std::size_t a = graph->IndexOf(e.from), b = graph->IndexOf(e.to);
     if (!reached[a]) continue;
     const double rotation_information = 1.0 / e.information.inverse()(2, 2);
-    rotations.Add(a, -Rotation(e.measurement.theta()), b, Eigen::Matrix2d::Identity(),
+    rotations.Add(a, -RotationMatrix(e.measurement.theta()), b, Eigen::Matrix2d::Identity(),
                   Eigen::Vector2d::Zero(), rotation_information * Eigen::Matrix2d::Identity());
   }
   const Eigen::VectorXd cs = rotations.Solve();
@@ -171,7 +169,7 @@ InitializationSummary InitializeChordal(PoseGraph* graph) {
   for (const PoseGraphEdge& e : graph->edges()) {
     const std::size_t a = graph->IndexOf(e.from), b = graph->IndexOf(e.to);
     if (!reached[a]) continue;
-    const Eigen::Matrix2d rt = Rotation(theta[a]).transpose();
+    const Eigen::Matrix2d rt = RotationMatrix(theta[a]).transpose();
     translations.Add(a, -rt, b, rt, e.measurement.translation(),
                      e.information.topLeftCorner<2, 2>());
   }

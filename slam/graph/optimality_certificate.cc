@@ -21,8 +21,6 @@ namespace {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
-Eigen::Matrix2d Rotation(double theta) { return Eigen::Rotation2Dd(theta).toRotationMatrix(); }
-
 // The largest absolute row sum: a bound on every eigenvalue's magnitude (Gershgorin).
 double GershgorinBound(const SparseMatrix& s) {
   Eigen::VectorXd row_sums = Eigen::VectorXd::Zero(s.rows());
@@ -65,7 +63,7 @@ double IsotropicCostAndDerivatives(const std::vector<IsotropicEdge>& edges,
   for (const IsotropicEdge& e : edges) {
     const std::size_t a = e.a, b = e.b;
     const IsotropicWeights& wt = e.w;
-    const Eigen::Vector2d w = Rotation(x[a].z()) * e.z;
+    const Eigen::Vector2d w = RotationMatrix(x[a].z()) * e.z;
     const Eigen::Vector2d u(-w.y(), w.x());
     const Eigen::Vector2d d = x[b].head<2>() - x[a].head<2>() - w;
     const double angle = x[b].z() - x[a].z() - e.theta;
@@ -182,7 +180,7 @@ Eigen::MatrixXd StackedPosesTransposed(const PoseGraph& graph) {
   for (std::size_t i = 0; i < n; ++i) {
     const Pose2& p = graph.vertices()[i].pose;
     xt.row(3 * i) = p.translation().transpose();
-    xt.block<2, 2>(3 * i + 1, 0) = Rotation(p.theta()).transpose();
+    xt.block<2, 2>(3 * i + 1, 0) = RotationMatrix(p.theta()).transpose();
   }
   return xt;
 }
@@ -219,7 +217,7 @@ double SeSyncCost(const PoseGraph& graph) {
     const Pose2& b = graph.pose(e.to);
     const double angle = b.theta() - a.theta() - e.measurement.theta();
     const Eigen::Vector2d dt =
-        b.translation() - a.translation() - Rotation(a.theta()) * e.measurement.translation();
+        b.translation() - a.translation() - RotationMatrix(a.theta()) * e.measurement.translation();
     f += w.kappa * 4.0 * (1.0 - std::cos(angle)) + w.tau * dt.squaredNorm();
   }
   return f;
@@ -242,7 +240,7 @@ SparseMatrix SeSyncDataMatrix(const PoseGraph& graph) {
     }
     // Rotation: kappa |R_j row - R_ij^T R_i row|^2: kappa I on both diagonal blocks,
     // -kappa R_ij at (i, j) and its transpose at (j, i).
-    const Eigen::Matrix2d rij = Rotation(e.measurement.theta());
+    const Eigen::Matrix2d rij = RotationMatrix(e.measurement.theta());
     for (int r = 0; r < 2; ++r) {
       triplets.emplace_back(i + 1 + r, i + 1 + r, w.kappa);
       triplets.emplace_back(j + 1 + r, j + 1 + r, w.kappa);
