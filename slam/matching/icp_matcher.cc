@@ -49,7 +49,7 @@ Eigen::Matrix3d FlooredInverse(const Eigen::Matrix3d& h) {
 struct Reference {
   const IcpOptions& options;
   const PointKdTree& tree;
-  const std::vector<Eigen::Vector2d>& normals;
+  const IcpMatcher& matcher;  // Normal(i)
   bool to_line() const { return options.metric == IcpMetric::kPointToLine; }
 };
 
@@ -79,7 +79,7 @@ int Associate(const Reference& reference, std::span<const Eigen::Vector2d> sourc
     double d2 = 0.0;
     if (!reference.tree.Nearest(pair.world, &pair.ref, &d2, max_d2)) continue;
     if (reference.to_line()) {
-      const Eigen::Vector2d& n = reference.normals[pair.ref];
+      const Eigen::Vector2d n = reference.matcher.Normal(pair.ref);
       if (n.isZero()) continue;
       pair.residual = n.dot(pair.world - ref[pair.ref]);
     } else {
@@ -110,7 +110,7 @@ NormalEquations Accumulate(const Reference& reference, const std::vector<Pair>& 
     const double w = RobustWeight(reference.options, pair.residual);
     const Eigen::Vector2d dyaw = Perp(pair.rotated);
     if (reference.to_line()) {
-      const Eigen::Vector2d& n = reference.normals[pair.ref];
+      const Eigen::Vector2d n = reference.matcher.Normal(pair.ref);
       const Eigen::Vector3d j(n.x(), n.y(), n.dot(dyaw));
       eq.h += w * j * j.transpose();
       eq.g += w * j * pair.residual;
@@ -189,39 +189,49 @@ std::vector<std::string> IcpOptions::Validate() const {
 IcpMatcher::IcpMatcher(const IcpOptions& options, std::vector<Eigen::Vector2d> reference)
     : options_(options), tree_(std::move(reference)) {
   SLAMRIG_CHECK_VALID(options_, "IcpOptions");
-  if (options_.metric != IcpMetric::kPointToLine) return;
-  // Normals: the minor principal axis of each point's neighbourhood.
+  if (!has_normals()) return;
+  normals_.assign(tree_.size(), Eigen::Vector2d::Zero());
+  normal_once_ = std::make_unique<std::once_flag[]>(tree_.size());
+}
+
+Eigen::Vector2d IcpMatcher::Normal(std::uint32_t i) const {
+  if (!has_normals()) return Eigen::Vector2d::Zero();
+  SLAMRIG_CHECK(i < normals_.size(), "IcpMatcher::Normal: no such reference point");
+  std::call_once(normal_once_[i], [&] { normals_[i] = ComputeNormal(i); });
+  return normals_[i];
+}
+
+// The minor principal axis of the point's neighbourhood: its normal_neighbors nearest points
+// within normal_radius_m (itself included); none for fewer than 3.
+Eigen::Vector2d IcpMatcher::ComputeNormal(std::uint32_t i) const {
   const auto& points = tree_.points();
-  normals_.assign(points.size(), Eigen::Vector2d::Zero());
   std::vector<std::uint32_t> indices;
   std::vector<double> distances2;
   const double radius2 = options_.normal_radius_m * options_.normal_radius_m;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    tree_.KNearest(points[i], options_.normal_neighbors, &indices, &distances2);
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    int n = 0;
-    for (std::size_t k = 0; k < indices.size(); ++k) {
-      if (distances2[k] > radius2) break;
-      mean += points[indices[k]];
-      ++n;
-    }
-    if (n < 3) continue;
-    mean /= n;
-    Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
-    for (int k = 0; k < n; ++k) {
-      const Eigen::Vector2d d = points[indices[static_cast<std::size_t>(k)]] - mean;
-      scatter += d * d.transpose();
-    }
-    // Closed-form eigenvector of the smaller eigenvalue of the symmetric 2x2 scatter matrix:
-    // the major axis has angle 0.5 atan2(2 sxy, sxx - syy); the normal is perpendicular to it.
-    const double major = 0.5 * std::atan2(2.0 * scatter(0, 1), scatter(0, 0) - scatter(1, 1));
-    normals_[i] = Eigen::Vector2d(-std::sin(major), std::cos(major));
+  tree_.KNearest(points[i], options_.normal_neighbors, &indices, &distances2);
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  int n = 0;
+  for (std::size_t k = 0; k < indices.size(); ++k) {
+    if (distances2[k] > radius2) break;
+    mean += points[indices[k]];
+    ++n;
   }
+  if (n < 3) return Eigen::Vector2d::Zero();
+  mean /= n;
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector2d d = points[indices[static_cast<std::size_t>(k)]] - mean;
+    scatter += d * d.transpose();
+  }
+  // Closed-form eigenvector of the smaller eigenvalue of the symmetric 2x2 scatter matrix: the
+  // major axis has angle 0.5 atan2(2 sxy, sxx - syy); the normal is perpendicular to it.
+  const double major = 0.5 * std::atan2(2.0 * scatter(0, 1), scatter(0, 0) - scatter(1, 1));
+  return Eigen::Vector2d(-std::sin(major), std::cos(major));
 }
 
 std::optional<MatchResult> IcpMatcher::Match(std::span<const Eigen::Vector2d> source,
                                              const Pose2& reference_from_source_guess) const {
-  const Reference reference{options_, tree_, normals_};
+  const Reference reference{options_, tree_, *this};
   std::vector<Pair> pairs;
   pairs.reserve(source.size());
   std::vector<double> scratch;

@@ -1,6 +1,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -84,8 +87,11 @@ class IcpMatcher {
   const std::vector<Eigen::Vector2d>& reference() const { return tree_.points(); }
   /// The k-d tree over reference(), in its order.
   const PointKdTree& tree() const { return tree_; }
-  /// Unit normals of the reference points ((0, 0) where there is none); empty for point-to-point.
-  const std::vector<Eigen::Vector2d>& normals() const { return normals_; }
+  /// Whether the reference points have normals (point-to-line).
+  bool has_normals() const { return options_.metric == IcpMetric::kPointToLine; }
+  /// The unit normal of reference point `i` ((0, 0) where it has none, and for point-to-point).
+  /// Computed when first asked for (a match asks only for its pairs' points), once; thread-safe.
+  Eigen::Vector2d Normal(std::uint32_t i) const;
 
   /// Aligns `source` (points in the source's own frame) to the reference from
   /// `reference_from_source_guess`. Fails (std::nullopt) when an iteration has fewer than
@@ -102,9 +108,14 @@ class IcpMatcher {
                                                const Pose2& reference_from_source_guess);
 
  private:
+  Eigen::Vector2d ComputeNormal(std::uint32_t i) const;
+
   IcpOptions options_;
   PointKdTree tree_;
-  std::vector<Eigen::Vector2d> normals_;
+  // Point-to-line: one normal and one once-flag per reference point, the normal written by the
+  // first caller of Normal(i).
+  mutable std::vector<Eigen::Vector2d> normals_;
+  std::unique_ptr<std::once_flag[]> normal_once_;
 };
 
 }  // namespace slamrig::slam

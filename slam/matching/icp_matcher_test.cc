@@ -3,9 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+#include <thread>
+#include <utility>
+#include <vector>
 
 #include "slam/matching/testing/segment_world.h"
+#include "slam/odometry/gaussian.h"
 
 namespace slamrig::slam {
 namespace {
@@ -231,6 +236,73 @@ TEST(IcpMatcherTest, FailsWhenTheSourceIsFarFromTheReference) {
   EXPECT_FALSE(matcher.Match(ref, Pose2(50.0, 50.0, 0.0)).has_value());
   const IcpMatcher empty(IcpOptions{}, {});
   EXPECT_FALSE(empty.Match(ref, Pose2()).has_value());
+}
+
+// A reference point's normal is the minor principal axis of its nearest neighbours within the
+// radius (brute force here), computed once whichever thread asks first.
+TEST(IcpMatcherTest, NormalsAreTheMinorAxisOfTheNearestNeighbours) {
+  RandomEngine rng(51);
+  std::vector<Eigen::Vector2d> points;
+  for (int p = 0; p < 300; ++p) {
+    // Points along a few random walls, with noise: most normals are well defined.
+    const double t = Uniform01(rng);
+    const int wall = p % 3;
+    const Eigen::Vector2d dir(std::cos(wall * 1.1), std::sin(wall * 1.1));
+    const double noise = 0.01 * (Uniform01(rng) - 0.5);
+    const Eigen::Vector2d across(-dir.y(), dir.x());
+    points.push_back(Eigen::Vector2d(wall * 2.0, wall) + 4.0 * t * dir + noise * across);
+  }
+  points.emplace_back(50.0, 50.0);  // alone: no normal
+  IcpOptions options;
+  options.metric = IcpMetric::kPointToLine;
+  const IcpMatcher matcher(options, points);
+  const IcpMatcher twin(options, points);
+  // The twin's normals are asked for from two threads at once, in opposite orders.
+  std::vector<Eigen::Vector2d> forward(points.size()), backward(points.size());
+  std::thread other([&] {
+    for (std::size_t i = points.size(); i-- > 0;)
+      backward[i] = twin.Normal(static_cast<std::uint32_t>(i));
+  });
+  for (std::size_t i = 0; i < points.size(); ++i)
+    forward[i] = twin.Normal(static_cast<std::uint32_t>(i));
+  other.join();
+  int with_normal = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    std::vector<std::pair<double, std::size_t>> by_distance;
+    for (std::size_t j = 0; j < points.size(); ++j) {
+      by_distance.emplace_back((points[j] - points[i]).squaredNorm(), j);
+    }
+    std::sort(by_distance.begin(), by_distance.end());
+    std::vector<Eigen::Vector2d> near;
+    for (std::size_t k = 0; k < static_cast<std::size_t>(options.normal_neighbors); ++k) {
+      if (by_distance[k].first > options.normal_radius_m * options.normal_radius_m) break;
+      near.push_back(points[by_distance[k].second]);
+    }
+    const Eigen::Vector2d normal = matcher.Normal(static_cast<std::uint32_t>(i));
+    EXPECT_EQ(forward[i], normal) << i;
+    EXPECT_EQ(backward[i], normal) << i;
+    if (near.size() < 3) {
+      EXPECT_EQ(normal, Eigen::Vector2d::Zero()) << i;
+      continue;
+    }
+    ++with_normal;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& q : near) mean += q;
+    mean /= static_cast<double>(near.size());
+    Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+    for (const Eigen::Vector2d& q : near) scatter += (q - mean) * (q - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(scatter);
+    EXPECT_NEAR(normal.norm(), 1.0, 1e-12) << i;
+    EXPECT_NEAR(std::abs(normal.dot(eig.eigenvectors().col(0))), 1.0, 1e-9) << i;
+  }
+  EXPECT_GT(with_normal, 250);
+  EXPECT_EQ(matcher.Normal(static_cast<std::uint32_t>(points.size() - 1)), Eigen::Vector2d::Zero());
+  // Point-to-point: no normals.
+  IcpOptions to_points;
+  to_points.metric = IcpMetric::kPointToPoint;
+  const IcpMatcher plain(to_points, points);
+  EXPECT_FALSE(plain.has_normals());
+  EXPECT_EQ(plain.Normal(0), Eigen::Vector2d::Zero());
 }
 
 TEST(IcpOptionsTest, ValidateNamesEveryBrokenField) {

@@ -147,7 +147,7 @@ std::pair<int, std::vector<KeyframeShareOf>> IcpOdometry::AddKeyframe(
   // The shares of the map this scan was matched against (none before the first map, none for
   // point-to-point ICP).
   std::vector<KeyframeShareOf> shares;
-  if (matcher_ && !matcher_->normals().empty()) {
+  if (matcher_ && matcher_->has_normals() && !matcher_->reference().empty()) {
     const std::vector<Eigen::Matrix3d> weights = FrameWeights(KeyframeInformations(
         map_, *matcher_, static_cast<int>(keyframes_.size()), scan, pose_.translation()));
     for (std::size_t j = 0; j < keyframes_.size(); ++j) {

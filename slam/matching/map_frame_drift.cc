@@ -34,9 +34,8 @@ std::vector<Eigen::Matrix3d> KeyframeInformations(const LocalMapPoints& map,
                                                   const Eigen::Vector2d& robot_xy) {
   std::vector<Eigen::Matrix3d> informations(static_cast<std::size_t>(keyframes),
                                             Eigen::Matrix3d::Zero());
-  const std::span<const Eigen::Vector2d> normals = matcher.normals();
-  if (normals.empty() || map.points.empty()) return informations;
-  SLAMRIG_CHECK(normals.size() == map.points.size(), "one normal per point");
+  if (!matcher.has_normals() || map.points.empty()) return informations;
+  SLAMRIG_CHECK(matcher.reference().size() == map.points.size(), "one reference point per point");
   const double max_distance_m = matcher.options().max_correspondence_distance_m;
   for (const Eigen::Vector2d& q : scan) {
     std::uint32_t i = 0;
@@ -44,8 +43,9 @@ std::vector<Eigen::Matrix3d> KeyframeInformations(const LocalMapPoints& map,
     if (!matcher.tree().Nearest(q, &i, &distance2, max_distance_m * max_distance_m)) {
       continue;
     }
+    const Eigen::Vector2d normal = matcher.Normal(i);
     informations[static_cast<std::size_t>(map.keyframe[i])] +=
-        PointToLineInformation(std::span(&map.points[i], 1), normals.subspan(i, 1), robot_xy);
+        PointToLineInformation(std::span(&map.points[i], 1), std::span(&normal, 1), robot_xy);
   }
   return informations;
 }
