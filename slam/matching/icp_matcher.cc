@@ -191,14 +191,22 @@ IcpMatcher::IcpMatcher(const IcpOptions& options, std::vector<Eigen::Vector2d> r
   SLAMRIG_CHECK_VALID(options_, "IcpOptions");
   if (!has_normals()) return;
   normals_.assign(tree_.size(), Eigen::Vector2d::Zero());
-  normal_once_ = std::make_unique<std::once_flag[]>(tree_.size());
+  normal_state_ = std::vector<std::atomic<std::uint8_t>>(tree_.size());
 }
 
 Eigen::Vector2d IcpMatcher::Normal(std::uint32_t i) const {
   if (!has_normals()) return Eigen::Vector2d::Zero();
   SLAMRIG_CHECK(i < normals_.size(), "IcpMatcher::Normal: no such reference point");
-  std::call_once(normal_once_[i], [&] { normals_[i] = ComputeNormal(i); });
-  return normals_[i];
+  enum : std::uint8_t { kEmpty = 0, kWriting = 1, kReady = 2 };
+  std::atomic<std::uint8_t>& state = normal_state_[i];
+  if (state.load(std::memory_order_acquire) == kReady) return normals_[i];
+  const Eigen::Vector2d normal = ComputeNormal(i);
+  std::uint8_t expected = kEmpty;
+  if (state.compare_exchange_strong(expected, kWriting, std::memory_order_acq_rel)) {
+    normals_[i] = normal;
+    state.store(kReady, std::memory_order_release);
+  }
+  return normal;
 }
 
 // The minor principal axis of the point's neighbourhood: its normal_neighbors nearest points

@@ -1,9 +1,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <atomic>
 #include <cstdint>
-#include <memory>
-#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -90,7 +89,7 @@ class IcpMatcher {
   /// Whether the reference points have normals (point-to-line).
   bool has_normals() const { return options_.metric == IcpMetric::kPointToLine; }
   /// The unit normal of reference point `i` ((0, 0) where it has none, and for point-to-point).
-  /// Computed when first asked for (a match asks only for its pairs' points), once; thread-safe.
+  /// Computed when first asked for (a match asks only for its pairs' points), kept; thread-safe.
   Eigen::Vector2d Normal(std::uint32_t i) const;
 
   /// Aligns `source` (points in the source's own frame) to the reference from
@@ -112,10 +111,11 @@ class IcpMatcher {
 
   IcpOptions options_;
   PointKdTree tree_;
-  // Point-to-line: one normal and one once-flag per reference point, the normal written by the
-  // first caller of Normal(i).
+  // Point-to-line: one normal per reference point, and its state (empty, being written, ready):
+  // the first caller of Normal(i) to claim it writes it; one that loses the race returns the
+  // value it computed itself, the same.
   mutable std::vector<Eigen::Vector2d> normals_;
-  std::unique_ptr<std::once_flag[]> normal_once_;
+  mutable std::vector<std::atomic<std::uint8_t>> normal_state_;
 };
 
 }  // namespace slamrig::slam
