@@ -28,14 +28,22 @@ PointRaster RasterOf(const std::vector<Eigen::Vector2d>& points, double resoluti
   // rather than once per point and cell.
   std::vector<double> nearest(static_cast<std::size_t>(width) * height,
                               std::numeric_limits<double>::infinity());
+  // d^2 = dx^2 + dy^2 from the cell centre's offsets along each axis, each taken once per point.
+  std::vector<double> dx2(static_cast<std::size_t>(2 * reach + 1));
   for (const Eigen::Vector2d& p : points) {
     const int cx = static_cast<int>(std::floor((p.x() - lo.x()) / resolution_m));
     const int cy = static_cast<int>(std::floor((p.y() - lo.y()) / resolution_m));
+    const int x0 = std::max(0, cx - reach), x1 = std::min(width - 1, cx + reach);
+    for (int ix = x0; ix <= x1; ++ix) {
+      const double dx = lo.x() + resolution_m * (ix + 0.5) - p.x();
+      dx2[static_cast<std::size_t>(ix - x0)] = dx * dx;
+    }
     for (int iy = std::max(0, cy - reach); iy <= std::min(height - 1, cy + reach); ++iy) {
-      for (int ix = std::max(0, cx - reach); ix <= std::min(width - 1, cx + reach); ++ix) {
-        const Eigen::Vector2d center = lo + resolution_m * Eigen::Vector2d(ix + 0.5, iy + 0.5);
-        double& d2 = nearest[static_cast<std::size_t>(iy) * width + ix];
-        d2 = std::min(d2, (center - p).squaredNorm());
+      const double dy = lo.y() + resolution_m * (iy + 0.5) - p.y();
+      const double dy2 = dy * dy;
+      double* row = nearest.data() + static_cast<std::size_t>(iy) * width;
+      for (int ix = x0; ix <= x1; ++ix) {
+        row[ix] = std::min(row[ix], dx2[static_cast<std::size_t>(ix - x0)] + dy2);
       }
     }
   }
