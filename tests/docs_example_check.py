@@ -6,7 +6,8 @@
 2. docs/examples/register.patch (the one entry in slam/pipeline/algorithms.cc and the test's line
    in slam/pipeline/CMakeLists.txt) still applies to the tree (`patch --dry-run`).
 3. With a build folder: the example estimator and its test still compile against today's
-   headers (`-fsyntax-only` with the flags compile_commands.json gives the pipeline's files), and
+   headers (`-fsyntax-only` with the flags compile_commands.json gives the pipeline's files, or
+   its unity batches), and
    the estimator still fits the algorithm table (AlgorithmOptionsFor is instantiated).
 
 Usage: tests/docs_example_check.py REPOSITORY [BUILD_DIR]
@@ -70,12 +71,15 @@ def check_patch(root):
     return []
 
 
-def command_for(commands, suffix):
-    for entry in commands:
-        if entry["file"].endswith(suffix):
-            if "arguments" in entry:
-                return entry["arguments"], entry["directory"]
-            return shlex.split(entry["command"]), entry["directory"]
+def command_for(commands, patterns):
+    """The compile command of the first entry whose file ends with a match of one of `patterns`
+    (regular expressions), tried in order."""
+    for pattern in patterns:
+        for entry in commands:
+            if re.search("(^|/)" + pattern + "$", entry["file"]):
+                if "arguments" in entry:
+                    return entry["arguments"], entry["directory"]
+                return shlex.split(entry["command"]), entry["directory"]
     return None, None
 
 
@@ -90,7 +94,7 @@ def syntax_check(arguments, directory, source, include_first):
         if a in ("-o", "-c", "-MF", "-MT", "-MQ"):
             skip = a != "-c"
             continue
-        if a.endswith((".cc", ".cpp")) or a in ("-MD", "-MMD"):
+        if a.endswith((".cc", ".cpp", ".cxx")) or a in ("-MD", "-MMD"):
             continue
         out.append(a)
     out = [out[0], f"-I{include_first}"] + out[1:] + ["-fsyntax-only", source]
@@ -113,10 +117,17 @@ def check_compiles(root, build):
             f.write('#include "slam/pipeline/scan_to_scan_estimator.h"\n'
                     "template class slamrig::slam::AlgorithmOptionsFor<"
                     "slamrig::slam::ScanToScanOptions, slamrig::slam::ScanToScanEstimator>;\n")
-        for source, model in ((unit, "slam/pipeline/algorithms.cc"),
-                              (os.path.join(root, EXAMPLES, "scan_to_scan_estimator_test.cc"),
-                               "slam/pipeline/rbpf_estimator_test.cc")):
-            arguments, directory = command_for(commands, model)
+        # The library's flags: algorithms.cc's, or in a unity build (SLAMRIG_UNITY_BUILD) a
+        # batch's, which compiles it among others with the same flags.
+        library = ("slam/pipeline/algorithms.cc",
+                   [re.escape("slam/pipeline/algorithms.cc"),
+                    r"slam/pipeline/CMakeFiles/slamrig_pipeline\.dir/Unity/unity_\d+_cxx\.cxx"])
+        test = ("slam/pipeline/rbpf_estimator_test.cc",
+                [re.escape("slam/pipeline/rbpf_estimator_test.cc")])
+        for source, (model, patterns) in (
+                (unit, library),
+                (os.path.join(root, EXAMPLES, "scan_to_scan_estimator_test.cc"), test)):
+            arguments, directory = command_for(commands, patterns)
             if arguments is None:
                 problems.append(f"{database}: no entry for {model}")
                 continue
