@@ -15,6 +15,7 @@
 
 #include "slam/pf/thread_pool.h"
 #include "slam/types/error.h"
+#include "tests/util/scoped_env.h"
 #include "tests/util/temp_dir.h"
 
 namespace slamrig::scenario {
@@ -113,15 +114,10 @@ TEST(SweepTest, RunsEveryRunOnceAndResumesAfterAKill) {
 // Runs in parallel share the processors: each child's SLAMRIG_THREADS is its share (the default
 // thread count of its estimators), unless the user set one; the rest of the environment passes.
 TEST(SweepTest, ParallelRunsGetTheirShareOfTheProcessors) {
-  const char* saved = std::getenv("SLAMRIG_THREADS");
-  const std::string restore = saved != nullptr ? saved : "";
-  ::setenv("SLAMRIG_SWEEP_TEST_MARK", "0.5", 1);
+  const testing::ScopedEnv threads("SLAMRIG_THREADS", nullptr);
+  const testing::ScopedEnv mark("SLAMRIG_SWEEP_TEST_MARK", "0.5");
   for (const bool user_set : {false, true}) {
-    if (user_set) {
-      ::setenv("SLAMRIG_THREADS", "7", 1);
-    } else {
-      ::unsetenv("SLAMRIG_THREADS");
-    }
+    threads.Set(user_set ? "7" : nullptr);
     Fixture f;
     const std::string runner = f.dir.Write("threads_runner.sh", R"sh(#!/bin/sh
 out=""
@@ -138,19 +134,13 @@ printf '{"passed": true, "configs": {"pf": {"ate_rmse_m": %s, "name": "pf"}}}\n'
                                        "scenario: scenario.yaml\nseeds: 2\nparameters:\n"
                                        "  a.noise: [1]\nmetrics: [pf.ate_rmse_m]\n"));
     EXPECT_EQ(RunSweep(f.spec, f.options).failed, 0);
-    const int threads = user_set ? 7 : std::max(1, slam::AvailableProcessors() / 2);
+    const int share = user_set ? 7 : std::max(1, slam::AvailableProcessors() / 2);
     const std::vector<std::string> lines = f.Lines();
     ASSERT_EQ(lines.size(), 3u);
     for (std::size_t k = 1; k < lines.size(); ++k) {
-      EXPECT_THAT(lines[k], ::testing::HasSubstr(",pass," + std::to_string(threads) + ".5,"))
+      EXPECT_THAT(lines[k], ::testing::HasSubstr(",pass," + std::to_string(share) + ".5,"))
           << lines[k];
     }
-  }
-  ::unsetenv("SLAMRIG_SWEEP_TEST_MARK");
-  if (saved != nullptr) {
-    ::setenv("SLAMRIG_THREADS", restore.c_str(), 1);
-  } else {
-    ::unsetenv("SLAMRIG_THREADS");
   }
 }
 

@@ -4,10 +4,10 @@
 #include <sched.h>
 
 #include <atomic>
-#include <cstdlib>
 #include <string>
 
 #include "slam/types/error.h"
+#include "tests/util/scoped_env.h"
 
 namespace slamrig::slam {
 namespace {
@@ -31,20 +31,18 @@ TEST(ThreadPoolTest, ParallelForVisitsEveryIndexExactlyOnce) {
 // The default thread count: the processors of this process's affinity, or SLAMRIG_THREADS when
 // set; a bad SLAMRIG_THREADS is a ConfigError that names it.
 TEST(ThreadPoolTest, ThreadsZeroMeansTheProcessorsOrSlamrigThreads) {
-  const char* saved = std::getenv("SLAMRIG_THREADS");
-  const std::string restore = saved != nullptr ? saved : "";
-  ::unsetenv("SLAMRIG_THREADS");
+  const testing::ScopedEnv threads("SLAMRIG_THREADS", nullptr);
   cpu_set_t set;
   CPU_ZERO(&set);
   ASSERT_EQ(::sched_getaffinity(0, sizeof(set), &set), 0);
   EXPECT_EQ(AvailableProcessors(), CPU_COUNT(&set));
   EXPECT_EQ(ThreadCount(0), CPU_COUNT(&set));
   EXPECT_EQ(ThreadCount(3), 3);
-  ::setenv("SLAMRIG_THREADS", "5", 1);
+  threads.Set("5");
   EXPECT_EQ(ThreadCount(0), 5);
   EXPECT_EQ(ThreadCount(2), 2);
   for (const char* bad : {"0", "-1", "abc", "5x", "", "1025", "99999999999"}) {
-    ::setenv("SLAMRIG_THREADS", bad, 1);
+    threads.Set(bad);
     try {
       ThreadCount(0);
       ADD_FAILURE() << "accepted SLAMRIG_THREADS=" << bad;
@@ -53,11 +51,6 @@ TEST(ThreadPoolTest, ThreadsZeroMeansTheProcessorsOrSlamrigThreads) {
                 std::string::npos)
           << e.what();
     }
-  }
-  if (saved != nullptr) {
-    ::setenv("SLAMRIG_THREADS", restore.c_str(), 1);
-  } else {
-    ::unsetenv("SLAMRIG_THREADS");
   }
 }
 
