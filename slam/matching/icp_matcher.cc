@@ -45,14 +45,6 @@ Eigen::Matrix3d FlooredInverse(const Eigen::Matrix3d& h) {
   return eig.eigenvectors() * values.asDiagonal() * eig.eigenvectors().transpose();
 }
 
-// What a match aligns to: the options, the reference's k-d tree and its normals.
-struct Reference {
-  const IcpOptions& options;
-  const PointKdTree& tree;
-  const IcpMatcher& matcher;  // Normal(i)
-  bool to_line() const { return options.metric == IcpMetric::kPointToLine; }
-};
-
 // Gauss-Newton normal equations in (x, y, yaw) and the weighted squared residuals.
 struct NormalEquations {
   Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
@@ -64,12 +56,12 @@ struct NormalEquations {
 // The pairs of `source` seen from `pose`: nearest neighbours within the gate (with a normal, for
 // point-to-line), then trimmed to the best trim_fraction (ties at the threshold kept), in source
 // order. Returns the number that passed the gate, before trimming.
-int Associate(const Reference& reference, std::span<const Eigen::Vector2d> source,
+int Associate(const IcpMatcher& reference, std::span<const Eigen::Vector2d> source,
               const Pose2& pose, std::vector<Pair>* pairs, std::vector<double>* scratch) {
-  const IcpOptions& options = reference.options;
+  const IcpOptions& options = reference.options();
   const double max_d2 =
       options.max_correspondence_distance_m * options.max_correspondence_distance_m;
-  const auto& ref = reference.tree.points();
+  const auto& ref = reference.tree().points();
   pairs->clear();
   const double c = std::cos(pose.theta()), s = std::sin(pose.theta());
   for (const Eigen::Vector2d& p : source) {
@@ -77,9 +69,9 @@ int Associate(const Reference& reference, std::span<const Eigen::Vector2d> sourc
     pair.rotated = Eigen::Vector2d(c * p.x() - s * p.y(), s * p.x() + c * p.y());
     pair.world = pair.rotated + pose.translation();
     double d2 = 0.0;
-    if (!reference.tree.Nearest(pair.world, &pair.ref, &d2, max_d2)) continue;
-    if (reference.to_line()) {
-      const Eigen::Vector2d n = reference.matcher.Normal(pair.ref);
+    if (!reference.tree().Nearest(pair.world, &pair.ref, &d2, max_d2)) continue;
+    if (reference.has_normals()) {
+      const Eigen::Vector2d n = reference.Normal(pair.ref);
       if (n.isZero()) continue;
       pair.residual = n.dot(pair.world - ref[pair.ref]);
     } else {
@@ -103,14 +95,14 @@ int Associate(const Reference& reference, std::span<const Eigen::Vector2d> sourc
 
 // The robustly weighted normal equations of `pairs` (Jacobians with respect to (x, y, yaw) of the
 // pose, d(R p)/d yaw = perp(R p)).
-NormalEquations Accumulate(const Reference& reference, const std::vector<Pair>& pairs) {
+NormalEquations Accumulate(const IcpMatcher& reference, const std::vector<Pair>& pairs) {
   NormalEquations eq;
-  const auto& ref = reference.tree.points();
+  const auto& ref = reference.tree().points();
   for (const Pair& pair : pairs) {
-    const double w = RobustWeight(reference.options, pair.residual);
+    const double w = RobustWeight(reference.options(), pair.residual);
     const Eigen::Vector2d dyaw = Perp(pair.rotated);
-    if (reference.to_line()) {
-      const Eigen::Vector2d n = reference.matcher.Normal(pair.ref);
+    if (reference.has_normals()) {
+      const Eigen::Vector2d n = reference.Normal(pair.ref);
       const Eigen::Vector3d j(n.x(), n.y(), n.dot(dyaw));
       eq.h += w * j * j.transpose();
       eq.g += w * j * pair.residual;
@@ -145,13 +137,13 @@ Pose2 PointToLineStep(const NormalEquations& eq, const Pose2& pose) {
 
 // The weighted closed-form alignment of the pairs (Besl and McKay 1992; in 2D the SVD
 // of the cross-covariance reduces to one atan2), applied on top of `pose`.
-Pose2 PointToPointStep(const Reference& reference, const std::vector<Pair>& pairs,
+Pose2 PointToPointStep(const IcpMatcher& reference, const std::vector<Pair>& pairs,
                        const Pose2& pose) {
-  const auto& ref = reference.tree.points();
+  const auto& ref = reference.tree().points();
   double sw = 0.0;
   Eigen::Vector2d mean_p = Eigen::Vector2d::Zero(), mean_q = Eigen::Vector2d::Zero();
   for (const Pair& pair : pairs) {
-    const double w = RobustWeight(reference.options, pair.residual);
+    const double w = RobustWeight(reference.options(), pair.residual);
     sw += w;
     mean_p += w * pair.world;
     mean_q += w * ref[pair.ref];
@@ -160,7 +152,7 @@ Pose2 PointToPointStep(const Reference& reference, const std::vector<Pair>& pair
   mean_q /= sw;
   double sin_sum = 0.0, cos_sum = 0.0;
   for (const Pair& pair : pairs) {
-    const double w = RobustWeight(reference.options, pair.residual);
+    const double w = RobustWeight(reference.options(), pair.residual);
     const Eigen::Vector2d a = pair.world - mean_p, b = ref[pair.ref] - mean_q;
     sin_sum += w * (a.x() * b.y() - a.y() * b.x());
     cos_sum += w * (a.x() * b.x() + a.y() * b.y());
@@ -239,18 +231,17 @@ Eigen::Vector2d IcpMatcher::ComputeNormal(std::uint32_t i) const {
 
 std::optional<MatchResult> IcpMatcher::Match(std::span<const Eigen::Vector2d> source,
                                              const Pose2& reference_from_source_guess) const {
-  const Reference reference{options_, tree_, *this};
   std::vector<Pair> pairs;
   pairs.reserve(source.size());
   std::vector<double> scratch;
   Pose2 pose = reference_from_source_guess;
   MatchResult result;
   for (int iteration = 1; iteration <= options_.max_iterations; ++iteration) {
-    Associate(reference, source, pose, &pairs, &scratch);
+    Associate(*this, source, pose, &pairs, &scratch);
     if (static_cast<int>(pairs.size()) < options_.min_correspondences) return std::nullopt;
     result.iterations = iteration;
-    const Pose2 next = reference.to_line() ? PointToLineStep(Accumulate(reference, pairs), pose)
-                                           : PointToPointStep(reference, pairs, pose);
+    const Pose2 next = has_normals() ? PointToLineStep(Accumulate(*this, pairs), pose)
+                                     : PointToPointStep(*this, pairs, pose);
     const double moved = (next.translation() - pose.translation()).norm();
     const double turned = std::abs(NormalizeAngle(next.theta() - pose.theta()));
     pose = next;
@@ -261,9 +252,9 @@ std::optional<MatchResult> IcpMatcher::Match(std::span<const Eigen::Vector2d> so
   }
 
   // Final pairs and covariance at the estimate.
-  const int gated = Associate(reference, source, pose, &pairs, &scratch);
+  const int gated = Associate(*this, source, pose, &pairs, &scratch);
   if (static_cast<int>(pairs.size()) < options_.min_correspondences) return std::nullopt;
-  const NormalEquations final_equations = Accumulate(reference, pairs);
+  const NormalEquations final_equations = Accumulate(*this, pairs);
   const double variance =
       final_equations.weighted_squares / std::max(1, final_equations.num_residuals - 3);
   result.pose = pose;

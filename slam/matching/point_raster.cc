@@ -51,7 +51,7 @@ PointRaster RasterOf(const std::vector<Eigen::Vector2d>& points, double resoluti
   raster.values.assign(nearest.size(), 0.0f);
   for (std::size_t c = 0; c < nearest.size(); ++c) {
     if (nearest[c] == std::numeric_limits<double>::infinity()) continue;
-    raster.values[c] = std::max(0.0f, static_cast<float>(std::exp(-nearest[c] * inv_two_var)));
+    raster.values[c] = static_cast<float>(std::exp(-nearest[c] * inv_two_var));
   }
   raster.view = GridView{raster.values.data(), width, height, lo, resolution_m};
   return raster;
