@@ -32,7 +32,9 @@ endfunction()
 # headers they share (Eigen's above all) are parsed and instantiated once per batch instead of
 # once per file; the main job builds in about half the compiler time. Files of one target must
 # then not define the same names in their anonymous namespaces. Off, every file is compiled
-# alone: scripts/test.sh's sanitizer build does that, so a missing include still fails CI.
+# alone: scripts/test.sh's sanitizer build does that for every library the unit tests link, so a
+# missing include there still fails CI (not in apps/*.cc or the Python bridge, which it does not
+# build).
 function(slamrig_unity_build target)
   if(SLAMRIG_UNITY_BUILD)
     set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)

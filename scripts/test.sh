@@ -39,7 +39,8 @@ echo "== ASan/UBSan build (clang, libFuzzer instrumentation): the unit tests and
 # the unit tests are ordinary gtest binaries in it, the fuzz targets link libFuzzer.
 # -O1 with line tables only: the sanitizers' reports keep file and line, and the build, CI's
 # second longest stage, compiles and links far less than at -O2 -g. Without the unity build, so
-# that every file is compiled alone once: a missing include fails here.
+# that every file of the libraries the unit tests link is compiled alone once: a missing include
+# there fails here (apps/*.cc and the Python bridge are compiled in batches only).
 CC=clang CXX=clang++ cmake -S . -B build-san -DSLAMRIG_FUZZ=ON -DSLAMRIG_SANITIZE=ON \
   -DSLAMRIG_UNITY_BUILD=OFF -DSLAMRIG_BUILD_BENCHMARKS=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
