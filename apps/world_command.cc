@@ -28,7 +28,8 @@ int RunGenerate(const std::vector<std::string>& args) {
           "(map_server)\n"
           "and a picture DIR/world.png. Same kind, seed and parameters, same bytes. --set takes\n"
           "the kind's parameters and the route's (speed_m_s, laps, robot_radius_m,\n"
-          "clearance_margin_m, lookahead_m, map_resolution_m); see the world generator's notes.");
+          "clearance_margin_m, lookahead_m, map_resolution_m, route_length_m); see the world "
+          "generator's notes.");
   parser.AddPositional("KIND", sim::worldgen::WorldKindNames(), &kind);
   parser.AddOption("seed", "N", "seed of the layout", &seed);
   parser.AddRepeated("set", "KEY=VALUE", "a parameter of the kind or the route, e.g. width_m=80",

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <queue>
 #include <tuple>
 
 #include "slam/types/check.h"
+#include "slam/types/validation.h"
 
 namespace slamrig::sim::worldgen {
 namespace {
@@ -121,27 +123,44 @@ std::vector<Eigen::Vector2d> Simplify(const std::vector<Eigen::Vector2d>& points
   return out;
 }
 
-}  // namespace
-
-Route PlanRoute(const Layout& layout) {
-  const int n = static_cast<int>(layout.nodes.size());
+// The layout's edges as arcs, and each node's arcs.
+struct Graph {
   std::vector<Arc> arcs;
-  std::vector<std::vector<int>> adjacency(static_cast<std::size_t>(n));
+  std::vector<std::vector<int>> adjacency;
+};
+
+Graph MakeGraph(const Layout& layout) {
+  Graph g;
+  g.adjacency.resize(layout.nodes.size());
   for (int e = 0; e < static_cast<int>(layout.edges.size()); ++e) {
-    arcs.push_back({layout.edges[e].a, layout.edges[e].b, e});
-    adjacency[layout.edges[e].a].push_back(e);
-    adjacency[layout.edges[e].b].push_back(e);
+    g.arcs.push_back({layout.edges[e].a, layout.edges[e].b, e});
+    g.adjacency[layout.edges[e].a].push_back(e);
+    g.adjacency[layout.edges[e].b].push_back(e);
   }
-  // Connected: every node with an edge is reachable from the start.
+  return g;
+}
+
+// The nodes with an edge when every one of them is reachable from the start, else -1.
+int NodesReachedFromStart(const Layout& layout, const Graph& g) {
   std::vector<double> distance;
   std::vector<int> via;
-  Dijkstra(layout, adjacency, arcs, layout.start_node, &distance, &via);
+  Dijkstra(layout, g.adjacency, g.arcs, layout.start_node, &distance, &via);
   int used_nodes = 0;
-  for (int v = 0; v < n; ++v) {
-    if (adjacency[v].empty()) continue;
+  for (std::size_t v = 0; v < g.adjacency.size(); ++v) {
+    if (g.adjacency[v].empty()) continue;
+    if (!std::isfinite(distance[v])) return -1;
     ++used_nodes;
-    SLAMRIG_CHECK(std::isfinite(distance[v]), "a layout's graph is connected");
   }
+  return used_nodes;
+}
+
+// The tour of every edge of a connected layout.
+Route PlanTour(const Layout& layout) {
+  Graph g = MakeGraph(layout);
+  const int used_nodes = NodesReachedFromStart(layout, g);
+  SLAMRIG_CHECK(used_nodes > 0, "a layout's graph is connected");
+  std::vector<Arc>& arcs = g.arcs;
+  std::vector<std::vector<int>>& adjacency = g.adjacency;
   Route route;
   route.loops = static_cast<int>(layout.edges.size()) - used_nodes + 1;
   PairOddNodes(layout, &adjacency, &arcs);
@@ -179,6 +198,77 @@ Route PlanRoute(const Layout& layout) {
     }
   }
   return route;
+}
+
+// The graph of the chosen edges, in the layout's order, without the branches that would end where
+// the layout goes on (a node of one chosen edge but several in the layout, the start excepted):
+// the route turns back only at the world's own dead ends.
+Layout Subgraph(const Layout& layout, std::vector<bool> chosen) {
+  std::vector<int> layout_degree(layout.nodes.size(), 0);
+  for (const LayoutEdge& edge : layout.edges) ++layout_degree[edge.a], ++layout_degree[edge.b];
+  for (bool pruned = true; pruned;) {
+    pruned = false;
+    std::vector<int> degree(layout.nodes.size(), 0);
+    for (std::size_t k = 0; k < chosen.size(); ++k) {
+      if (chosen[k]) ++degree[layout.edges[k].a], ++degree[layout.edges[k].b];
+    }
+    const auto cut_short = [&](int v) {
+      return degree[v] == 1 && layout_degree[v] > 1 && v != layout.start_node;
+    };
+    for (std::size_t k = 0; k < chosen.size(); ++k) {
+      if (chosen[k] && (cut_short(layout.edges[k].a) || cut_short(layout.edges[k].b))) {
+        chosen[k] = false;
+        pruned = true;
+      }
+    }
+  }
+  Layout part;
+  part.nodes = layout.nodes;
+  part.start_node = layout.start_node;
+  for (std::size_t k = 0; k < chosen.size(); ++k) {
+    if (chosen[k]) part.edges.push_back(layout.edges[k]);
+  }
+  return part;
+}
+
+}  // namespace
+
+Route PlanRoute(const Layout& layout, double max_length_m) {
+  Route whole = PlanTour(layout);
+  if (max_length_m <= 0.0 || whole.length_m <= max_length_m) return whole;
+  // The part of the layout nearest the start: edges by the distance of their far end from it
+  // (ties by their near end, then by index); of every prefix, less the branches it would cut
+  // short, the longest tour that fits.
+  const Graph g = MakeGraph(layout);
+  std::vector<double> distance;
+  std::vector<int> via;
+  Dijkstra(layout, g.adjacency, g.arcs, layout.start_node, &distance, &via);
+  std::vector<std::tuple<double, double, int>> order;
+  for (int e = 0; e < static_cast<int>(layout.edges.size()); ++e) {
+    const double da = distance[layout.edges[e].a], db = distance[layout.edges[e].b];
+    order.emplace_back(std::max(da, db), std::min(da, db), e);
+  }
+  std::sort(order.begin(), order.end());
+  std::vector<bool> chosen(layout.edges.size(), false);
+  std::optional<Route> best;
+  double shortest_loop = std::numeric_limits<double>::infinity();
+  for (const auto& [far, near, e] : order) {
+    chosen[e] = true;
+    const Layout part = Subgraph(layout, chosen);
+    const int used_nodes = NodesReachedFromStart(part, MakeGraph(part));
+    if (used_nodes <= 0 || static_cast<int>(part.edges.size()) - used_nodes + 1 < 1) continue;
+    Route route = PlanTour(part);
+    shortest_loop = std::min(shortest_loop, route.length_m);
+    if (route.length_m <= max_length_m && (!best || route.length_m > best->length_m)) {
+      best = std::move(route);
+    }
+  }
+  if (!best) {
+    FailParameter("route_length_m", max_length_m,
+                  "too short for one loop of this world; must be >= " +
+                      FormatNumber(std::ceil(shortest_loop)) + " (or 0: the whole route)");
+  }
+  return *best;
 }
 
 }  // namespace slamrig::sim::worldgen

@@ -19,6 +19,10 @@ struct Route {
 /// there and back, on its edge's first pass): a Chinese-postman tour, odd nodes paired greedily
 /// by shortest path and those paths driven twice, the Euler circuit found by Hierholzer's
 /// algorithm. Dead ends are driven in and back out. The graph must be connected (checked).
-Route PlanRoute(const Layout& layout);
+/// With `max_length_m` > 0 and a tour longer than that, the route drives instead the part of the
+/// graph nearest the start whose tour fits (edges taken by the distance of their far end from the
+/// start), so that a short drive still closes loops; it throws ParameterError on
+/// `route_length_m` when not even one loop fits.
+Route PlanRoute(const Layout& layout, double max_length_m = 0.0);
 
 }  // namespace slamrig::sim::worldgen

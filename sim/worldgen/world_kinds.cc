@@ -46,6 +46,7 @@ std::vector<std::string> RouteOptions::Validate() const {
   rules.InRange("clearance_margin_m", clearance_margin_m, 0.0, 2.0);
   rules.InRange("lookahead_m", lookahead_m, 0.1, 5.0);
   rules.InRange("map_resolution_m", map_resolution_m, 0.01, 1.0);
+  rules.InRange("route_length_m", route_length_m, 0.0, 1e6);
   return rules.errors();
 }
 

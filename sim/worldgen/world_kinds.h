@@ -30,6 +30,10 @@ struct RouteOptions {
   double clearance_margin_m = 0.2;  ///< the route keeps robot_radius_m plus this from every wall
   double lookahead_m = 0.5;         ///< pure pursuit lookahead of the drive
   double map_resolution_m = 0.05;   ///< cell size of the written map
+  /// The longest a lap may be: 0 drives the whole world; a shorter budget drives the part of the
+  /// world nearest the start whose tour fits, loops included (a five-minute drive that still
+  /// closes loops). At least one loop must fit.
+  double route_length_m = 0.0;
 
   /// One message per broken rule, e.g. "laps = 0; must be >= 1".
   std::vector<std::string> Validate() const;

@@ -23,6 +23,7 @@ void VisitFields(V& v, RouteOptions& r) {
   v("clearance_margin_m", r.clearance_margin_m);
   v("lookahead_m", r.lookahead_m);
   v("map_resolution_m", r.map_resolution_m);
+  v("route_length_m", r.route_length_m);
 }
 
 template <typename V>
@@ -147,7 +148,7 @@ GeneratedWorld Generate(const GenerateSpec& spec) {
   GeneratedWorld g;
   g.spec = spec;
   g.layout = MakeLayout(spec);
-  g.route = PlanRoute(g.layout);
+  g.route = PlanRoute(g.layout, spec.route.route_length_m);
   WorldSpec& w = g.world;
   w.name = g.layout.name;
   w.walls = g.layout.walls;

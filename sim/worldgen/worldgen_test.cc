@@ -121,6 +121,64 @@ TEST(WorldgenTest, TheRouteCoversEveryEdgeAndReversesAtDeadEnds) {
   EXPECT_GT(Generate(SmallSpec(WorldKind::kMaze, 3)).route.reversals, 2);
 }
 
+// Distance from `p` to the closed polyline `w`.
+double DistanceToRoute(const std::vector<Eigen::Vector2d>& w, const Eigen::Vector2d& p) {
+  double best = 1e9;
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    const Eigen::Vector2d a = w[i], d = w[(i + 1) % w.size()] - a;
+    const double f = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    best = std::min(best, (a + f * d - p).norm());
+  }
+  return best;
+}
+
+// A length budget drives part of the world: the lap fits, closes a loop, starts where the whole
+// route starts and drives only where the whole route drives; a budget too short for one loop
+// names route_length_m and the least length, which then works.
+TEST(WorldgenTest, ARouteWithinItsLengthClosesALoopOnTheWorldsOwnRoute) {
+  for (const WorldKind kind : kAllKinds) {
+    for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+      GenerateSpec spec = SmallSpec(kind, seed);
+      const GeneratedWorld whole = Generate(spec);
+      spec.route.route_length_m = 0.4 * whole.route.length_m;
+      GeneratedWorld part;
+      try {
+        part = Generate(spec);
+      } catch (const ParameterError& e) {
+        EXPECT_EQ(e.field(), "route_length_m");
+        const std::string what = e.what(), tag = "must be >= ";
+        ASSERT_NE(what.find(tag), std::string::npos) << what;
+        const double least = std::stod(what.substr(what.find(tag) + tag.size()));
+        EXPECT_GT(least, spec.route.route_length_m) << what;
+        spec.route.route_length_m = least;
+        part = Generate(spec);
+      }
+      const std::string name = std::string(WorldKindName(kind)) + " seed " + std::to_string(seed);
+      EXPECT_LE(part.route.length_m, spec.route.route_length_m) << name;
+      EXPECT_LT(part.route.length_m, whole.route.length_m) << name;
+      EXPECT_GE(part.route.loops, 1) << name;
+      EXPECT_EQ(part.route.waypoints.front(), whole.route.waypoints.front()) << name;
+      const auto& w = part.route.waypoints;
+      for (std::size_t i = 0; i < w.size(); ++i) {
+        for (const double f : {0.0, 0.25, 0.5, 0.75}) {
+          const Eigen::Vector2d p = w[i] + f * (w[(i + 1) % w.size()] - w[i]);
+          EXPECT_LT(DistanceToRoute(whole.route.waypoints, p), 1e-6) << name << " waypoint " << i;
+        }
+      }
+    }
+  }
+  GenerateSpec tiny = SmallSpec(WorldKind::kCampus, 1);
+  tiny.route.route_length_m = 10.0;
+  try {
+    Generate(tiny);
+    ADD_FAILURE() << "a 10 m campus route was made";
+  } catch (const ParameterError& e) {
+    EXPECT_THAT(e.what(),
+                ::testing::StartsWith(
+                    "route_length_m = 10; too short for one loop of this world; must be >= "));
+  }
+}
+
 // The map against the Box2D world: rays cast from the route hit where the map turns occupied.
 TEST(WorldgenTest, TheMapMatchesTheWorld) {
   for (const WorldKind kind : kAllKinds) {
