@@ -45,14 +45,16 @@ std::vector<std::string> IcpOdometryOptions::Validate() const {
       .NonNegative("sigma_yaw_per_rad", sigma_yaw_per_rad)
       .NonNegative("sigma_yaw_per_m", sigma_yaw_per_m)
       .NonNegative("sigma_yaw_floor_rad", sigma_yaw_floor_rad)
-      .Nested("search", search.Validate());
+      .Nested("search", search.Validate())
+      .Nested("calibration", calibration.Validate());
   std::vector<std::string> errors = icp.Validate();
   AppendErrors(&errors, points.Validate());
   AppendErrors(&errors, PrefixErrors("icp_odometry", rules.errors()));
   return errors;
 }
 
-IcpOdometry::IcpOdometry(const IcpOdometryOptions& options) : options_(options) {
+IcpOdometry::IcpOdometry(const IcpOdometryOptions& options)
+    : options_(options), calibration_(options.calibration) {
   SLAMRIG_CHECK_VALID(options_, "IcpOdometryOptions");
 }
 
@@ -217,12 +219,14 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
     }
   }
   const Pose2 prior = pose_ * odometry_increment;
+  // Where the odometry stands in for the scan, it does so with its fitted drift taken out.
+  const Pose2 fallback = pose_ * calibration_.Correct(odometry_increment);
   // The increment's noise, rotated from the previous base frame into the odom frame.
   const Eigen::Matrix2d r = Eigen::Rotation2Dd(pose_.theta()).toRotationMatrix();
   Eigen::Matrix3d prior_covariance = IncrementCovariance(odometry_increment);
   prior_covariance.topLeftCorner<2, 2>() =
       r * prior_covariance.topLeftCorner<2, 2>() * r.transpose();
-  step.pose = prior;
+  step.pose = fallback;
   step.prior = prior;
   step.window = SearchWindow(odometry_increment);
   step.covariance = prior_covariance;
@@ -237,10 +241,10 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
   step.outcome = points.empty() ? IcpOdometryOutcome::kNoPoints : IcpOdometryOutcome::kMatchFailed;
 
   if (match) {
-    // Keep the prior along poorly constrained directions of the match.
+    // Keep the (calibrated) odometry along poorly constrained directions of the match.
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(
         match->covariance.topLeftCorner<2, 2>());
-    Eigen::Vector2d correction = match->pose.translation() - prior.translation();
+    Eigen::Vector2d correction = match->pose.translation() - fallback.translation();
     bool degenerate = false;
     const double max_var = options_.max_translation_stddev_m * options_.max_translation_stddev_m;
     for (int i = 0; i < 2; ++i) {
@@ -254,10 +258,10 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
     }
     double yaw = match->pose.theta();
     if (match->covariance(2, 2) > options_.max_yaw_stddev_rad * options_.max_yaw_stddev_rad) {
-      yaw = prior.theta();
+      yaw = fallback.theta();
       degenerate = true;
     }
-    step.pose = Pose2(prior.x() + correction.x(), prior.y() + correction.y(), yaw);
+    step.pose = Pose2(fallback.x() + correction.x(), fallback.y() + correction.y(), yaw);
     step.covariance = match->covariance;
     step.score = match->score;
     step.outcome = degenerate ? IcpOdometryOutcome::kDegenerate : IcpOdometryOutcome::kMatched;
@@ -280,6 +284,12 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
       break;
   }
 
+  // The drift is fitted from clear matches following clear matches: the increment between them
+  // is the scans' own, not a correction of what a blind stretch let accumulate.
+  if (step.outcome == IcpOdometryOutcome::kMatched && last_matched_) {
+    calibration_.Observe(odometry_increment, pose_.Inverse() * step.pose);
+  }
+  last_matched_ = step.outcome == IcpOdometryOutcome::kMatched;
   pose_ = step.pose;
   const Pose2 since = last_keyframe_.Between(pose_);
   if (!points.empty() && (!matcher_ || since.translation().norm() >= options_.keyframe_distance_m ||

@@ -12,6 +12,7 @@
 #include "slam/matching/map_frame_drift.h"
 #include "slam/matching/point_raster.h"
 #include "slam/matching/scan_points.h"
+#include "slam/odometry/odometry_calibration.h"
 #include "slam/types/pose2.h"
 #include "slam/types/records.h"
 
@@ -77,6 +78,13 @@ struct IcpOdometryOptions {
   double sigma_yaw_floor_rad = 0.002;
   /// The search before ICP for a prior too uncertain for ICP alone.
   IcpOdometrySearchOptions search;
+  /// Self-calibration of the odometry's heading drift from the clear matches' corrections: where
+  /// the odometry stands in for the scans (a failed match, a scan with no points, a degenerate
+  /// direction) it stands in with its systematic drift taken out. Wheels a fraction of a percent
+  /// apart turn a robot a degree per metre; ten metres without a usable scan (an open square, a
+  /// black facade) would otherwise cost ten degrees that no later match on new ground repairs.
+  /// The match itself still starts from the raw odometry.
+  OdometryCalibrationOptions calibration = {.enabled = true};
 
   /// One message per broken rule (prefixed "icp_odometry."; the ICP and point options' own).
   std::vector<std::string> Validate() const;
@@ -147,6 +155,8 @@ class IcpOdometry {
   /// 1 until clear matches say the prior is worse than the model.
   const Eigen::Vector2d& noise_scale() const { return noise_scale_; }
   const IcpOdometryCounts& counts() const { return counts_; }
+  /// The odometry's heading drift as fitted so far (OdometryCalibration).
+  const OdometryCalibration& calibration() const { return calibration_; }
   /// Points of the current local map, odom frame.
   const std::vector<Eigen::Vector2d>& local_map() const;
 
@@ -190,6 +200,8 @@ class IcpOdometry {
   // after each keyframe.
   std::optional<PointRaster> raster_;
   std::optional<CorrelativeMatcher> searcher_;
+  OdometryCalibration calibration_;
+  bool last_matched_ = false;  // the previous scan's match was clear (kMatched)
   Eigen::Vector2d noise_scale_{1.0, 1.0};
   Eigen::Vector2d noise_mean_size_{1.0, 1.0};
   IcpOdometryCounts counts_;

@@ -66,6 +66,7 @@ void VisitFields(V& v, IcpOdometryOptions& o) {
   v("sigma_yaw_per_m", o.sigma_yaw_per_m);
   v("sigma_yaw_floor_rad", o.sigma_yaw_floor_rad);
   v.Struct("search", o.search);
+  v.Struct("calibration", o.calibration);
 }
 
 /// The field table of CorrelativeMatcherOptions (the windows of a loop search are set per

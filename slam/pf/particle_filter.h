@@ -9,7 +9,7 @@
 #include "slam/matching/likelihood_field.h"
 #include "slam/matching/map_correlator.h"
 #include "slam/matching/scan_refiner.h"
-#include "slam/pf/odometry_calibration.h"
+#include "slam/odometry/odometry_calibration.h"
 #include "slam/pf/particle_filter_options.h"
 #include "slam/pf/solution_remapping.h"
 #include "slam/pf/thread_pool.h"

@@ -11,7 +11,7 @@
 #include "slam/matching/scan_points.h"
 #include "slam/matching/scan_refiner.h"
 #include "slam/odometry/rot_trans_rot_model.h"
-#include "slam/pf/odometry_calibration.h"
+#include "slam/odometry/odometry_calibration.h"
 #include "slam/pf/resampling.h"
 
 namespace slamrig::slam {

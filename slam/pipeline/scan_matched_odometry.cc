@@ -12,7 +12,7 @@ namespace {
 // turns between two scans is off it by decimetres and tenths of a radian however short the
 // interval, so the model's floors are wide (the search window +-3 sigma: 1.2 m and 0.75 rad at
 // least) and the search runs on every scan. No online noise measurement: the prediction's errors
-// are the robot's changes of mind, not a noise level to learn.
+// are the robot's changes of mind, not a noise level to learn, nor a wheel's drift to calibrate.
 IcpOdometryOptions WideGates() {
   IcpOdometryOptions o;
   o.max_correction_m = 1.0;
@@ -23,6 +23,7 @@ IcpOdometryOptions WideGates() {
   o.sigma_yaw_floor_rad = 0.25;
   o.search.sigmas = 3.0;
   o.search.adapt_rate = 0.0;
+  o.calibration.enabled = false;
   return o;
 }
 

@@ -1,4 +1,4 @@
-#include "slam/pf/odometry_calibration.h"
+#include "slam/odometry/odometry_calibration.h"
 
 #include <algorithm>
 #include <cmath>
