@@ -239,10 +239,11 @@ RunQueueSummary RunQueue(const RunQueueSpec& spec, const RunQueueOptions& option
   std::size_t next = 0;
   int finished_now = 0;
   const Progress progress(options.progress, summary.total, summary.already_done);
-  progress.Report(finished_now, running.size(), summary.failed);
   while (next < todo.size() || !running.empty()) {
     while (next < todo.size() && static_cast<int>(running.size()) < jobs && InterruptSignal() == 0)
       running.Add(SpawnRun(spec, options, todo[next++], jobs));
+    // Said once the freed slots are filled again, so "running" is what runs.
+    progress.Report(finished_now, running.size(), summary.failed);
     const auto ended = running.WaitAny();
     // SIGINT/SIGTERM: `running` stops the children on the way out, and their rows stay missing.
     ThrowIfInterrupted();
@@ -267,8 +268,8 @@ RunQueueSummary RunQueue(const RunQueueSpec& spec, const RunQueueOptions& option
     AppendLine(fd, JoinCsv(row), csv_path);
     ++finished_now;
     ++summary.ran;
-    progress.Report(finished_now, running.size(), summary.failed);
   }
+  progress.Report(finished_now, running.size(), summary.failed);
   progress.End();
   SortResults(spec, csv_path);
   if (spec.summarise) spec.summarise();
