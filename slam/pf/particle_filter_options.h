@@ -10,8 +10,8 @@
 #include "slam/matching/map_correlator.h"
 #include "slam/matching/scan_points.h"
 #include "slam/matching/scan_refiner.h"
-#include "slam/odometry/rot_trans_rot_model.h"
 #include "slam/odometry/odometry_calibration.h"
+#include "slam/odometry/rot_trans_rot_model.h"
 #include "slam/pf/resampling.h"
 
 namespace slamrig::slam {
