@@ -154,15 +154,17 @@ int NodesReachedFromStart(const Layout& layout, const Graph& g) {
   return used_nodes;
 }
 
-// The tour of every edge of a connected layout.
-Route PlanTour(const Layout& layout) {
+// The tour of every edge of `layout`, or nothing when its edges are not all reachable from the
+// start or it has fewer than `min_loops` independent cycles.
+std::optional<Route> PlanTour(const Layout& layout, int min_loops) {
   Graph g = MakeGraph(layout);
   const int used_nodes = NodesReachedFromStart(layout, g);
-  SLAMRIG_CHECK(used_nodes > 0, "a layout's graph is connected");
+  const int loops = static_cast<int>(layout.edges.size()) - used_nodes + 1;
+  if (used_nodes <= 0 || loops < min_loops) return std::nullopt;
   std::vector<Arc>& arcs = g.arcs;
   std::vector<std::vector<int>>& adjacency = g.adjacency;
   Route route;
-  route.loops = static_cast<int>(layout.edges.size()) - used_nodes + 1;
+  route.loops = loops;
   PairOddNodes(layout, &adjacency, &arcs);
   const auto circuit = EulerCircuit(adjacency, arcs, layout.start_node);
 
@@ -234,8 +236,9 @@ Layout Subgraph(const Layout& layout, std::vector<bool> chosen) {
 }  // namespace
 
 Route PlanRoute(const Layout& layout, double max_length_m) {
-  Route whole = PlanTour(layout);
-  if (max_length_m <= 0.0 || whole.length_m <= max_length_m) return whole;
+  std::optional<Route> whole = PlanTour(layout, 0);
+  SLAMRIG_CHECK(whole.has_value(), "a layout's graph is connected");
+  if (max_length_m <= 0.0 || whole->length_m <= max_length_m) return *whole;
   // The part of the layout nearest the start: edges by the distance of their far end from it
   // (ties by their near end, then by index); of every prefix, less the branches it would cut
   // short, the longest tour that fits.
@@ -254,12 +257,10 @@ Route PlanRoute(const Layout& layout, double max_length_m) {
   double shortest_loop = std::numeric_limits<double>::infinity();
   for (const auto& [far, near, e] : order) {
     chosen[e] = true;
-    const Layout part = Subgraph(layout, chosen);
-    const int used_nodes = NodesReachedFromStart(part, MakeGraph(part));
-    if (used_nodes <= 0 || static_cast<int>(part.edges.size()) - used_nodes + 1 < 1) continue;
-    Route route = PlanTour(part);
-    shortest_loop = std::min(shortest_loop, route.length_m);
-    if (route.length_m <= max_length_m && (!best || route.length_m > best->length_m)) {
+    std::optional<Route> route = PlanTour(Subgraph(layout, chosen), 1);
+    if (!route) continue;
+    shortest_loop = std::min(shortest_loop, route->length_m);
+    if (route->length_m <= max_length_m && (!best || route->length_m > best->length_m)) {
       best = std::move(route);
     }
   }
