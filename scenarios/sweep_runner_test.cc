@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "slam/pf/thread_pool.h"
+#include "slam/types/thread_pool.h"
 #include "slam/types/error.h"
 #include "tests/util/scoped_env.h"
 #include "tests/util/temp_dir.h"

@@ -2,8 +2,10 @@
 
 #include <condition_variable>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <mutex>
+#include <span>
 #include <thread>
 #include <vector>
 
@@ -21,6 +23,38 @@ int DefaultThreadCount();
 
 /// `requested` when it is >= 1, else DefaultThreadCount().
 int ThreadCount(int requested);
+
+/// Runs every task once, on up to `max_threads` threads (the caller's among them), and returns
+/// when all have ended. The tasks must be independent: which thread runs which never changes a
+/// result. When tasks throw, the exception of the first of them (in order) is rethrown here, after
+/// every task has ended.
+void RunTasks(std::span<const std::function<void()>> tasks, int max_threads);
+
+/// One thread of its own that runs one task at a time beside the caller: Start hands it a task
+/// (after the one in hand has ended), Wait returns when that task has ended and rethrows what it
+/// threw. Kept for the object's life, so a task per scan costs a wake-up, not a thread.
+class BackgroundWorker {
+ public:
+  BackgroundWorker();
+  /// Waits for the task in hand (what it threw is dropped), then ends the thread.
+  ~BackgroundWorker();
+  BackgroundWorker(const BackgroundWorker&) = delete;
+  BackgroundWorker& operator=(const BackgroundWorker&) = delete;
+
+  void Start(std::function<void()> task);
+  void Wait();
+
+ private:
+  void Loop();
+
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::function<void()> task_;
+  bool busy_ = false;
+  bool stop_ = false;
+  std::exception_ptr error_;
+  std::thread thread_;
+};
 
 /// A fixed set of worker threads for data-parallel loops. `ParallelFor` splits [0, n) into one
 /// contiguous block per thread (the caller runs the first) and returns when all are done. Which

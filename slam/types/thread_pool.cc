@@ -1,12 +1,15 @@
-#include "slam/pf/thread_pool.h"
+#include "slam/types/thread_pool.h"
 
 #include <sched.h>
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <string>
+#include <system_error>
 
 #include "slam/types/check.h"
 #include "slam/types/error.h"
@@ -45,6 +48,88 @@ int DefaultThreadCount() {
 }
 
 int ThreadCount(int requested) { return requested >= 1 ? requested : DefaultThreadCount(); }
+
+void RunTasks(std::span<const std::function<void()>> tasks, int max_threads) {
+  std::vector<std::exception_ptr> errors(tasks.size());
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (std::size_t i = next++; i < tasks.size(); i = next++) {
+      try {
+        tasks[i]();
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    }
+  };
+  const std::size_t threads_wanted =
+      std::min(tasks.size(), static_cast<std::size_t>(std::max(1, max_threads)));
+  std::vector<std::thread> threads;
+  for (std::size_t t = 1; t < threads_wanted; ++t) {
+    try {
+      threads.emplace_back(work);
+    } catch (const std::system_error&) {
+      break;  // no thread to be had: the ones started and the caller do the rest
+    }
+  }
+  work();
+  for (std::thread& t : threads) t.join();
+  for (const std::exception_ptr& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+}
+
+BackgroundWorker::BackgroundWorker() : thread_([this] { Loop(); }) {}
+
+BackgroundWorker::~BackgroundWorker() {
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [this] { return !busy_; });
+    stop_ = true;
+  }
+  changed_.notify_all();
+  thread_.join();
+}
+
+void BackgroundWorker::Start(std::function<void()> task) {
+  Wait();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    task_ = std::move(task);
+    busy_ = true;
+  }
+  changed_.notify_all();
+}
+
+void BackgroundWorker::Wait() {
+  std::exception_ptr error;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [this] { return !busy_; });
+    std::swap(error, error_);
+  }
+  if (error) std::rethrow_exception(error);
+}
+
+void BackgroundWorker::Loop() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (true) {
+    changed_.wait(lock, [this] { return busy_ || stop_; });
+    if (!busy_) return;  // stopped, and nothing in hand
+    std::function<void()> task = std::move(task_);
+    lock.unlock();
+    std::exception_ptr error;
+    try {
+      task();
+    } catch (...) {
+      error = std::current_exception();
+    }
+    task = nullptr;  // what it holds is released before the caller hears that it ended
+    lock.lock();
+    error_ = error;
+    busy_ = false;
+    changed_.notify_all();
+  }
+}
 
 ThreadPool::ThreadPool(int num_threads) {
   SLAMRIG_CHECK(num_threads >= 1, "ThreadPool needs at least one thread");
