@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -19,6 +20,7 @@
 #include "slam/io/map_image.h"
 #include "slam/io/map_server.h"
 #include "slam/io/tum_io.h"
+#include "slam/types/thread_pool.h"
 
 namespace slamrig::scenario {
 namespace {
@@ -391,26 +393,32 @@ std::string MapsHtml(const ScenarioResult& r, const Folder& file) {
     overlays.push_back({&r.configs[i].estimate, r.configs[i].name, colour.b, colour.g, colour.r});
   }
   const std::string truth_source = r.spec->simulated ? "true poses" : r.reference_kind;
+  // The images are drawn and encoded side by side, each into its own file.
+  std::vector<std::function<void()>> images;
   slam::MapImageOptions options;
   options.title = r.spec->name + ": map from " + truth_source + ", trajectories overlaid";
-  slam::WriteMapPng(file("map.png"), *background, overlays, options);
+  images.emplace_back(
+      [&, options] { slam::WriteMapPng(file("map.png"), *background, overlays, options); });
   std::string html = Figure("map.png", "The map from the " + EscapeHtml(truth_source) +
                                            " with the reference and estimated trajectories.");
+  // Each configuration's map is in its own frame: both trajectories are brought there.
+  std::vector<Trajectory> truth_local(r.configs.size()), estimate_local(r.configs.size());
   for (std::size_t i = 0; i < r.configs.size(); ++i) {
     const ConfigResult& c = r.configs[i];
-    // The estimator's map is in its own frame: bring both trajectories there.
-    const Pose2 estimator_from_map = c.map_from_estimator.Inverse();
-    Trajectory truth_local, estimate_local;
-    for (const auto& p : r.truth.poses()) truth_local.Append(p.time, estimator_from_map * p.pose);
-    for (const auto& p : c.estimate.poses())
-      estimate_local.Append(p.time, estimator_from_map * p.pose);
-    slam::TrajectoryOverlay truth_here = truth_overlay, estimate_here = overlays[i + 1];
-    truth_here.trajectory = &truth_local;
-    estimate_here.trajectory = &estimate_local;
     slam::MapImageOptions own;
     own.title = c.name + ": its own map and trajectory";
     own.segments = OwnMapSegments(r, c);
-    slam::WriteMapPng(file(c.name + "_map.png"), c.run.map, {truth_here, estimate_here}, own);
+    images.emplace_back([&, i, own] {
+      const Pose2 estimator_from_map = c.map_from_estimator.Inverse();
+      for (const auto& p : r.truth.poses())
+        truth_local[i].Append(p.time, estimator_from_map * p.pose);
+      for (const auto& p : c.estimate.poses())
+        estimate_local[i].Append(p.time, estimator_from_map * p.pose);
+      slam::TrajectoryOverlay truth_here = truth_overlay, estimate_here = overlays[i + 1];
+      truth_here.trajectory = &truth_local[i];
+      estimate_here.trajectory = &estimate_local[i];
+      slam::WriteMapPng(file(c.name + "_map.png"), c.run.map, {truth_here, estimate_here}, own);
+    });
     const bool has_landmarks = !c.run.landmarks.landmarks.empty();
     html += Figure(c.name + "_map.png",
                    EscapeHtml(c.name) + "'s map with its trajectory" +
@@ -421,6 +429,7 @@ std::string MapsHtml(const ScenarioResult& r, const Folder& file) {
                                       : "") +
                        ".");
   }
+  slam::RunTasks(images, slam::DefaultThreadCount());
   return html;
 }
 
@@ -648,11 +657,16 @@ void WriteReport(const ScenarioResult& r, const std::string& out_dir) {
   if (!r.recording.empty()) RunRecorder::Commit(r.recording);
   slam::WriteFileAtomically(file("config.yaml"), r.spec->resolved_yaml);
   if (!r.truth.empty()) slam::WriteTum(file("truth.tum"), r.truth);
-  WriteConfigFiles(r, file);
-  const std::string maps = MapsHtml(r, file);
-  const std::string texture = TextureHtml(r, file);
-  const std::string plots = ErrorPlotsHtml(r, file) + NeesPlotHtml(r, file) +
-                            TracePlotsHtml(r, file) + ErrorsByConfigHtml(r, file);
+  // The files, each section's own, are written side by side.
+  std::string maps, texture, plots;
+  const std::function<void()> sections[] = {
+      [&] { maps = MapsHtml(r, file); }, [&] { WriteConfigFiles(r, file); },
+      [&] { texture = TextureHtml(r, file); },
+      [&] {
+        plots = ErrorPlotsHtml(r, file) + NeesPlotHtml(r, file) + TracePlotsHtml(r, file) +
+                ErrorsByConfigHtml(r, file);
+      }};
+  slam::RunTasks(sections, slam::DefaultThreadCount());
 
   std::ostringstream h;
   h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>" << EscapeHtml(r.spec->name)

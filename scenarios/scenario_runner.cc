@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <optional>
+#include <span>
+#include <vector>
 
 #include "scenarios/external_run.h"
 #include "scenarios/external_stream.h"
@@ -26,6 +29,7 @@
 #include "slam/pipeline/external_estimator.h"
 #include "slam/types/error.h"
 #include "slam/types/interrupt.h"
+#include "slam/types/thread_pool.h"
 
 namespace slamrig::scenario {
 namespace {
@@ -36,6 +40,14 @@ namespace {
 constexpr double kRecoveredM = 0.5;
 
 using Runners = std::vector<std::unique_ptr<slam::EstimatorRunner>>;
+
+// Whether the estimators may each run on a thread of their own: none is a program of the user's
+// (a stream's program ends before an offline one starts) or Python (one interpreter).
+bool Concurrent(const Runners& runners) {
+  return std::none_of(runners.begin(), runners.end(), [](const auto& r) {
+    return r->config().algorithm == "external" || r->config().algorithm == "python";
+  });
+}
 
 // A stream-mode external configuration's program, started and attached to its estimator.
 void AttachStream(slam::EstimatorRunner& runner, const std::string& work_dir) {
@@ -515,6 +527,30 @@ std::size_t ScansToRun(const LogSource& log, const std::vector<Record>& records)
   return log.max_scans > 0 ? std::min(n, log.max_scans) : n;
 }
 
+// The estimators take `records` and the reference map its scans, each on a thread of its own
+// where there are processors: they are independent of one another, so the results are the same
+// in any order. `progress` hears every 100th scan of the first estimator.
+void RunSideBySide(Runners& runners, std::span<const Record> records,
+                   std::span<const std::pair<const LaserScan*, Pose2>> truth_map_scans,
+                   slam::OccupancyGrid* truth_map, const std::function<void(Time)>& progress) {
+  std::vector<std::function<void()>> tasks;
+  tasks.emplace_back([&] {
+    for (const auto& [scan, reference] : truth_map_scans) truth_map->InsertScan(*scan, reference);
+  });
+  for (std::size_t i = 0; !records.empty() && i < runners.size(); ++i) {
+    tasks.emplace_back([&, i] {
+      std::size_t scans = 0;
+      for (const Record& record : records) {
+        ThrowIfInterrupted();
+        runners[i]->Add(record);
+        if (i == 0 && progress && std::holds_alternative<LaserScan>(record) && ++scans % 100 == 0)
+          progress(RecordTime(record));
+      }
+    });
+  }
+  slam::RunTasks(tasks, Concurrent(runners) ? slam::DefaultThreadCount() : 1);
+}
+
 ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
   const LogSource& log = *spec.log;
   slam::Dataset data = slam::ReadLog(log.path, log.read);
@@ -554,10 +590,16 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
 
   // The reference map: the log's scans at its reference poses, one per scan in order.
   slam::OccupancyGrid truth_map{slam::OccupancyGridOptions{}};
+  std::vector<std::pair<const LaserScan*, Pose2>> truth_map_scans;
   std::optional<Time> first_time, last_time;
   std::size_t scans = 0;
   const bool limited = spec.has_duration;
-  for (const Record& record : data.records) {
+  // Watched record by record (a recording, a live view, a callback, a pace), the estimators take
+  // each record in turn; else each takes them all on a thread of its own after this loop.
+  const bool watched = recorder || view || options.on_scan || options.pace;
+  std::size_t end = 0;
+  for (; end < data.records.size(); ++end) {
+    const Record& record = data.records[end];
     const Time t = RecordTime(record);
     const bool is_scan = std::holds_alternative<LaserScan>(record);
     if (!first_time) first_time = t;
@@ -569,7 +611,7 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
         const Pose2& reference = data.reference[scans].map_from_base;
         result.truth.Append(data.reference[scans].time, reference);
         if (recorder) recorder->Truth(data.reference[scans].time, reference);
-        if (!true_map) truth_map.InsertScan(*scan, reference);
+        if (!true_map) truth_map_scans.emplace_back(scan, reference);
         if (!map_from_start) map_from_start = reference;
       }
       ++scans;
@@ -578,6 +620,7 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
       ++result.frames;  // a log's frames have no true floor to be scored against
     }
     last_time = last_time ? std::max(*last_time, t) : t;
+    if (!watched) continue;
     if (recorder) recorder->Record(record);
     for (auto& r : runners) r->Add(record);
     if (options.pace) options.pace(t);
@@ -589,6 +632,12 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
       options.progress(SecondsBetween(t, *first_time), spec.duration_s);
     }
   }
+  std::function<void(Time)> progress;
+  if (options.progress) {
+    progress = [&](Time t) { options.progress(SecondsBetween(t, *first_time), spec.duration_s); };
+  }
+  RunSideBySide(runners, std::span(data.records).first(watched ? 0 : end), truth_map_scans,
+                &truth_map, progress);
   if (result.scans == 0) {
     // Scored over the whole reference: no scan to pair reference poses with.
     for (const GroundTruthPose& g : data.reference) result.truth.Append(g.time, g.map_from_base);
