@@ -4,8 +4,10 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "sim/camera/camera_rig.h"
 #include "sim/robot_yaml.h"
@@ -19,6 +21,7 @@
 #include "slam/types/check.h"
 #include "slam/types/error.h"
 #include "slam/types/interrupt.h"
+#include "slam/types/thread_pool.h"
 #include "slam/types/trajectory.h"
 #include "slam/types/validation.h"
 
@@ -184,17 +187,39 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
     }
   };
 
+  // The sinks take the records on a thread of their own, a batch of steps at a time, while the
+  // simulation makes the next batch: the same records in the same order, so the same bytes.
+  // (Declared after what its tasks use: its destructor waits for the task in hand.)
+  constexpr std::size_t kBatchSteps = 64;
+  std::vector<sim::StepResult> batch;
+  std::unique_ptr<slam::BackgroundWorker> writer;
+  if (slam::DefaultThreadCount() > 1) writer = std::make_unique<slam::BackgroundWorker>();
+  auto hand_over = [&] {
+    std::function<void()> task = [&consume, steps = std::move(batch)] {
+      for (const sim::StepResult& step : steps) consume(step);
+    };
+    batch.clear();
+    if (writer) {
+      writer->Start(std::move(task));
+    } else {
+      task();
+    }
+  };
+
   const double limit_s = run.duration_s > 0.0 ? run.duration_s : run.max_duration_s;
   Pose2 previous = sim.Truth().map_from_base;
   while (sim.time().seconds() < limit_s - 0.5 * sim.step_s()) {
     ThrowIfInterrupted();  // the sinks' destructors remove their temporary files
     if (run.duration_s == 0.0 && sim.drive_finished()) break;
-    consume(advance(false));
+    batch.push_back(advance(false));
+    if (batch.size() >= kBatchSteps) hand_over();
     const Pose2 now = sim.Truth().map_from_base;
     summary.path_length_m += (now.translation() - previous.translation()).norm();
     previous = now;
   }
-  consume(advance(true));
+  batch.push_back(advance(true));
+  hand_over();
+  if (writer) writer->Wait();
   log.Commit();
 
   CountRecords(sinks, &summary);
