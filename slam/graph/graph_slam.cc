@@ -21,6 +21,7 @@
 #include "slam/matching/point_raster.h"
 #include "slam/matching/scan_points.h"
 #include "slam/types/check.h"
+#include "slam/types/thread_pool.h"
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
@@ -68,7 +69,8 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
       .Positive("loop_sigma_yaw_floor_rad", loop_sigma_yaw_floor_rad)
       .AtLeast("optimize_every_keyframes", optimize_every_keyframes, 1)
       .Fraction("diverged_strained_share", diverged_strained_share)
-      .Nested("optimizer", optimizer.Validate());
+      .Nested("optimizer", optimizer.Validate())
+      .InRange("threads", num_threads, 0, 1024);
   return rules.errors();
 }
 
@@ -78,36 +80,68 @@ GraphSlam::GraphSlam(const GraphSlamOptions& options)
       optimizer_(options.optimizer),
       consistency_(options.loop_pairwise_chi2) {
   SLAMRIG_CHECK_VALID(options_, "GraphSlamOptions");
+  if (ThreadCount(options.num_threads) > 1) back_end_ = std::make_unique<BackgroundWorker>();
 }
 
+GraphSlam::~GraphSlam() = default;
+
 Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment) {
-  last_step_ = odometry_.Add(scan, odometry_increment);
-  const IcpOdometryStep& step = last_step_;
-  const int index = static_cast<int>(scan_node_.size());
-  const Pose2 since = nodes_.empty() ? Pose2() : nodes_.back().odom_pose.Between(step.pose);
+  // The front end, beside the back end's work on the previous node: ICP odometry never reads the
+  // graph, and what decides a node is the front end's own.
+  IcpOdometryStep step = odometry_.Add(scan, odometry_increment);
+  const bool first = nodes_decided_ == 0;
+  const Pose2 since = first ? Pose2() : newest_node_odom_pose_.Between(step.pose);
   // A doubtful match becomes a node too, so that the odometry check judges it. (A failed match
   // is not: its prior is the wheels', which the next match corrects against the local map.)
   const bool matched = step.outcome == IcpOdometryOutcome::kMatched ||
                        step.outcome == IcpOdometryOutcome::kDegenerate;
   const bool doubtful = matched && step.score < options_.node_below_match_score;
   failed_since_node_ = failed_since_node_ || step.outcome == IcpOdometryOutcome::kMatchFailed;
-  if (nodes_.empty() || since.translation().norm() >= options_.keyframe_distance_m ||
+  std::optional<std::vector<Eigen::Vector2d>> node_points;
+  if (first || since.translation().norm() >= options_.keyframe_distance_m ||
       std::abs(since.theta()) >= options_.keyframe_angle_rad || doubtful) {
     std::vector<Eigen::Vector2d> points = ScanToBasePoints(scan, options_.odometry.points);
-    if (nodes_.empty() || !points.empty()) {
-      AddNode(index, step.pose, doubtful || failed_since_node_, std::move(points));
-      failed_since_node_ = false;
-      SearchLoops();
-      const int added = static_cast<int>(nodes_.size()) - nodes_at_last_optimization_;
-      if (pending_closure_ && added >= options_.optimize_every_keyframes) Optimize();
-    }
+    if (first || !points.empty()) node_points = std::move(points);
   }
-  scan_node_.push_back(static_cast<int>(nodes_.size()) - 1);
-  scan_from_node_.push_back(nodes_.back().odom_pose.Between(step.pose));
-  return graph_.pose(scan_node_.back()) * scan_from_node_.back();
+  JoinBackEnd();  // every earlier node is placed
+  last_step_ = std::move(step);
+  last_scan_is_node_ = node_points.has_value();
+  const int index = static_cast<int>(scan_node_.size());
+  if (!node_points) {
+    scan_node_.push_back(nodes_decided_ - 1);
+    scan_from_node_.push_back(newest_node_odom_pose_.Between(last_step_.pose));
+    return graph_.pose(scan_node_.back()) * scan_from_node_.back();
+  }
+  // A new node: its online pose is the previous node's as the graph has it and the front end's
+  // motion since; the back end places it next (the odometry check, the loop search and an
+  // optimisation move it from there), and the scans after it see where that put it.
+  const Pose2 online = first ? Pose2() : graph_.pose(nodes_decided_ - 1) * since;
+  const bool node_doubtful = doubtful || failed_since_node_;
+  failed_since_node_ = false;
+  newest_node_odom_pose_ = last_step_.pose;
+  scan_node_.push_back(nodes_decided_++);
+  scan_from_node_.push_back(Pose2());
+  auto place = [this, index, pose = last_step_.pose, node_doubtful,
+                points = std::move(*node_points)]() mutable {
+    AddNode(index, pose, node_doubtful, std::move(points));
+    SearchLoops();
+    const int added = static_cast<int>(nodes_.size()) - nodes_at_last_optimization_;
+    if (pending_closure_ && added >= options_.optimize_every_keyframes) Optimize();
+  };
+  if (back_end_) {
+    back_end_->Start(std::move(place));
+  } else {
+    place();
+  }
+  return online;
+}
+
+void GraphSlam::JoinBackEnd() const {
+  if (back_end_) back_end_->Wait();  // rethrows what the back end threw
 }
 
 void GraphSlam::Finish() {
+  JoinBackEnd();
   if (pending_closure_) Optimize();
   CheckOptimality();
   JudgeConsistency();
@@ -148,6 +182,7 @@ void GraphSlam::CheckOptimality() {
 }
 
 std::vector<Pose2> GraphSlam::Poses() const {
+  JoinBackEnd();
   std::vector<Pose2> poses;
   poses.reserve(scan_node_.size());
   for (std::size_t i = 0; i < scan_node_.size(); ++i) {
@@ -157,6 +192,7 @@ std::vector<Pose2> GraphSlam::Poses() const {
 }
 
 std::vector<LoopClosure> GraphSlam::loop_closures() const {
+  JoinBackEnd();
   std::vector<LoopClosure> kept;
   for (std::size_t i = 0; i < closures_.size(); ++i) {
     const std::size_t e = closure_edges_[i];
@@ -167,6 +203,7 @@ std::vector<LoopClosure> GraphSlam::loop_closures() const {
 }
 
 std::vector<LoopClosure> GraphSlam::UnstrainedLoopClosures() const {
+  JoinBackEnd();
   std::vector<LoopClosure> agreed;
   for (std::size_t i = 0; i < closures_.size(); ++i) {
     const std::size_t e = closure_edges_[i];

@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,6 +26,7 @@
 #include "slam/types/loop_closure.h"
 #include "slam/types/pose2.h"
 #include "slam/types/records.h"
+#include "slam/types/thread_pool.h"
 
 namespace slamrig::slam {
 
@@ -66,9 +68,17 @@ class GraphSlam {
  public:
   /// SLAMRIG_CHECKs that options.Validate() is empty.
   explicit GraphSlam(const GraphSlamOptions& options);
+  /// Waits for the back end's work in hand.
+  ~GraphSlam();
+  GraphSlam(const GraphSlam&) = delete;
+  GraphSlam& operator=(const GraphSlam&) = delete;
 
   /// Adds one scan taken after `odometry_increment` (previous base to this base, wheel odometry)
-  /// and returns its pose in the graph's frame (the first scan's base frame).
+  /// and returns its online pose in the graph's frame (the first scan's base frame): the front
+  /// end's motion since the newest node, placed where the graph has that node. A scan that
+  /// becomes a node is placed by the back end after Add returns (with options.num_threads > 1
+  /// on its own thread, beside the front end's next scan); every accessor below waits for it,
+  /// and the next scan's pose is placed on it. Same results with any thread count.
   Pose2 Add(const LaserScan& scan, const Pose2& odometry_increment);
   /// Final optimisation.
   void Finish();
@@ -84,11 +94,22 @@ class GraphSlam {
   std::vector<LoopClosure> UnstrainedLoopClosures() const;
   /// The candidates that failed their match or a check, each with the graph's relative pose
   /// between the two scans when it was tried.
-  const std::vector<LoopClosure>& rejected_closures() const { return rejected_; }
-  const GraphSlamCounts& counts() const { return counts_; }
-  const PoseGraph& graph() const { return graph_; }
+  const std::vector<LoopClosure>& rejected_closures() const {
+    JoinBackEnd();
+    return rejected_;
+  }
+  const GraphSlamCounts& counts() const {
+    JoinBackEnd();
+    return counts_;
+  }
+  const PoseGraph& graph() const {
+    JoinBackEnd();
+    return graph_;
+  }
   /// How the front end (ICP odometry) placed the last scan given to Add(), for its health.
   const IcpOdometryStep& last_step() const { return last_step_; }
+  /// Whether the last scan given to Add() became a node of the graph.
+  bool last_scan_is_node() const { return last_scan_is_node_; }
 
  private:
   struct Node {
@@ -100,6 +121,8 @@ class GraphSlam {
     // odometry check re-placed it, when it carries the next edge over from the previous node.
     Pose2 rematch_offset;
   };
+  // Waits until the back end has placed every node decided so far; rethrows what it threw.
+  void JoinBackEnd() const;
   // Variances (xy, yaw) along the least uncertain graph path from the newest node to every node.
   std::vector<Eigen::Vector2d> PathVariances() const;
   void AddNode(int scan, const Pose2& odom_pose, bool doubtful,
@@ -141,9 +164,16 @@ class GraphSlam {
   PairwiseConsistency consistency_;
   std::vector<PoseGraphEdge> hypothesis_edges_;  // every closure given to consistency_
   std::vector<LoopClosure> hypothesis_closures_;
-  bool failed_since_node_ = false;  // an ICP odometry match failed since the newest node
   bool pending_closure_ = false;
   int nodes_at_last_optimization_ = 0;
+
+  // The front end's side, on the caller's thread only.
+  bool failed_since_node_ = false;  // an ICP odometry match failed since the newest node
+  int nodes_decided_ = 0;           // nodes made, placed by the back end or still to be
+  Pose2 newest_node_odom_pose_;     // the newest node's IcpOdometry pose
+  bool last_scan_is_node_ = false;
+  // The back end's thread, when it has one (destroyed first: it waits for the task in hand).
+  mutable std::unique_ptr<BackgroundWorker> back_end_;
 };
 
 }  // namespace slamrig::slam

@@ -130,6 +130,11 @@ struct GraphSlamOptions {
   /// The back end; Cauchy on loop closures only, by default.
   PoseGraphOptimizerOptions optimizer = {
       .max_iterations = 50, .robust_loss = RobustLoss::kCauchy, .robust_loss_scale = 1.0};
+  /// Threads: with two or more, the back end (placing a node, its loop search, the
+  /// optimisations) runs on a thread of its own beside the front end's next scan; 1 runs both on
+  /// the caller's. 0: one per processor this process may use, or SLAMRIG_THREADS
+  /// (DefaultThreadCount). Results never depend on it.
+  int num_threads = 0;
 
   /// One message per broken rule, named by the field table's keys.
   std::vector<std::string> Validate() const;
@@ -178,6 +183,7 @@ void VisitFields(V& v, GraphSlamOptions& o) {
   v("optimize_every_keyframes", o.optimize_every_keyframes);
   v("diverged_strained_share", o.diverged_strained_share);
   v.Struct("optimizer", o.optimizer);
+  v("threads", o.num_threads);
 }
 
 }  // namespace slamrig::slam

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "slam/eval/loop_closure_score.h"
@@ -87,6 +88,61 @@ TEST(GraphSlamTest, ClosesTheOfficeLoopAndBeatsOdometry) {
   const LoopClosureScore score = ScoreLoopClosures(slam.loop_closures(), reference);
   EXPECT_EQ(score.false_closures, 0);
   EXPECT_GE(score.recall, 0.8);
+}
+
+// The back end on a thread of its own beside the front end gives the very results of one thread:
+// every online pose Add returns, every final pose, every count and closure, bit for bit.
+TEST(GraphSlamTest, ABackEndOnItsOwnThreadGivesTheSameResults) {
+  testing::SyntheticRunOptions options;
+  options.waypoints = testing::OfficeLoop();
+  options.laps = 2;
+  options.max_duration_s = 140.0;  // one lap and a third: closures and optimisations
+  options.scan_rate_hz = 10.0;
+  options.lidar.num_beams = 181;
+  options.lidar.angle_increment_rad = 1.5 * M_PI / 180.0;
+  options.right_scale_error = 0.03;
+  const testing::SyntheticRun run =
+      testing::MakeSyntheticRun(testing::SegmentWorld::Office(), options);
+  const ScanSyncResult synced = SyncToScans(run.records, ScanSyncOptions{});
+  struct Result {
+    std::vector<Pose2> online, poses;
+    GraphSlamCounts counts;
+    std::vector<LoopClosure> closures;
+  };
+  auto slam = [&](int threads) {
+    GraphSlamOptions o;
+    o.num_threads = threads;
+    GraphSlam g{o};
+    Result r;
+    for (const SyncedScan& s : synced.scans) r.online.push_back(g.Add(s.scan, s.increment));
+    g.Finish();
+    r.poses = g.Poses();
+    r.counts = g.counts();
+    r.closures = g.loop_closures();
+    return r;
+  };
+  const Result one = slam(1), two = slam(2);
+  ASSERT_GT(one.counts.loop_closures, 0);
+  ASSERT_GT(one.counts.optimizations, 0);
+  auto same = [](const std::vector<Pose2>& a, const std::vector<Pose2>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (std::memcmp(&a[i], &b[i], sizeof(Pose2)) != 0) return false;
+    }
+    return true;
+  };
+  EXPECT_TRUE(same(one.online, two.online));
+  EXPECT_TRUE(same(one.poses, two.poses));
+  EXPECT_EQ(one.counts.keyframes, two.counts.keyframes);
+  EXPECT_EQ(one.counts.loop_candidates, two.counts.loop_candidates);
+  EXPECT_EQ(one.counts.loop_closures, two.counts.loop_closures);
+  EXPECT_EQ(one.counts.optimizations, two.counts.optimizations);
+  EXPECT_EQ(one.counts.final_chi2, two.counts.final_chi2);
+  ASSERT_EQ(one.closures.size(), two.closures.size());
+  for (std::size_t i = 0; i < one.closures.size(); ++i) {
+    EXPECT_EQ(one.closures[i].from_scan, two.closures[i].from_scan);
+    EXPECT_EQ(one.closures[i].to_scan, two.closures[i].to_scan);
+  }
 }
 
 struct IdenticalRoomsRun {

@@ -17,11 +17,10 @@ GraphSlamEstimator::GraphSlamEstimator(const GraphSlamEstimatorOptions& options,
     : options_(options), slam_(options.graph), map_(options.map) {}
 
 ScanEstimate GraphSlamEstimator::AddScan(const SyncedScan& scan) {
-  const int keyframes = slam_.counts().keyframes;
   const Pose2 pose = slam_.Add(scan.scan, scan.increment);
   // Only the graph's nodes enter the map: inserting every scan at the scan rate wears thin walls
   // away (grazing beams clear them) and over-weights the places where the robot stood still.
-  if (slam_.counts().keyframes > keyframes) {
+  if (slam_.last_scan_is_node()) {
     map_.InsertScan(scan.scan, pose);
     node_scans_.push_back(scan.scan);
   }
