@@ -83,10 +83,9 @@ struct IcpOdometryOptions {
   /// direction) it stands in with its systematic drift taken out. Wheels a fraction of a percent
   /// apart turn a robot a degree per metre; ten metres without a usable scan (an open square, a
   /// black facade) would otherwise cost ten degrees that no later match on new ground repairs.
-  /// The match itself still starts from the raw odometry. Opt-in: on, graph SLAM's final solution
-  /// on the synthetic office loop (GraphSlamTest) is no longer certified (a duality gap of 2e-4
-  /// with lambda_min at 0: the certificate's refinement stalls), which is not understood yet.
-  OdometryCalibrationOptions calibration;
+  /// The match itself still starts from the raw odometry. On by default (docs/estimators.md,
+  /// icp-odometry: the figures with and without it).
+  OdometryCalibrationOptions calibration = {.enabled = true};
 
   /// One message per broken rule (prefixed "icp_odometry."; the ICP and point options' own).
   std::vector<std::string> Validate() const;
