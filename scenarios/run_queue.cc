@@ -22,9 +22,9 @@
 #include "scenarios/slurm_sweep.h"
 #include "scenarios/sweep_summary.h"
 #include "slam/io/atomic_file.h"
-#include "slam/types/thread_pool.h"
 #include "slam/types/error.h"
 #include "slam/types/interrupt.h"
+#include "slam/types/thread_pool.h"
 
 namespace slamrig::scenario {
 namespace {

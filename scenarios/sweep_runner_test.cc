@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "slam/types/thread_pool.h"
 #include "slam/types/error.h"
+#include "slam/types/thread_pool.h"
 #include "tests/util/scoped_env.h"
 #include "tests/util/temp_dir.h"
 

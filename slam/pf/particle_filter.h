@@ -12,9 +12,9 @@
 #include "slam/odometry/odometry_calibration.h"
 #include "slam/pf/particle_filter_options.h"
 #include "slam/pf/solution_remapping.h"
-#include "slam/types/thread_pool.h"
 #include "slam/types/pose2.h"
 #include "slam/types/records.h"
+#include "slam/types/thread_pool.h"
 
 namespace slamrig::slam {
 

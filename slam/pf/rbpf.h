@@ -8,9 +8,9 @@
 #include "slam/odometry/gaussian.h"
 #include "slam/pf/rbpf_matcher.h"
 #include "slam/pf/rbpf_options.h"
-#include "slam/types/thread_pool.h"
 #include "slam/types/pose2.h"
 #include "slam/types/records.h"
+#include "slam/types/thread_pool.h"
 
 namespace slamrig::slam {
 
