@@ -594,9 +594,10 @@ ScenarioResult RunLog(const ScenarioSpec& spec, const RunnerOptions& options) {
   std::optional<Time> first_time, last_time;
   std::size_t scans = 0;
   const bool limited = spec.has_duration;
-  // Watched record by record (a recording, a live view, a callback, a pace), the estimators take
-  // each record in turn; else each takes them all on a thread of its own after this loop.
-  const bool watched = recorder || view || options.on_scan || options.pace;
+  // Watched record by record (a recording or a live view of every estimator, a pace), the
+  // estimators take each record in turn; else each takes them all on a thread of its own after
+  // this loop (on_scan hears the first estimator's scans on that estimator's thread).
+  const bool watched = recorder || view || options.pace;
   std::size_t end = 0;
   for (; end < data.records.size(); ++end) {
     const Record& record = data.records[end];

@@ -24,7 +24,9 @@ struct RunnerOptions {
   /// Called about once per simulated second with (sim time, duration); for progress output.
   std::function<void(double, double)> progress;
   /// A log source: called after each scan the first configuration takes, with the scans taken,
-  /// the scans the run will take and that configuration's runner (its estimator's view).
+  /// the scans the run will take and that configuration's runner (its estimator's view). It may
+  /// be called on a thread other than the caller's (the one that runs the first configuration),
+  /// and `progress` too; never two calls at once.
   std::function<void(std::size_t done, std::size_t total, const slam::SyncedScan& scan,
                      const slam::EstimatorRunner& runner)>
       on_scan;
