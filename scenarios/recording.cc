@@ -4,7 +4,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -192,18 +191,12 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
   // (Declared after what its tasks use: its destructor waits for the task in hand.)
   constexpr std::size_t kBatchSteps = 64;
   std::vector<sim::StepResult> batch;
-  std::unique_ptr<slam::BackgroundWorker> writer;
-  if (slam::DefaultThreadCount() > 1) writer = std::make_unique<slam::BackgroundWorker>();
+  slam::BackgroundWorker writer(slam::DefaultThreadCount() > 1);
   auto hand_over = [&] {
-    std::function<void()> task = [&consume, steps = std::move(batch)] {
+    writer.Start([&consume, steps = std::move(batch)] {
       for (const sim::StepResult& step : steps) consume(step);
-    };
+    });
     batch.clear();
-    if (writer) {
-      writer->Start(std::move(task));
-    } else {
-      task();
-    }
   };
 
   const double limit_s = run.duration_s > 0.0 ? run.duration_s : run.max_duration_s;
@@ -219,7 +212,7 @@ RunSummary RecordSimulation(const sim::SimulatorOptions& options, const RunOptio
   }
   batch.push_back(advance(true));
   hand_over();
-  if (writer) writer->Wait();
+  writer.Wait();
   log.Commit();
 
   CountRecords(sinks, &summary);

@@ -401,22 +401,21 @@ std::string MapsHtml(const ScenarioResult& r, const Folder& file) {
       [&, options] { slam::WriteMapPng(file("map.png"), *background, overlays, options); });
   std::string html = Figure("map.png", "The map from the " + EscapeHtml(truth_source) +
                                            " with the reference and estimated trajectories.");
-  // Each configuration's map is in its own frame: both trajectories are brought there.
-  std::vector<Trajectory> truth_local(r.configs.size()), estimate_local(r.configs.size());
   for (std::size_t i = 0; i < r.configs.size(); ++i) {
     const ConfigResult& c = r.configs[i];
     slam::MapImageOptions own;
     own.title = c.name + ": its own map and trajectory";
     own.segments = OwnMapSegments(r, c);
     images.emplace_back([&, i, own] {
+      // The estimator's map is in its own frame: bring both trajectories there.
       const Pose2 estimator_from_map = c.map_from_estimator.Inverse();
-      for (const auto& p : r.truth.poses())
-        truth_local[i].Append(p.time, estimator_from_map * p.pose);
+      Trajectory truth_local, estimate_local;
+      for (const auto& p : r.truth.poses()) truth_local.Append(p.time, estimator_from_map * p.pose);
       for (const auto& p : c.estimate.poses())
-        estimate_local[i].Append(p.time, estimator_from_map * p.pose);
+        estimate_local.Append(p.time, estimator_from_map * p.pose);
       slam::TrajectoryOverlay truth_here = truth_overlay, estimate_here = overlays[i + 1];
-      truth_here.trajectory = &truth_local[i];
-      estimate_here.trajectory = &estimate_local[i];
+      truth_here.trajectory = &truth_local;
+      estimate_here.trajectory = &estimate_local;
       slam::WriteMapPng(file(c.name + "_map.png"), c.run.map, {truth_here, estimate_here}, own);
     });
     const bool has_landmarks = !c.run.landmarks.landmarks.empty();

@@ -41,11 +41,11 @@ constexpr double kRecoveredM = 0.5;
 
 using Runners = std::vector<std::unique_ptr<slam::EstimatorRunner>>;
 
-// Whether the estimators may each run on a thread of their own: none is a program of the user's
-// (a stream's program ends before an offline one starts) or Python (one interpreter).
+// Whether the estimators may each run on a thread of their own (the algorithm table says).
 bool Concurrent(const Runners& runners) {
-  return std::none_of(runners.begin(), runners.end(), [](const auto& r) {
-    return r->config().algorithm == "external" || r->config().algorithm == "python";
+  return std::all_of(runners.begin(), runners.end(), [](const auto& r) {
+    const slam::Algorithm* algorithm = slam::FindAlgorithm(r->config().algorithm);
+    return algorithm != nullptr && algorithm->runs_beside_others;
   });
 }
 

@@ -78,9 +78,9 @@ GraphSlam::GraphSlam(const GraphSlamOptions& options)
     : options_(options),
       odometry_(options.odometry),
       optimizer_(options.optimizer),
-      consistency_(options.loop_pairwise_chi2) {
+      consistency_(options.loop_pairwise_chi2),
+      back_end_(ThreadCount(options.num_threads) > 1) {
   SLAMRIG_CHECK_VALID(options_, "GraphSlamOptions");
-  if (ThreadCount(options.num_threads) > 1) back_end_ = std::make_unique<BackgroundWorker>();
 }
 
 GraphSlam::~GraphSlam() = default;
@@ -128,16 +128,12 @@ Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment) {
     const int added = static_cast<int>(nodes_.size()) - nodes_at_last_optimization_;
     if (pending_closure_ && added >= options_.optimize_every_keyframes) Optimize();
   };
-  if (back_end_) {
-    back_end_->Start(std::move(place));
-  } else {
-    place();
-  }
+  back_end_.Start(std::move(place));
   return online;
 }
 
 void GraphSlam::JoinBackEnd() const {
-  if (back_end_) back_end_->Wait();  // rethrows what the back end threw
+  back_end_.Wait();  // rethrows what the back end threw
 }
 
 void GraphSlam::Finish() {

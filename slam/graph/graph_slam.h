@@ -13,7 +13,6 @@
 #include <Eigen/Core>
 #include <limits>
 #include <map>
-#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -173,7 +172,7 @@ class GraphSlam {
   Pose2 newest_node_odom_pose_;     // the newest node's IcpOdometry pose
   bool last_scan_is_node_ = false;
   // The back end's thread, when it has one (destroyed first: it waits for the task in hand).
-  mutable std::unique_ptr<BackgroundWorker> back_end_;
+  mutable BackgroundWorker back_end_;
 };
 
 }  // namespace slamrig::slam

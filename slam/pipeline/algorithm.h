@@ -90,6 +90,10 @@ struct Algorithm {
   /// `statistics` is all it reports; false for an algorithm whose statistics are only known
   /// once it runs (a Python class's).
   bool statistics_declared = true;
+  /// It may run on a thread of its own beside the run's other estimators: false for a Python
+  /// class (one interpreter) and a program of the user's (a stream's program ends before an
+  /// offline one starts).
+  bool runs_beside_others = true;
 };
 
 /// Every algorithm, in the order --help lists them.

@@ -92,7 +92,8 @@ const std::vector<Algorithm>& Algorithms() {
        },
        /*maps_landmarks=*/false,
        /*closes_loops=*/true,
-       /*statistics_declared=*/false},
+       /*statistics_declared=*/false,
+       /*runs_beside_others=*/false},
       {"external",
        "any program as an estimator: `command:` (no shell; {input}, {output}, {seed} replaced) "
        "reads the records as `input:` (carmen, mcap, sqlite3, ece276a) and writes a TUM "
@@ -105,7 +106,8 @@ const std::vector<Algorithm>& Algorithms() {
        /*maps_landmarks=*/false,
        /*closes_loops=*/false,
        // The scenario runner adds them after the program ends; the in-process part has none.
-       /*statistics_declared=*/false},
+       /*statistics_declared=*/false,
+       /*runs_beside_others=*/false},
   };
   return algorithms;
 }

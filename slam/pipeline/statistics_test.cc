@@ -38,6 +38,10 @@ TEST(StatisticsTest, EveryAlgorithmReportsExactlyTheStatisticsItDeclares) {
         << a.name << ": a name declared twice";
   }
   EXPECT_FALSE(FindAlgorithm("python")->statistics_declared);
+  // Only the in-process C++ estimators run on threads of their own beside one another.
+  for (const Algorithm& a : Algorithms()) {
+    EXPECT_EQ(a.runs_beside_others, a.name != "python" && a.name != "external") << a.name;
+  }
 }
 
 }  // namespace

@@ -78,9 +78,12 @@ void RunTasks(std::span<const std::function<void()>> tasks, int max_threads) {
   }
 }
 
-BackgroundWorker::BackgroundWorker() : thread_([this] { Loop(); }) {}
+BackgroundWorker::BackgroundWorker(bool threaded) {
+  if (threaded) thread_ = std::thread([this] { Loop(); });
+}
 
 BackgroundWorker::~BackgroundWorker() {
+  if (!thread_.joinable()) return;
   {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait(lock, [this] { return !busy_; });
@@ -91,6 +94,10 @@ BackgroundWorker::~BackgroundWorker() {
 }
 
 void BackgroundWorker::Start(std::function<void()> task) {
+  if (!thread_.joinable()) {
+    task();
+    return;
+  }
   Wait();
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -101,6 +108,7 @@ void BackgroundWorker::Start(std::function<void()> task) {
 }
 
 void BackgroundWorker::Wait() {
+  if (!thread_.joinable()) return;
   std::exception_ptr error;
   {
     std::unique_lock<std::mutex> lock(mutex_);

@@ -33,9 +33,11 @@ void RunTasks(std::span<const std::function<void()>> tasks, int max_threads);
 /// One thread of its own that runs one task at a time beside the caller: Start hands it a task
 /// (after the one in hand has ended), Wait returns when that task has ended and rethrows what it
 /// threw. Kept for the object's life, so a task per scan costs a wake-up, not a thread.
+/// Without a thread (`threaded` false, as one processor asks) Start runs the task in the caller
+/// at once (what it throws comes out of Start) and Wait has nothing to wait for.
 class BackgroundWorker {
  public:
-  BackgroundWorker();
+  explicit BackgroundWorker(bool threaded = true);
   /// Waits for the task in hand (what it threw is dropped), then ends the thread.
   ~BackgroundWorker();
   BackgroundWorker(const BackgroundWorker&) = delete;

@@ -92,6 +92,14 @@ TEST(ThreadPoolTest, ABackgroundWorkerRunsItsTasksInOrderAndRethrows) {
   EXPECT_THROW(worker.Start([] {}), std::runtime_error);  // Start waits for the one in hand
   worker.Wait();
 
+  // Without a thread: each task runs in the caller, at once, and its error comes out of Start.
+  BackgroundWorker inline_worker(false);
+  std::thread::id ran_on;
+  inline_worker.Start([&] { ran_on = std::this_thread::get_id(); });
+  EXPECT_EQ(ran_on, caller);
+  EXPECT_THROW(inline_worker.Start([] { throw std::runtime_error("inline"); }), std::runtime_error);
+  inline_worker.Wait();  // nothing in hand
+
   // The destructor waits for the task in hand.
   std::atomic<bool> done{false};
   {
