@@ -68,6 +68,8 @@ std::vector<SyncedScan> ScanSynchronizer::Add(const Record& record) {
     case OdometrySource::kWheelTicks:
       if (const auto* ticks = std::get_if<WheelTicks>(&record)) {
         interval_.AddTicks(*ticks);
+        last_ticks_time_ = ticks->time;
+        ticks_since_scan_ = true;
       } else if (const auto* imu = std::get_if<ImuSample>(&record)) {
         interval_.AddGyro(imu->angular_velocity_rad_s.z());
       } else if (const auto* scan = std::get_if<LaserScan>(&record)) {
@@ -115,11 +117,15 @@ SyncedScan ScanSynchronizer::CompleteTicks(const LaserScan& scan) {
     synced.increment = DiffDriveIncrement(synced.distance_m, motion.yaw_rad, options_.integration);
     pose_ = pose_ * synced.increment;
     if (!interval_.has_ticks()) ++scans_without_odometry_;
+    if (!ticks_since_scan_ && last_ticks_time_) {
+      synced.odometry_gap_s = SecondsBetween(scan.time, *last_ticks_time_);
+    }
   } else if (!interval_.has_ticks()) {
     ++scans_without_odometry_;
   }
   synced.odom_from_base = pose_;
   last_scan_time_ = scan.time;
+  ticks_since_scan_ = false;
   // Counts before the first scan belong to no interval; start every interval empty.
   interval_.Clear();
   return synced;
@@ -146,16 +152,23 @@ void ScanSynchronizer::CompletePending(const OdometryPose* next, std::vector<Syn
   for (const LaserScan& scan : pending_) {
     Pose2 pose;
     const OdometryPose* last = last_odometry_ ? &*last_odometry_ : nullptr;
+    // No sample since the previous scan: the odometry is silent from `last` to `next` (or to
+    // this scan when none came after it).
+    const bool silent = last && last_scan_time_ && last->time <= *last_scan_time_;
+    double gap_s = 0.0;
     if (last && next && last->time <= scan.time && scan.time <= next->time) {
       pose = Interpolate(*last, *next, scan.time);
+      gap_s = SecondsBetween(next->time, last->time);
     } else if (last) {
       pose = last->odom_from_base;
+      gap_s = SecondsBetween(scan.time, last->time);
     } else if (next) {
       pose = next->odom_from_base;
     } else {
       ++scans_without_odometry_;
     }
     out->push_back(CompleteWithPose(scan, pose));
+    if (silent) out->back().odometry_gap_s = gap_s;
   }
   pending_.clear();
 }

@@ -56,6 +56,12 @@ struct SyncedScan {
   double distance_m = 0.0;      ///< travelled distance in the interval (v * tau), signed
   double yaw_change_rad = 0.0;  ///< heading change in the interval (omega * tau)
   int imu_samples = 0;          ///< gyro samples averaged for this interval
+  /// How long the odometry said nothing about this scan's motion: with odometry poses, the time
+  /// between the two samples the scan's pose was interpolated between (or held from) when that
+  /// span holds no sample after the previous scan; with wheel ticks, the time since the last
+  /// tick record when the interval had none. 0 otherwise, and without odometry. A long one is a
+  /// gap in the log (the robot may have turned through it while the increment holds still).
+  double odometry_gap_s = 0.0;
 };
 
 /// The synchronised scans and what went wrong on the way (counted, never silent).
@@ -94,7 +100,9 @@ class ScanSynchronizer {
   int gyro_fallbacks_ = 0;
   int scans_without_odometry_ = 0;
   std::optional<Time> last_scan_time_;
-  // Wheel ticks: sums since the previous scan.
+  // Wheel ticks: sums since the previous scan, and when the last tick record came.
+  std::optional<Time> last_ticks_time_;
+  bool ticks_since_scan_ = false;
   OdometryInterval interval_;
   std::optional<double> held_rate_;  // last interval's mean gyro rate, for dropouts
   Pose2 pose_;

@@ -124,6 +124,37 @@ TEST(ScanSyncTest, OdometryPosesAreInterpolatedToScanTimes) {
   EXPECT_NEAR(composed.y(), result.scans.back().odom_from_base.y(), 1e-9);
 }
 
+// Odometry poses at 20 Hz with nothing between 5 s and 8 s, scans at 7 Hz: a scan whose interval
+// holds no sample is said to follow a gap as long as the silence it was interpolated across (3 s);
+// every other scan, including the first in the hole (its interval still holds the sample at 5 s),
+// follows none. Wheel ticks at 10 Hz with the same hole: the time since the last tick record.
+TEST(ScanSyncTest, AScanAfterSilentOdometrySaysHowLongItWasSilent) {
+  std::vector<Record> poses, ticks;
+  for (int k = 0; k <= 200; ++k) {
+    const double t = 0.05 * k;
+    if (t > 5.0 + 1e-9 && t < 8.0 - 1e-9) continue;
+    poses.push_back(OdometryPose{Time::FromSeconds(t), Pose2(0.1 * t, 0.0, 0.0)});
+    if (k % 2 == 0) ticks.push_back(WheelTicks{Time::FromSeconds(t), {10}, {10}});
+  }
+  for (int k = 0; k < 60; ++k) {
+    poses.push_back(Scan(0.013 + k / 7.0));
+    ticks.push_back(Scan(0.013 + k / 7.0));
+  }
+  for (std::vector<Record>* records : {&poses, &ticks}) {
+    const ScanSyncResult result = SyncToScans(SortedByTime(std::move(*records)), ScanSyncOptions{});
+    ASSERT_EQ(result.scans.size(), 60u);
+    const bool from_poses = result.source_used == OdometrySource::kOdometryPoses;
+    for (std::size_t i = 1; i < result.scans.size(); ++i) {
+      const double t = result.scans[i].scan.time.seconds();
+      const double previous = result.scans[i - 1].scan.time.seconds();
+      const bool silent = previous > 5.0 && t < 8.0;
+      const double expected = !silent ? 0.0 : from_poses ? 3.0 : t - 5.0;
+      EXPECT_NEAR(result.scans[i].odometry_gap_s, expected, 1e-9)
+          << (from_poses ? "poses " : "ticks ") << i << " at " << t;
+    }
+  }
+}
+
 TEST(ScanSyncTest, NoOdometryGivesIdentityIncrementsAndCountsThem) {
   const ScanSyncResult result = SyncToScans({Scan(0.0), Scan(0.1)}, ScanSyncOptions{});
   EXPECT_EQ(result.source_used, OdometrySource::kNone);

@@ -553,14 +553,51 @@ std::optional<ParticleFilter::ScoredPose> ParticleFilter::AcceptedPlace(
   return ScoredPose{refined.pose, quality};
 }
 
+bool ParticleFilter::SearchAfterGap(const std::vector<Eigen::Vector2d>& points,
+                                    ParticleFilterStep* step) {
+  const RelocalisationOptions& o = options_.relocalisation;
+  // The places' bar is the long-term quality: none before it is trusted.
+  if (!o.enabled || options_.observation != ObservationModel::kLikelihoodField ||
+      tracked_updates_ <= o.warmup_updates || points.size() < kMinGlobalSearchPoints) {
+    return false;
+  }
+  // A one-off search (the map changes with every update): the map within reach of the window.
+  const Pose2& here = step->best_pose;
+  const double half = o.slip_radius_m + Reach(points) + 2.0 * map_.resolution();
+  const Eigen::Vector2d h = Eigen::Vector2d::Constant(half);
+  CorrelativeMatcherOptions m;
+  m.linear_window_m = o.slip_radius_m;
+  m.angular_window_rad = kEveryHeadingRad;
+  m.min_score = 0.0;
+  const CorrelativeMatcher matcher(
+      m, map_, 1, Eigen::AlignedBox2d(here.translation() - h, here.translation() + h));
+  const std::optional<MatchResult> match = matcher.Match(points, here);
+  if (!match) return false;
+  const std::optional<ScoredPose> place = AcceptedPlace(points, match->pose);
+  if (!place || !(place->quality > step->quality + o.win_margin * quality_slow_)) return false;
+  const Pose2 correction = place->pose * here.Inverse();
+  for (Particle& p : particles_) p.pose = correction * p.pose;
+  step->best_pose = place->pose;
+  step->mean_pose = correction * step->mean_pose;
+  step->quality = place->quality;
+  ++gap_correction_count_;
+  return true;
+}
+
 bool ParticleFilter::FitsAsPlace(double quality) const {
   return quality >= options_.relocalisation.accept_ratio * quality_slow_;
 }
 
-ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
+ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
+                                           double odometry_gap_s) {
   if (!started_) return Start(scan);
   pending_motion_ = pending_motion_ * odometry_increment;
-  if (!MovedEnough()) return FollowOdometry();
+  pending_gap_s_ = std::max(pending_gap_s_, odometry_gap_s);
+  const RelocalisationOptions& reloc = options_.relocalisation;
+  const bool after_gap = reloc.odometry_gap_s > 0.0 && pending_gap_s_ > reloc.odometry_gap_s;
+  // After a gap the odometry's silence is no evidence of standing still: update at once.
+  if (!after_gap && !MovedEnough()) return FollowOdometry();
+  pending_gap_s_ = 0.0;
   const Pose2 raw_motion = pending_motion_;
   const Pose2 motion = calibration_.Correct(raw_motion);
   Predict(motion);
@@ -585,6 +622,7 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
   ChooseEstimate(constraints, degenerate, predicted_mean, &step);
   step.quality = Quality(step.best_score, points.size());
   step.neff = EffectiveSampleSize(weights);
+  if (after_gap && !lost_) step.gap_corrected = SearchAfterGap(points, &step);
   if (!UpdateMapAndLostState(scan, points, &step)) {
     last_step_ = step;
     return step;
@@ -596,8 +634,8 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
   if (degenerate) HoldMeanAlongWeakDirections(predicted_mean, constraints);
   // The calibration learns from updates that tracked on both ends: a loss, a relocalisation or a
   // slip correction moves the estimate by more than the odometry's error.
-  if (!points.empty() && !step.lost && !step.relocalised && !last_step_.lost &&
-      !last_step_.relocalised) {
+  if (!points.empty() && !step.lost && !step.relocalised && !step.gap_corrected &&
+      !last_step_.lost && !last_step_.relocalised) {
     calibration_.Observe(raw_motion, last_step_.best_pose.Inverse() * step.best_pose);
   }
   last_step_ = step;

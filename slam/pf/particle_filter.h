@@ -39,6 +39,9 @@ struct ParticleFilterStep {
   double quality = 0.0;
   bool lost = false;         ///< the filter is lost: the map is frozen, the cloud goes on filtering
   bool relocalised = false;  ///< a global match was confirmed and the cloud put there
+  /// The odometry was silent before this update (RelocalisationOptions::odometry_gap_s) and the
+  /// search at every heading near by moved the cloud.
+  bool gap_corrected = false;
 };
 
 /// Particle-filter SLAM on one shared log-odds map, as in the UCSD ECE276A reports (Wang,
@@ -52,8 +55,10 @@ class ParticleFilter {
   explicit ParticleFilter(const ParticleFilterOptions& options);
 
   /// Processes one scan. `odometry_increment` is the robot-frame motion since the previous scan
-  /// (ignored for the first scan, which only starts the map at the identity pose).
-  ParticleFilterStep AddScan(const LaserScan& scan, const Pose2& odometry_increment);
+  /// (ignored for the first scan, which only starts the map at the identity pose);
+  /// `odometry_gap_s` how long the odometry was silent before it (SyncedScan::odometry_gap_s).
+  ParticleFilterStep AddScan(const LaserScan& scan, const Pose2& odometry_increment,
+                             double odometry_gap_s = 0.0);
 
   const std::vector<Particle>& particles() const { return particles_; }
   const OccupancyGrid& map() const { return map_; }
@@ -65,6 +70,8 @@ class ParticleFilter {
   int relocalisation_count() const { return relocalisation_count_; }
   /// Lost alarms that ended with the tracked hypothesis matching well again (no relocalisation).
   int resumed_count() const { return resumed_count_; }
+  /// Updates after an odometry gap on which the search at every heading moved the cloud.
+  int gap_correction_count() const { return gap_correction_count_; }
   /// The likelihood field's sigma now, and the smoothed median wall distance it follows
   /// (AdaptiveSigmaOptions).
   double field_sigma_m() const { return likelihood_field_.sigma_m(); }
@@ -146,6 +153,10 @@ class ParticleFilter {
   // candidates for the next lost update.
   LostVerdict Decide(const std::vector<Eigen::Vector2d>& points, const ScoredPose& tracked,
                      std::vector<Candidate> places);
+  // After an odometry gap (RelocalisationOptions::odometry_gap_s): the best place within
+  // slip_radius_m of the estimate at every heading; when it fits as a place and beats the
+  // filter's own match by win_margin, the cloud moves there. True when it moved.
+  bool SearchAfterGap(const std::vector<Eigen::Vector2d>& points, ParticleFilterStep* step);
   // A new cloud around `place` (reset_sigma_*), tracking from there.
   void RestartAt(const Pose2& place, ParticleFilterStep* step);
   // Farther apart than distinct_radius_m or distinct_angle_rad.
@@ -198,7 +209,8 @@ class ParticleFilter {
   std::vector<Particle> particles_;
   std::vector<double> log_weights_;
   bool started_ = false;
-  Pose2 pending_motion_;  // odometry since the last update
+  Pose2 pending_motion_;        // odometry since the last update
+  double pending_gap_s_ = 0.0;  // the longest odometry gap since the last update
   OdometryCalibration calibration_;
   ParticleFilterStep last_step_;
   int resample_count_ = 0;
@@ -219,6 +231,7 @@ class ParticleFilter {
   int lost_count_ = 0;
   int relocalisation_count_ = 0;
   int resumed_count_ = 0;
+  int gap_correction_count_ = 0;
 };
 
 /// Weighted mean of particle poses: arithmetic in x, y; circular in yaw.

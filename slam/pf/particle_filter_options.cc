@@ -17,6 +17,7 @@ std::vector<std::string> RelocalisationOptions::Validate() const {
       .NonNegative("win_margin", win_margin)
       .Positive("slip_radius_m", slip_radius_m)
       .Positive("slip_angle_rad", slip_angle_rad)
+      .NonNegative("odometry_gap_s", odometry_gap_s)
       .AtLeast("confirm_updates", confirm_updates, 1)
       .AtLeast("global_candidates", global_candidates, 1)
       .Positive("distinct_radius_m", distinct_radius_m)

@@ -84,7 +84,13 @@ struct RelocalisationOptions {
   /// clearly better still) is the odometry slipping by more than the shift search covers, not a
   /// kidnapping: the cloud is moved there and tracking resumes.
   double slip_radius_m = 1.0;
-  double slip_angle_rad = 0.6;       ///< and headings within this of the tracked one
+  double slip_angle_rad = 0.6;  ///< and headings within this of the tracked one
+  /// The odometry went silent for longer than this before an update (a gap in the log,
+  /// SyncedScan::odometry_gap_s): the robot may have turned through it while the increment held
+  /// still. That update also searches within slip_radius_m at every heading, and the cloud moves
+  /// to the place found when it fits as a place (accept_ratio) and beats the filter's own match
+  /// by win_margin. 0: never.
+  double odometry_gap_s = 1.0;
   double search_max_range_m = 10.0;  ///< points used by the global search (a finer yaw step)
   /// The global search's raster: the map max-pooled to this (rounded to a whole number of map
   /// cells, at least one), each place it finds then matched at the map's resolution (the shift
@@ -124,6 +130,7 @@ void VisitFields(V& v, RelocalisationOptions& o) {
   v("resume_updates", o.resume_updates);
   v("slip_radius_m", o.slip_radius_m);
   v("slip_angle_rad", o.slip_angle_rad);
+  v("odometry_gap_s", o.odometry_gap_s);
   v("search_max_range_m", o.search_max_range_m);
   v("search_resolution_m", o.search_resolution_m);
   v("search_window_m", o.search_window_m);

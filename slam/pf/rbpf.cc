@@ -15,6 +15,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "slam/pf/particle_filter.h"
 #include "slam/types/check.h"
@@ -222,6 +223,46 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
   return best.pose.Between(remapped);
 }
 
+Pose2 Rbpf::SearchAfterGap(const Pose2& motion, const std::vector<MatchPoint>& points,
+                           bool* moved) const {
+  // The increment is unknown over the gap: no motion prior on either hypothesis, only the scan's
+  // likelihood on the best particle's map. The grid of headings and positions (a spread subset of
+  // the points, as in CheckOdometry) picks where to climb from.
+  const RbpfParticle& best = particles_[best_];
+  const Pose2 predicted = best.pose * motion;
+  constexpr double kNoPrior = 1e6;
+  const PosePrior no_prior{predicted, kNoPrior, kNoPrior};
+  const ClimbResult near = matcher_.Climb(best.map, points, predicted, no_prior);
+  const double log_near = matcher_.Evaluate(best.map, points, near.pose).log_likelihood;
+  constexpr std::size_t kGridPoints = 48;
+  constexpr double kYawStepRad = 0.02;
+  std::vector<MatchPoint> sparse;
+  const std::size_t stride = std::max<std::size_t>(1, points.size() / kGridPoints);
+  for (std::size_t i = 0; i < points.size(); i += stride) sparse.push_back(points[i]);
+  const double step = options_.odometry_window_step_m;
+  const int n = static_cast<int>(std::ceil(options_.odometry_gap_window_m / step));
+  const int headings = static_cast<int>(std::ceil(2.0 * std::numbers::pi / kYawStepRad));
+  Pose2 start = predicted;
+  double start_ll = -std::numeric_limits<double>::infinity();
+  for (int k = 0; k < headings; ++k) {
+    const double yaw = predicted.theta() + k * (2.0 * std::numbers::pi / headings);
+    for (int iy = -n; iy <= n; ++iy) {
+      for (int ix = -n; ix <= n; ++ix) {
+        const Pose2 pose(predicted.x() + ix * step, predicted.y() + iy * step, yaw);
+        const double ll = matcher_.Evaluate(best.map, sparse, pose).log_likelihood;
+        if (ll > start_ll) {
+          start_ll = ll;
+          start = pose;
+        }
+      }
+    }
+  }
+  const ClimbResult far = matcher_.Climb(best.map, points, start, no_prior);
+  const double log_far = matcher_.Evaluate(best.map, points, far.pose).log_likelihood;
+  *moved = log_far > log_near;
+  return best.pose.Between(*moved ? far.pose : near.pose);
+}
+
 Pose2 Rbpf::RemapDegenerate(const TiledGrid& map, const std::vector<MatchPoint>& points,
                             const Pose2& near, const Pose2& far) const {
   // Solution remapping after Zhang, Kaess, Singh, "On Degeneracy of Optimization-based State
@@ -268,7 +309,8 @@ void Rbpf::Resample(const std::vector<double>& weights) {
   ++resample_count_;
 }
 
-RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
+RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
+                       double odometry_gap_s) {
   RbpfStep step;
   if (!started_) {
     // Every particle starts at the identity with the first scan's map, all tiles shared.
@@ -285,7 +327,10 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
     return step;
   }
   pending_motion_ = pending_motion_ * odometry_increment;
-  if (pending_motion_.translation().norm() < options_.min_update_distance_m &&
+  pending_gap_s_ = std::max(pending_gap_s_, odometry_gap_s);
+  // After a gap the odometry's silence is no evidence of standing still: update at once.
+  const bool after_gap = options_.odometry_gap_s > 0.0 && pending_gap_s_ > options_.odometry_gap_s;
+  if (!after_gap && pending_motion_.translation().norm() < options_.min_update_distance_m &&
       std::abs(pending_motion_.theta()) < options_.min_update_angle_rad) {
     step = last_step_;
     step.best_pose = last_step_.best_pose * pending_motion_;
@@ -297,6 +342,7 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
   }
   const Pose2 pending = pending_motion_;
   pending_motion_ = Pose2();
+  pending_gap_s_ = 0.0;
   step.updated = true;
   ++update_count_;
 
@@ -310,7 +356,11 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment) {
     AssignIndependenceWeights(points, options_.weight_correlation_length_m);
   }
   Pose2 motion = pending;
-  if (options_.odometry_failure_probability > 0.0 && !points.empty()) {
+  if (after_gap && !points.empty()) {
+    bool moved = false;
+    motion = SearchAfterGap(pending, points, &moved);
+    gap_corrections_ += moved;
+  } else if (options_.odometry_failure_probability > 0.0 && !points.empty()) {
     motion = CheckOdometry(pending, points, &step.odometry_rejected);
     odometry_rejections_ += step.odometry_rejected;
   }

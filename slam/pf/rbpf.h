@@ -69,7 +69,9 @@ class Rbpf {
 
   /// Processes one scan; `odometry_increment` is the robot-frame motion since the previous scan
   /// (ignored for the first, which starts every map at the identity pose).
-  RbpfStep AddScan(const LaserScan& scan, const Pose2& odometry_increment);
+  /// `odometry_gap_s`: how long the odometry was silent before it (SyncedScan::odometry_gap_s).
+  RbpfStep AddScan(const LaserScan& scan, const Pose2& odometry_increment,
+                   double odometry_gap_s = 0.0);
 
   const std::vector<RbpfParticle>& particles() const { return particles_; }
   /// The particle with the most likely path.
@@ -83,6 +85,9 @@ class Rbpf {
   /// Updates whose odometry increment the check replaced
   /// (RbpfOptions::odometry_failure_probability).
   int odometry_rejections() const { return odometry_rejections_; }
+  /// Updates after an odometry gap whose increment the search at every heading replaced
+  /// (RbpfOptions::odometry_gap_s).
+  int gap_corrections() const { return gap_corrections_; }
   const RbpfOptions& options() const { return options_; }
 
  private:
@@ -95,6 +100,11 @@ class Rbpf {
   /// the mixture model finds that more likely (then `*rejected` is set).
   Pose2 CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& points,
                       bool* rejected) const;
+  /// After an odometry gap: the most likely of the match near the prediction and the best match
+  /// within +-odometry_gap_window_m at every heading, as an increment (`*moved` when it is the
+  /// latter).
+  Pose2 SearchAfterGap(const Pose2& motion, const std::vector<MatchPoint>& points,
+                       bool* moved) const;
   /// `far` with its translation from `near` dropped along the directions in which the scan
   /// cannot place the robot (odometry_degenerate_ratio).
   Pose2 RemapDegenerate(const TiledGrid& map, const std::vector<MatchPoint>& points,
@@ -117,6 +127,8 @@ class Rbpf {
   int resample_count_ = 0;
   int update_count_ = 0;
   int odometry_rejections_ = 0;
+  int gap_corrections_ = 0;
+  double pending_gap_s_ = 0.0;  // the longest odometry gap since the last update
 };
 
 }  // namespace slamrig::slam

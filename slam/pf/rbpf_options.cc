@@ -33,6 +33,8 @@ std::vector<std::string> RbpfOptions::Validate() const {
       .NonNegative("odometry_window_per_m", odometry_window_per_m)
       .Positive("odometry_window_min_m", odometry_window_min_m)
       .Positive("odometry_window_step_m", odometry_window_step_m)
+      .NonNegative("odometry_gap_s", odometry_gap_s)
+      .NonNegative("odometry_gap_window_m", odometry_gap_window_m)
       .Require(below_one(odometry_degenerate_ratio), "odometry_degenerate_ratio",
                odometry_degenerate_ratio, "must be in [0, 1)")
       .Fraction("resample_neff_ratio", resample_neff_ratio)

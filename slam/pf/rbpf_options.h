@@ -99,6 +99,13 @@ struct RbpfOptions {
   double odometry_window_per_m = 2.0;
   double odometry_window_min_m = 0.1;
   double odometry_window_step_m = 0.1;  ///< spacing of the window's grid of starting poses
+  /// A gap in the log: the odometry silent for longer than odometry_gap_s before an update
+  /// (SyncedScan::odometry_gap_s), through which the robot may have turned while the increment
+  /// held still. The check then says nothing of the increment: it matches over a window of
+  /// +-odometry_gap_window_m at every heading, and the most likely match, there or near the
+  /// prediction, is the increment for every particle. 0: never.
+  double odometry_gap_s = 1.0;
+  double odometry_gap_window_m = 1.0;
   /// A direction in which the scan's information at the window's match is below this fraction of
   /// its information in the best-determined direction is degenerate (a corridor's axis): the
   /// match's displacement along it is dropped and the odometry kept there (Zhang, Kaess, Singh,
@@ -148,6 +155,8 @@ void VisitFields(V& v, RbpfOptions& o) {
   v("odometry_window_per_m", o.odometry_window_per_m);
   v("odometry_window_min_m", o.odometry_window_min_m);
   v("odometry_window_step_m", o.odometry_window_step_m);
+  v("odometry_gap_s", o.odometry_gap_s);
+  v("odometry_gap_window_m", o.odometry_gap_window_m);
   v("odometry_degenerate_ratio", o.odometry_degenerate_ratio);
   v.Enum("resampling", o.resampling,
          {{ResamplingScheme::kSystematic, "systematic"},

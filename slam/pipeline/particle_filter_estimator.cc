@@ -15,7 +15,7 @@ ParticleFilterEstimator::ParticleFilterEstimator(const ParticleFilterOptions& op
     : filter_(Seeded(options, context.seed)) {}
 
 ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
-  const ParticleFilterStep step = filter_.AddScan(scan.scan, scan.increment);
+  const ParticleFilterStep step = filter_.AddScan(scan.scan, scan.increment, scan.odometry_gap_s);
   if (scans_ == 0) start_ = scan.scan.time;
   neff_sum_ += step.neff;
   ++scans_;
@@ -46,7 +46,7 @@ const std::vector<std::string>& ParticleFilterEstimator::StatisticNames() {
   static const std::vector<std::string> names = {
       "mean_neff",       "resamples",       "updates",   "lost",
       "relocalisations", "resumed",         "lost_at_s", "relocalised_at_s",
-      "field_sigma_m",   "wall_distance_m", "diverged"};
+      "field_sigma_m",   "wall_distance_m", "diverged",  "gap_corrections"};
   return names;
 }
 
@@ -58,6 +58,7 @@ std::map<std::string, double> ParticleFilterEstimator::Statistics() const {
           {"relocalisations", filter_.relocalisation_count()},
           {"resumed", filter_.resumed_count()},
           {"lost_at_s", lost_at_s_},
+          {"gap_corrections", filter_.gap_correction_count()},
           {"relocalised_at_s", relocalised_at_s_},
           {"field_sigma_m", filter_.field_sigma_m()},
           {"wall_distance_m", filter_.wall_distance_m()},

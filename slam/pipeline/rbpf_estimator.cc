@@ -17,7 +17,7 @@ RbpfEstimator::RbpfEstimator(const RbpfOptions& options, const EstimatorContext&
     : filter_(Seeded(options, context.seed)), map_(options.map) {}
 
 ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
-  const RbpfStep step = filter_.AddScan(scan.scan, scan.increment);
+  const RbpfStep step = filter_.AddScan(scan.scan, scan.increment, scan.odometry_gap_s);
   offset_ = step.updated ? Pose2() : offset_ * scan.increment;
   scan_offsets_.emplace_back(filter_.update_count() - 1, offset_);
   neff_sum_ += step.neff;
@@ -68,6 +68,7 @@ const std::vector<std::string>& RbpfEstimator::StatisticNames() {
                                                  "updates",
                                                  "failed_matches",
                                                  "odometry_rejections",
+                                                 "gap_corrections",
                                                  "mean_weight_exponent",
                                                  "map_tiles",
                                                  "map_tiles_per_particle",
@@ -84,6 +85,7 @@ std::map<std::string, double> RbpfEstimator::Statistics() const {
           {"updates", updates_},
           {"failed_matches", failed_matches_},
           {"odometry_rejections", filter_.odometry_rejections()},
+          {"gap_corrections", filter_.gap_corrections()},
           {"mean_weight_exponent", updates_ > 0 ? exponent_sum_ / updates_ : 0.0},
           {"map_tiles", tiles},
           {"map_tiles_per_particle",
