@@ -307,13 +307,15 @@ Pose2 GraphSlam::CheckedRelative(const Pose2& icp_relative, const Pose2& alterna
 }
 
 std::vector<Eigen::Vector2d> GraphSlam::PathVariances() const {
-  // Dijkstra from the newest node on the position variance. Walking back along an edge of length
-  // l adds its own xy variance and its yaw variance times the squared lever from it to the newest
-  // node (the path length so far): a heading error at distance r moves the end by r * error.
+  // Dijkstra from the newest node on the position variance. Walking back from node u along an
+  // edge adds the edge's own xy variance and its yaw variance times the squared lever from u to
+  // the newest node: a heading error in the edge turns everything after it about u, and moves
+  // the newest node by |p_newest - p_u| times the error. The lever is the straight distance (the
+  // current estimate's), not the path's length: a loop that comes back near its start has short
+  // levers at both ends.
   struct State {
     double xy = std::numeric_limits<double>::infinity();
     double yaw = 0.0;
-    double length = 0.0;
   };
   const std::size_t n = nodes_.size();
   std::vector<std::vector<std::pair<int, std::size_t>>> adjacent(n);
@@ -325,17 +327,17 @@ std::vector<Eigen::Vector2d> GraphSlam::PathVariances() const {
   std::vector<State> state(n);
   using Item = std::pair<double, int>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-  state[n - 1] = State{0.0, 0.0, 0.0};
+  state[n - 1] = State{0.0, 0.0};
+  const Eigen::Vector2d newest = graph_.pose(static_cast<int>(n - 1)).translation();
   queue.emplace(0.0, static_cast<int>(n - 1));
   while (!queue.empty()) {
     const auto [cost, u] = queue.top();
     queue.pop();
     if (cost > state[u].xy) continue;
+    const double lever_sq = (graph_.pose(u).translation() - newest).squaredNorm();
     for (const auto& [w, e] : adjacent[u]) {
-      const double length = state[u].length + edges[e].measurement.translation().norm();
-      const State next{
-          state[u].xy + edge_variances_[e].x() + edge_variances_[e].y() * length * length,
-          state[u].yaw + edge_variances_[e].y(), length};
+      const State next{state[u].xy + edge_variances_[e].x() + edge_variances_[e].y() * lever_sq,
+                       state[u].yaw + edge_variances_[e].y()};
       if (next.xy < state[w].xy) {
         state[w] = next;
         queue.emplace(next.xy, w);
