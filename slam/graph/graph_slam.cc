@@ -462,6 +462,13 @@ std::optional<PoseGraphEdge> GraphSlam::TryClosure(int candidate, const Eigen::V
   const std::optional<MatchResult> coarse =
       CorrelativeMatcher(search, raster.view).Match(query, guess);
   if (!coarse) return std::nullopt;
+  // A best pose in the window's outermost ring is no peak of the search: the fit still rises
+  // outwards, beyond what the graph's uncertainty allows (an alias whose own peak lies outside).
+  const Eigen::Vector2d offset = coarse->pose.translation() - guess.translation();
+  if (offset.cwiseAbs().maxCoeff() > search.linear_window_m - options_.submap_resolution_m) {
+    ++counts_.window_edge_rejected;
+    return std::nullopt;
+  }
   const std::optional<MatchResult> fine =
       IcpMatcher(options_.loop_icp, submap).Match(query, coarse->pose);
   if (!fine || fine->score < options_.loop_min_icp_score ||

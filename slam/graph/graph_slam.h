@@ -41,6 +41,9 @@ struct GraphSlamCounts {
   /// switchable robust loss; they no longer count as loop closures.
   int switched_off = 0;
   int odometry_rematched = 0;  ///< odometry edges the odometry check replaced
+  /// Loop candidates whose correlative match lay in the search window's outermost ring (no peak
+  /// within the graph's uncertainty), rejected.
+  int window_edge_rejected = 0;
   /// With pairwise consistency: closures that passed their own checks but are outside the
   /// largest pairwise-consistent set (so not in the graph).
   int inconsistent = 0;
