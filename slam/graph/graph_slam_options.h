@@ -111,10 +111,11 @@ struct GraphSlamOptions {
   /// Geometric verification: the closure's Mahalanobis distance to the graph's own relative pose
   /// (with the accumulated and the match covariance) must be below this chi2 (3 dof; 99.9 %).
   double loop_chi2_gate = 16.27;
-  /// Pairwise consistency (Mangelson et al. 2018): with kPairwise the closures that pass the
-  /// checks above enter the graph only while they belong to the largest set whose every pair
-  /// closes its cycle through the odometry within loop_pairwise_chi2 (3 dof).
-  LoopConsistency loop_consistency = LoopConsistency::kNone;
+  /// Pairwise consistency (Mangelson et al. 2018): with kPairwise (the default) the closures that
+  /// pass the checks above enter the graph only while they belong to the largest set whose every
+  /// pair closes its cycle through the odometry within loop_pairwise_chi2 (3 dof): an aisle's
+  /// alias one rack over passes its own gate but not beside the true closures around it.
+  LoopConsistency loop_consistency = LoopConsistency::kPairwise;
   double loop_pairwise_chi2 = 16.27;
   /// The loop edge's covariance: ICP's, raised to at least these standard deviations.
   double loop_sigma_xy_floor_m = 0.02;

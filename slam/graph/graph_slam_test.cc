@@ -216,11 +216,13 @@ TEST(GraphSlamTest, IdenticalRoomsYieldNoFalseClosure) {
 }
 
 // With the chi2 gate against the graph opened wide, the aliased closures get through on their
-// own; pairwise consistency rejects them (room B's closures to room A contradict room B's own
-// closures through the odometry) and keeps the true ones.
+// own without pairwise consistency; with it (the default) they are rejected (room B's closures to
+// room A contradict room B's own closures through the odometry) and the true ones kept.
 TEST(GraphSlamTest, PairwiseConsistencyRejectsAliasedClosuresWithoutTheGate) {
   GraphSlamOptions options;
+  EXPECT_EQ(options.loop_consistency, LoopConsistency::kPairwise);
   options.loop_chi2_gate = 1e9;
+  options.loop_consistency = LoopConsistency::kNone;
   const IdenticalRoomsRun open = RunIdenticalRooms(options);
   ASSERT_GT(open.score.false_closures, 0);  // the gate was what kept them out
   // The false closures pull room B onto room A against the odometry: the graph says so.
