@@ -242,25 +242,46 @@ Pose2 Rbpf::SearchAfterGap(const Pose2& motion, const std::vector<MatchPoint>& p
   const double step = options_.odometry_window_step_m;
   const int n = static_cast<int>(std::ceil(options_.odometry_gap_window_m / step));
   const int headings = static_cast<int>(std::ceil(2.0 * std::numbers::pi / kYawStepRad));
-  Pose2 start = predicted;
-  double start_ll = -std::numeric_limits<double>::infinity();
+  // The best position at each heading; the best few headings, apart from each other, are climbed
+  // (the subset of points ranks them only roughly: a room's other wall may rank first).
+  std::vector<std::pair<double, Pose2>> per_heading;
+  per_heading.reserve(static_cast<std::size_t>(headings));
   for (int k = 0; k < headings; ++k) {
     const double yaw = predicted.theta() + k * (2.0 * std::numbers::pi / headings);
+    std::pair<double, Pose2> best_here{-std::numeric_limits<double>::infinity(), predicted};
     for (int iy = -n; iy <= n; ++iy) {
       for (int ix = -n; ix <= n; ++ix) {
         const Pose2 pose(predicted.x() + ix * step, predicted.y() + iy * step, yaw);
         const double ll = matcher_.Evaluate(best.map, sparse, pose).log_likelihood;
-        if (ll > start_ll) {
-          start_ll = ll;
-          start = pose;
-        }
+        if (ll > best_here.first) best_here = {ll, pose};
       }
     }
+    per_heading.push_back(best_here);
   }
-  const ClimbResult far = matcher_.Climb(best.map, points, start, no_prior);
-  const double log_far = matcher_.Evaluate(best.map, points, far.pose).log_likelihood;
+  std::stable_sort(per_heading.begin(), per_heading.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  constexpr int kStarts = 8;
+  constexpr double kDistinctRad = 0.1;
+  std::vector<Pose2> starts;
+  for (const auto& [ll, pose] : per_heading) {
+    if (static_cast<int>(starts.size()) == kStarts) break;
+    const bool distinct = std::none_of(starts.begin(), starts.end(), [&](const Pose2& s) {
+      return std::abs(NormalizeAngle(s.theta() - pose.theta())) < kDistinctRad;
+    });
+    if (distinct) starts.push_back(pose);
+  }
+  Pose2 far_pose = near.pose;
+  double log_far = -std::numeric_limits<double>::infinity();
+  for (const Pose2& start : starts) {
+    const ClimbResult far = matcher_.Climb(best.map, points, start, no_prior);
+    const double ll = matcher_.Evaluate(best.map, points, far.pose).log_likelihood;
+    if (ll > log_far) {
+      log_far = ll;
+      far_pose = far.pose;
+    }
+  }
   *moved = log_far > log_near;
-  return best.pose.Between(*moved ? far.pose : near.pose);
+  return best.pose.Between(*moved ? far_pose : near.pose);
 }
 
 Pose2 Rbpf::RemapDegenerate(const TiledGrid& map, const std::vector<MatchPoint>& points,
