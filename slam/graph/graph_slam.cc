@@ -501,7 +501,10 @@ std::optional<PoseGraphEdge> GraphSlam::TryClosure(int candidate, const Eigen::V
   const Eigen::Vector3d error(fine->pose.x() - guess.x(), fine->pose.y() - guess.y(),
                               NormalizeAngle(fine->pose.theta() - guess.theta()));
   const double chi2 = error.dot(gate_covariance.ldlt().solve(error));
-  if (!(chi2 <= options_.loop_chi2_gate)) return std::nullopt;
+  if (!(chi2 <= options_.loop_chi2_gate)) {
+    ++counts_.gate_rejected;
+    return std::nullopt;
+  }
 
   PoseGraphEdge edge;
   edge.from = candidate;

@@ -44,6 +44,9 @@ struct GraphSlamCounts {
   /// Loop candidates whose correlative match lay in the search window's outermost ring (no peak
   /// within the graph's uncertainty), rejected.
   int window_edge_rejected = 0;
+  /// Loop candidates whose match passed every check of its own and failed only the chi-square
+  /// gate against the graph: the scans fit there, the graph says elsewhere.
+  int gate_rejected = 0;
   /// With pairwise consistency: closures that passed their own checks but are outside the
   /// largest pairwise-consistent set (so not in the graph).
   int inconsistent = 0;

@@ -65,13 +65,24 @@ int GraphSlamEstimator::UnrepairedLosses() const {
 }
 
 const std::vector<std::string>& GraphSlamEstimator::StatisticNames() {
-  static const std::vector<std::string> names = {
-      "keyframes",      "loop_closures",      "loop_candidates",
-      "rejected",       "optimizations",      "final_chi2",
-      "switched_off",   "odometry_rematched", "window_edge_rejected",
-      "inconsistent",   "certified",          "certificate_lambda_min",
-      "strained_edges", "diverged",           "lost",
-      "chi2_ratio",     "unrepaired_losses"};
+  static const std::vector<std::string> names = {"keyframes",
+                                                 "loop_closures",
+                                                 "loop_candidates",
+                                                 "rejected",
+                                                 "optimizations",
+                                                 "final_chi2",
+                                                 "switched_off",
+                                                 "odometry_rematched",
+                                                 "window_edge_rejected",
+                                                 "gate_rejected",
+                                                 "inconsistent",
+                                                 "certified",
+                                                 "certificate_lambda_min",
+                                                 "strained_edges",
+                                                 "diverged",
+                                                 "lost",
+                                                 "chi2_ratio",
+                                                 "unrepaired_losses"};
   return names;
 }
 
@@ -87,6 +98,7 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"switched_off", c.switched_off},
           {"odometry_rematched", c.odometry_rematched},
           {"window_edge_rejected", c.window_edge_rejected},
+          {"gate_rejected", c.gate_rejected},
           {"inconsistent", c.inconsistent},
           {"certified", c.certified ? 1.0 : 0.0},
           {"certificate_lambda_min", c.certificate_lambda_min},

@@ -42,8 +42,9 @@ class GraphSlamEstimator final : public Estimator {
   std::optional<std::vector<Pose2>> RevisedPoses() const override { return slam_.Poses(); }
   const OccupancyGrid& map() const override { return map_; }
   /// keyframes, loop_closures, loop_candidates, rejected, optimizations, final_chi2,
-  /// switched_off, odometry_rematched, window_edge_rejected, inconsistent, the certificate's, and
-  /// its own judgement: strained_edges, chi2_ratio, unrepaired_losses, lost, diverged.
+  /// switched_off, odometry_rematched, window_edge_rejected, gate_rejected, inconsistent, the
+  /// certificate's, and its own judgement: strained_edges, chi2_ratio, unrepaired_losses, lost,
+  /// diverged.
   std::map<std::string, double> Statistics() const override;
   /// The names Statistics() reports, without an instance: the algorithm table's list (and so
   /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
