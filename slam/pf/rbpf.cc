@@ -263,7 +263,9 @@ Pose2 Rbpf::SearchAfterGap(const Pose2& motion, const std::vector<MatchPoint>& p
   constexpr int kStarts = 8;
   constexpr double kDistinctRad = 0.1;
   std::vector<Pose2> starts;
-  for (const auto& [ll, pose] : per_heading) {
+  for (const std::pair<double, Pose2>& ranked : per_heading) {
+    // Not a structured binding: clang 14 (the fuzz build) refuses one captured by a lambda.
+    const Pose2& pose = ranked.second;
     if (static_cast<int>(starts.size()) == kStarts) break;
     const bool distinct = std::none_of(starts.begin(), starts.end(), [&](const Pose2& s) {
       return std::abs(NormalizeAngle(s.theta() - pose.theta())) < kDistinctRad;
