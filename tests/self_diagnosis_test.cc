@@ -97,8 +97,8 @@ TEST(SelfDiagnosisTest, GraphCallsAnUnrepairedFrontEndLossDiverged) {
 
 // Seattle's log has no ODOM line for 3 s while the robot turns 1.4 rad on the spot: the reader
 // says so, the synchroniser hands the next scan the odometry's silence, and the pf and the rbpf
-// search every heading near by after it (metrics.json's gap_corrections). Without the search
-// both went on from a heading 84 degrees off (2.8 m and 3.0 m).
+// search every heading near by after it (metrics.json's gap_corrections), as ICP odometry does
+// its local map. Without the search they went on from a heading 84 degrees off (2.5-3.0 m).
 TEST(SelfDiagnosisTest, AfterAGapInTheOdometryThePfAndRbpfFindTheTurnItHid) {
   SLAMRIG_REQUIRE_DATASET(log, "carmen_corrected/seattle-corrected.log.gz");
   testing::TempDir dir;
@@ -120,6 +120,12 @@ TEST(SelfDiagnosisTest, AfterAGapInTheOdometryThePfAndRbpfFindTheTurnItHid) {
   const YAML::Node rbpf = slam("rbpf", "--algorithm rbpf --particles 10")["rbpf"];
   EXPECT_EQ(rbpf["gap_corrections"].as<double>(), 1.0);
   EXPECT_LT(rbpf["ate_rmse_m"].as<double>(), 0.3);
+  // ICP odometry searches its local map over every heading after the gap (2.5 m without).
+  const YAML::Node icp = slam("icp", "--algorithm icp-odometry")["icp-odometry"];
+  EXPECT_LT(icp["ate_rmse_m"].as<double>(), 0.3);
+  const YAML::Node icp_blind =
+      slam("icp_blind", "--algorithm icp-odometry --set search.gap_s=0")["icp-odometry"];
+  EXPECT_GT(icp_blind["ate_rmse_m"].as<double>(), 1.0);
 }
 
 }  // namespace

@@ -85,10 +85,11 @@ GraphSlam::GraphSlam(const GraphSlamOptions& options)
 
 GraphSlam::~GraphSlam() = default;
 
-Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment) {
+Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment,
+                     double odometry_gap_s) {
   // The front end, beside the back end's work on the previous node: ICP odometry never reads the
   // graph, and what decides a node is the front end's own.
-  IcpOdometryStep step = odometry_.Add(scan, odometry_increment);
+  IcpOdometryStep step = odometry_.Add(scan, odometry_increment, odometry_gap_s);
   const bool first = nodes_decided_ == 0;
   const Pose2 since = first ? Pose2() : newest_node_odom_pose_.Between(step.pose);
   // A doubtful match becomes a node too, so that the odometry check judges it. (A failed match

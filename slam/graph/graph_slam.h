@@ -84,7 +84,8 @@ class GraphSlam {
   /// becomes a node is placed by the back end after Add returns (with options.num_threads > 1
   /// on its own thread, beside the front end's next scan); every accessor below waits for it,
   /// and the next scan's pose is placed on it. Same results with any thread count.
-  Pose2 Add(const LaserScan& scan, const Pose2& odometry_increment);
+  /// `odometry_gap_s`: how long the odometry was silent before the scan (IcpOdometry's search).
+  Pose2 Add(const LaserScan& scan, const Pose2& odometry_increment, double odometry_gap_s = 0.0);
   /// Final optimisation.
   void Finish();
 

@@ -23,7 +23,8 @@ std::vector<std::string> IcpOdometrySearchOptions::Validate() const {
       .Positive("blur_m", blur_m)
       .NonNegative("min_gain", min_gain)
       .NonNegative("prior_weight", prior_weight)
-      .Fraction("adapt_rate", adapt_rate);
+      .Fraction("adapt_rate", adapt_rate)
+      .NonNegative("gap_s", gap_s);
   return rules.errors();
 }
 
@@ -170,8 +171,9 @@ std::pair<int, std::vector<KeyframeShareOf>> IcpOdometry::AddKeyframe(
   return {keyframes_.back().id, std::move(shares)};
 }
 
-IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_increment) {
-  return Add(scan, std::vector<Pose2>{odometry_increment});
+IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_increment,
+                                 double odometry_gap_s) {
+  return Add(scan, std::vector<Pose2>{odometry_increment}, odometry_gap_s);
 }
 
 std::optional<MatchResult> IcpOdometry::GatedMatch(const std::vector<Eigen::Vector2d>& points,
@@ -188,7 +190,8 @@ std::optional<MatchResult> IcpOdometry::GatedMatch(const std::vector<Eigen::Vect
   return match;
 }
 
-IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>& increments) {
+IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>& increments,
+                                 double odometry_gap_s) {
   SLAMRIG_CHECK(!increments.empty(), "IcpOdometry::Add: no increment");
   const std::vector<Eigen::Vector2d> points = ScanToBasePoints(scan, options_.points);
   ++counts_.scans;
@@ -210,10 +213,16 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
   // best, which is standing still), and the search and the degenerate directions keep to it.
   std::optional<MatchResult> match;
   const Pose2& odometry_increment = increments.front();
+  // After a gap the increment says nothing: the widest window, every heading.
+  const bool after_gap = options_.search.gap_s > 0.0 && odometry_gap_s > options_.search.gap_s;
+  auto window_of = [&](const Pose2& increment) {
+    return after_gap ? Eigen::Vector2d(options_.search.max_window_m, std::numbers::pi)
+                     : SearchWindow(increment);
+  };
   if (!points.empty() && matcher_) {
     for (std::size_t i = 0; i < increments.size(); ++i) {
       std::optional<MatchResult> m =
-          GatedMatch(points, pose_ * increments[i], SearchWindow(increments[i]));
+          GatedMatch(points, pose_ * increments[i], window_of(increments[i]));
       const double margin = match && i > 0 ? options_.search.min_gain : 0.0;
       if (m && (!match || m->score > match->score + margin)) match = std::move(m);
     }
@@ -228,7 +237,7 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
       r * prior_covariance.topLeftCorner<2, 2>() * r.transpose();
   step.pose = fallback;
   step.prior = prior;
-  step.window = SearchWindow(odometry_increment);
+  step.window = window_of(odometry_increment);
   step.covariance = prior_covariance;
   if (!points.empty() && matcher_) {
     const IcpOdometryCounts before = counts_;
@@ -265,7 +274,7 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
     step.covariance = match->covariance;
     step.score = match->score;
     step.outcome = degenerate ? IcpOdometryOutcome::kDegenerate : IcpOdometryOutcome::kMatched;
-    if (!degenerate) MeasureNoise(prior, step.pose, odometry_increment);
+    if (!degenerate && !after_gap) MeasureNoise(prior, step.pose, odometry_increment);
   }
   switch (step.outcome) {
     case IcpOdometryOutcome::kMatched:
@@ -286,7 +295,7 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
 
   // The drift is fitted from clear matches following clear matches: the increment between them
   // is the scans' own, not a correction of what a blind stretch let accumulate.
-  if (step.outcome == IcpOdometryOutcome::kMatched && last_matched_) {
+  if (step.outcome == IcpOdometryOutcome::kMatched && last_matched_ && !after_gap) {
     calibration_.Observe(odometry_increment, pose_.Inverse() * step.pose);
   }
   last_matched_ = step.outcome == IcpOdometryOutcome::kMatched;

@@ -38,6 +38,11 @@ struct IcpOdometrySearchOptions {
   /// The online noise measurement: an exponentially weighted mean (this weight per matched scan)
   /// of the squared corrections of clear matches, in units of the noise model's sigma; 0: off.
   double adapt_rate = 0.05;
+  /// After the odometry was silent for longer than this (SyncedScan::odometry_gap_s: a gap in the
+  /// log, through which the robot may have turned while the increment held still) the search
+  /// runs over max_window_m and every heading, whatever the noise model says, and the update
+  /// teaches neither the noise measurement nor the calibration. 0: never.
+  double gap_s = 1.0;
 
   /// One message per broken rule (unprefixed; IcpOdometryOptions nests them under "search").
   std::vector<std::string> Validate() const;
@@ -144,12 +149,15 @@ class IcpOdometry {
 
   /// Places `scan`, taken after the robot moved by `odometry_increment` (base frame at the previous
   /// scan to base frame at this one, from the wheel odometry; ignored for the first scan).
-  IcpOdometryStep Add(const LaserScan& scan, const Pose2& odometry_increment);
+  /// `odometry_gap_s`: how long the odometry was silent before the scan (search.gap_s).
+  IcpOdometryStep Add(const LaserScan& scan, const Pose2& odometry_increment,
+                      double odometry_gap_s = 0.0);
   /// Places `scan` from several candidate increments, the first the prior (a motion prediction)
   /// and the others seeds for ICP: the match from each that passes the gates, a seed's replacing
   /// the best so far only when it scores better by search.min_gain; the search, the fallback and
   /// the degenerate directions keep to the prior. One increment: exactly Add(scan, increment).
-  IcpOdometryStep Add(const LaserScan& scan, const std::vector<Pose2>& increments);
+  IcpOdometryStep Add(const LaserScan& scan, const std::vector<Pose2>& increments,
+                      double odometry_gap_s = 0.0);
 
   const Pose2& pose() const { return pose_; }
   /// The odometry's noise as measured so far, in units of the noise model's sigma (x and y, yaw):

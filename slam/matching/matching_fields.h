@@ -43,6 +43,7 @@ void VisitFields(V& v, IcpOdometrySearchOptions& o) {
   v("min_gain", o.min_gain);
   v("prior_weight", o.prior_weight);
   v("adapt_rate", o.adapt_rate);
+  v("gap_s", o.gap_s);
 }
 
 /// The field table of IcpOdometryOptions.

@@ -17,7 +17,7 @@ GraphSlamEstimator::GraphSlamEstimator(const GraphSlamEstimatorOptions& options,
     : options_(options), slam_(options.graph), map_(options.map) {}
 
 ScanEstimate GraphSlamEstimator::AddScan(const SyncedScan& scan) {
-  const Pose2 pose = slam_.Add(scan.scan, scan.increment);
+  const Pose2 pose = slam_.Add(scan.scan, scan.increment, scan.odometry_gap_s);
   // Only the graph's nodes enter the map: inserting every scan at the scan rate wears thin walls
   // away (grazing beams clear them) and over-weights the places where the robot stood still.
   if (slam_.last_scan_is_node()) {

@@ -22,7 +22,7 @@ IcpOdometryEstimator::IcpOdometryEstimator(const IcpOdometryEstimatorOptions& op
     : odometry_(options.icp_odometry), map_(options.map) {}
 
 ScanEstimate IcpOdometryEstimator::AddScan(const SyncedScan& scan) {
-  const IcpOdometryStep step = odometry_.Add(scan.scan, scan.increment);
+  const IcpOdometryStep step = odometry_.Add(scan.scan, scan.increment, scan.odometry_gap_s);
   map_.InsertScan(scan.scan, step.pose);
   ScanEstimate estimate;
   estimate.pose = step.pose;
