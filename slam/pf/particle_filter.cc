@@ -279,10 +279,7 @@ bool ParticleFilter::Relocalise(const std::vector<Eigen::Vector2d>& points, cons
     case LostDecision::kCorrectSlip: {
       // The best place near by fits better than the filter's: the odometry slipped, no
       // kidnapping. Tracking resumes there.
-      const Pose2 correction = verdict.pose * step->best_pose.Inverse();
-      for (Particle& p : particles_) p.pose = correction * p.pose;
-      step->best_pose = correction * step->best_pose;
-      step->mean_pose = correction * step->mean_pose;
+      MoveCloud(verdict.pose, step);
       ResumeTracking();
       step->lost = false;
       return false;
@@ -553,6 +550,13 @@ std::optional<ParticleFilter::ScoredPose> ParticleFilter::AcceptedPlace(
   return ScoredPose{refined.pose, quality};
 }
 
+void ParticleFilter::MoveCloud(const Pose2& to, ParticleFilterStep* step) {
+  const Pose2 correction = to * step->best_pose.Inverse();
+  for (Particle& p : particles_) p.pose = correction * p.pose;
+  step->best_pose = correction * step->best_pose;
+  step->mean_pose = correction * step->mean_pose;
+}
+
 bool ParticleFilter::SearchAfterGap(const std::vector<Eigen::Vector2d>& points,
                                     ParticleFilterStep* step) {
   const RelocalisationOptions& o = options_.relocalisation;
@@ -575,10 +579,7 @@ bool ParticleFilter::SearchAfterGap(const std::vector<Eigen::Vector2d>& points,
   if (!match) return false;
   const std::optional<ScoredPose> place = AcceptedPlace(points, match->pose);
   if (!place || !(place->quality > step->quality + o.win_margin * quality_slow_)) return false;
-  const Pose2 correction = place->pose * here.Inverse();
-  for (Particle& p : particles_) p.pose = correction * p.pose;
-  step->best_pose = place->pose;
-  step->mean_pose = correction * step->mean_pose;
+  MoveCloud(place->pose, step);
   step->quality = place->quality;
   ++gap_correction_count_;
   return true;

@@ -157,6 +157,9 @@ class ParticleFilter {
   // slip_radius_m of the estimate at every heading; when it fits as a place and beats the
   // filter's own match by win_margin, the cloud moves there. True when it moved.
   bool SearchAfterGap(const std::vector<Eigen::Vector2d>& points, ParticleFilterStep* step);
+  // Moves the whole cloud, and the step's estimate and mean, by the rigid correction that puts
+  // the estimate at `to` (a slip corrected, a turn found after a gap).
+  void MoveCloud(const Pose2& to, ParticleFilterStep* step);
   // A new cloud around `place` (reset_sigma_*), tracking from there.
   void RestartAt(const Pose2& place, ParticleFilterStep* step);
   // Farther apart than distinct_radius_m or distinct_angle_rad.

@@ -413,49 +413,28 @@ TEST(ParticleFilterTest, AfterAGapInTheOdometryTheFilterFindsTheTurnItMissed) {
   ASSERT_EQ(run.scans.size(), truth.size());
   // The first stretch, well after the start, over which the robot turns by more than 1 rad
   // within 3 s (what neither the filter's shift search nor its slip search could follow).
-  std::size_t from = 0, to = 0;
-  for (std::size_t i = 30; i < truth.size() && to == 0; ++i) {
-    for (std::size_t j = i + 1; j < truth.size() && j <= i + 30; ++j) {
-      const double turn =
-          NormalizeAngle(truth[j].map_from_base.theta() - truth[i].map_from_base.theta());
-      if (std::abs(turn) > 1.0) {
-        from = i;
-        to = j;
-        break;
-      }
-    }
-  }
-  ASSERT_GT(to, from) << "no turn in the run";
-  // The final pose's position and heading errors, and the corrections the gap search made.
+  const testing::Stretch turn = testing::FirstTurn(truth, 1.0, 30, 30);
+  ASSERT_GT(turn.to, turn.from) << "no turn in the run";
+  const std::vector<SyncedScan> scans = testing::WithOdometryGap(run.scans, turn);
+  // The final pose's errors, and the corrections the gap search made.
   struct Outcome {
-    double position_m = 0.0;
-    double heading_rad = 0.0;
+    testing::EndError end;
     int corrections = 0;
   };
   auto run_with = [&](const ParticleFilterOptions& options) {
     ParticleFilter filter(options);
     ParticleFilterStep step;
-    for (std::size_t i = 0; i < run.scans.size(); ++i) {
-      if (i > from && i < to) continue;  // the gap: no scan, no odometry
-      const bool after_gap = i == to;
-      const double gap_s =
-          after_gap ? SecondsBetween(run.scans[to].scan.time, run.scans[from].scan.time) : 0.0;
-      step = filter.AddScan(run.scans[i].scan, after_gap ? Pose2() : run.scans[i].increment, gap_s);
-    }
-    const Pose2 end = truth.front().map_from_base * step.best_pose;
-    const Pose2& last = truth.back().map_from_base;
-    return Outcome{(end.translation() - last.translation()).norm(),
-                   std::abs(NormalizeAngle(end.theta() - last.theta())),
-                   filter.gap_correction_count()};
+    for (const SyncedScan& s : scans) step = filter.AddScan(s.scan, s.increment, s.odometry_gap_s);
+    return Outcome{testing::EndPoseError(step.best_pose, truth), filter.gap_correction_count()};
   };
   ParticleFilterOptions options = FastOptions();
   const Outcome searched = run_with(options);
-  EXPECT_LT(searched.position_m, 0.1);
-  EXPECT_LT(searched.heading_rad, 0.05);
+  EXPECT_LT(searched.end.position_m, 0.1);
+  EXPECT_LT(searched.end.heading_rad, 0.05);
   EXPECT_EQ(searched.corrections, 1);
   options.relocalisation.odometry_gap_s = 0.0;
   const Outcome not_searched = run_with(options);
-  EXPECT_GT(not_searched.heading_rad, 0.5);
+  EXPECT_GT(not_searched.end.heading_rad, 0.5);
   EXPECT_EQ(not_searched.corrections, 0);
 }
 

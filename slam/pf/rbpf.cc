@@ -21,6 +21,19 @@
 #include "slam/types/check.h"
 
 namespace slamrig::slam {
+namespace {
+
+// About 48 of `points`, spread along the scan: ranks a grid of poses, for a climb from the best,
+// at a fraction of every point's cost.
+std::vector<MatchPoint> SpreadSubset(const std::vector<MatchPoint>& points) {
+  constexpr std::size_t kGridPoints = 48;
+  std::vector<MatchPoint> sparse;
+  const std::size_t stride = std::max<std::size_t>(1, points.size() / kGridPoints);
+  for (std::size_t i = 0; i < points.size(); i += stride) sparse.push_back(points[i]);
+  return sparse;
+}
+
+}  // namespace
 
 RbpfPoseNode::~RbpfPoseNode() {
   std::shared_ptr<RbpfPoseNode> next = std::move(parent);
@@ -195,10 +208,7 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
   if (!(log_far_density + log_yaw_density(predicted) > log_near)) return motion;
   // The grid only picks where to climb from: a spread subset of the points ranks its poses at a
   // fraction of the cost (the window holds thousands of poses on a log with 1 m increments).
-  constexpr std::size_t kGridPoints = 48;
-  std::vector<MatchPoint> sparse;
-  const std::size_t stride = std::max<std::size_t>(1, points.size() / kGridPoints);
-  for (std::size_t i = 0; i < points.size(); i += stride) sparse.push_back(points[i]);
+  const std::vector<MatchPoint> sparse = SpreadSubset(points);
   Pose2 start = predicted;
   double start_ll = -std::numeric_limits<double>::infinity();
   for (int iy = -n; iy <= n; ++iy) {
@@ -234,11 +244,8 @@ Pose2 Rbpf::SearchAfterGap(const Pose2& motion, const std::vector<MatchPoint>& p
   const PosePrior no_prior{predicted, kNoPrior, kNoPrior};
   const ClimbResult near = matcher_.Climb(best.map, points, predicted, no_prior);
   const double log_near = matcher_.Evaluate(best.map, points, near.pose).log_likelihood;
-  constexpr std::size_t kGridPoints = 48;
   constexpr double kYawStepRad = 0.02;
-  std::vector<MatchPoint> sparse;
-  const std::size_t stride = std::max<std::size_t>(1, points.size() / kGridPoints);
-  for (std::size_t i = 0; i < points.size(); i += stride) sparse.push_back(points[i]);
+  const std::vector<MatchPoint> sparse = SpreadSubset(points);
   const double step = options_.odometry_window_step_m;
   const int n = static_cast<int>(std::ceil(options_.odometry_gap_window_m / step));
   const int headings = static_cast<int>(std::ceil(2.0 * std::numbers::pi / kYawStepRad));

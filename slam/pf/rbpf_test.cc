@@ -196,48 +196,29 @@ TEST(RbpfTest, AfterAGapInTheOdometryTheFilterFindsTheTurnItMissed) {
   const ShortRun& run = GetShortRun();
   const std::vector<GroundTruthPose>& truth = run.run.truth;
   ASSERT_EQ(run.scans.size(), truth.size());
-  std::size_t from = 0, to = 0;
-  for (std::size_t i = 30; i < truth.size() && to == 0; ++i) {
-    for (std::size_t j = i + 1; j < truth.size() && j <= i + 30; ++j) {
-      if (std::abs(NormalizeAngle(truth[j].map_from_base.theta() -
-                                  truth[i].map_from_base.theta())) > 1.0) {
-        from = i;
-        to = j;
-        break;
-      }
-    }
-  }
-  ASSERT_GT(to, from) << "no turn in the run";
+  const slam::testing::Stretch turn = slam::testing::FirstTurn(truth, 1.0, 30, 30);
+  ASSERT_GT(turn.to, turn.from) << "no turn in the run";
+  const std::vector<SyncedScan> scans = slam::testing::WithOdometryGap(run.scans, turn);
   struct Outcome {
-    double position_m = 0.0;
-    double heading_rad = 0.0;
+    slam::testing::EndError end;
     int corrections = 0;
   };
   auto run_with = [&](const RbpfOptions& options) {
     Rbpf filter(options);
     RbpfStep step;
-    for (std::size_t i = 0; i < run.scans.size(); ++i) {
-      if (i > from && i < to) continue;  // the gap: no scan, no odometry
-      const bool after_gap = i == to;
-      const double gap_s =
-          after_gap ? SecondsBetween(run.scans[to].scan.time, run.scans[from].scan.time) : 0.0;
-      step = filter.AddScan(run.scans[i].scan, after_gap ? Pose2() : run.scans[i].increment, gap_s);
-    }
-    const Pose2 end = truth.front().map_from_base * step.best_pose;
-    const Pose2& last = truth.back().map_from_base;
-    return Outcome{(end.translation() - last.translation()).norm(),
-                   std::abs(NormalizeAngle(end.theta() - last.theta())), filter.gap_corrections()};
+    for (const SyncedScan& s : scans) step = filter.AddScan(s.scan, s.increment, s.odometry_gap_s);
+    return Outcome{slam::testing::EndPoseError(step.best_pose, truth), filter.gap_corrections()};
   };
   RbpfOptions options = FastOptions();
   options.num_particles = 5;  // the search is the best particle's: a few keep the test fast
   const Outcome searched = run_with(options);
   // The filter on this short run ends a few centimetres and hundredths of a radian off.
-  EXPECT_LT(searched.position_m, 0.15);
-  EXPECT_LT(searched.heading_rad, 0.1);
+  EXPECT_LT(searched.end.position_m, 0.15);
+  EXPECT_LT(searched.end.heading_rad, 0.1);
   EXPECT_EQ(searched.corrections, 1);
   options.odometry_gap_s = 0.0;
   const Outcome not_searched = run_with(options);
-  EXPECT_GT(not_searched.heading_rad, 0.5);
+  EXPECT_GT(not_searched.end.heading_rad, 0.5);
   EXPECT_EQ(not_searched.corrections, 0);
 }
 

@@ -129,4 +129,37 @@ double AnchoredPositionRmse(const std::vector<Pose2>& estimate,
   return std::sqrt(sum / static_cast<double>(estimate.size()));
 }
 
+Stretch FirstTurn(const std::vector<GroundTruthPose>& truth, double min_turn_rad, std::size_t first,
+                  std::size_t max_scans) {
+  for (std::size_t i = first; i < truth.size(); ++i) {
+    for (std::size_t j = i + 1; j < truth.size() && j <= i + max_scans; ++j) {
+      const double turn =
+          NormalizeAngle(truth[j].map_from_base.theta() - truth[i].map_from_base.theta());
+      if (std::abs(turn) > min_turn_rad) return {i, j};
+    }
+  }
+  return {};
+}
+
+std::vector<SyncedScan> WithOdometryGap(const std::vector<SyncedScan>& scans, Stretch gap) {
+  std::vector<SyncedScan> out;
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    if (i > gap.from && i < gap.to) continue;
+    out.push_back(scans[i]);
+    if (i == gap.to) {
+      out.back().increment = Pose2();
+      out.back().odometry_gap_s =
+          SecondsBetween(scans[gap.to].scan.time, scans[gap.from].scan.time);
+    }
+  }
+  return out;
+}
+
+EndError EndPoseError(const Pose2& last_estimate, const std::vector<GroundTruthPose>& truth) {
+  const Pose2 end = truth.front().map_from_base * last_estimate;
+  const Pose2& last = truth.back().map_from_base;
+  return {(end.translation() - last.translation()).norm(),
+          std::abs(NormalizeAngle(end.theta() - last.theta()))};
+}
+
 }  // namespace slamrig::slam::testing

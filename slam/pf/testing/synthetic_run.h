@@ -63,4 +63,25 @@ const std::vector<Record>& SmallOfficeRecords();
 double AnchoredPositionRmse(const std::vector<Pose2>& estimate,
                             const std::vector<GroundTruthPose>& truth);
 
+/// Scans `from` to `to` of a run.
+struct Stretch {
+  std::size_t from = 0;
+  std::size_t to = 0;
+};
+/// The first stretch from scan `first` on over which the truth turns by more than `min_turn_rad`
+/// within `max_scans` scans (the shortest from its start); {0, 0} when there is none.
+Stretch FirstTurn(const std::vector<GroundTruthPose>& truth, double min_turn_rad, std::size_t first,
+                  std::size_t max_scans);
+/// `scans` with a gap in the log over `gap`: the scans strictly inside it are missing (scan and
+/// odometry), and scan `gap.to` comes with no motion and the odometry's silence since `gap.from`
+/// (SyncedScan::odometry_gap_s), as a reader hands a log without ODOM lines there.
+std::vector<SyncedScan> WithOdometryGap(const std::vector<SyncedScan>& scans, Stretch gap);
+
+/// How far the last pose of an estimate (anchored at the first true pose) ends from the truth's.
+struct EndError {
+  double position_m = 0.0;
+  double heading_rad = 0.0;
+};
+EndError EndPoseError(const Pose2& last_estimate, const std::vector<GroundTruthPose>& truth);
+
 }  // namespace slamrig::slam::testing
