@@ -24,7 +24,10 @@ std::vector<std::string> IcpOdometrySearchOptions::Validate() const {
       .NonNegative("min_gain", min_gain)
       .NonNegative("prior_weight", prior_weight)
       .Fraction("adapt_rate", adapt_rate)
-      .NonNegative("gap_s", gap_s);
+      .NonNegative("gap_s", gap_s)
+      .NonNegative("wide_window_m", wide_window_m)
+      .Require(wide_window_rad >= 0.0 && wide_window_rad <= std::numbers::pi, "wide_window_rad",
+               wide_window_rad, "must be in [0, pi]");
   return rules.errors();
 }
 
@@ -106,20 +109,39 @@ Eigen::Vector2d IcpOdometry::SearchWindow(const Pose2& increment) const {
 
 std::optional<MatchResult> IcpOdometry::SearchedMatch(const std::vector<Eigen::Vector2d>& points,
                                                       const Pose2& prior,
-                                                      const Eigen::Vector2d& window,
+                                                      const Eigen::Vector2d& model_window,
                                                       std::optional<MatchResult> from_prior) {
   const IcpOdometrySearchOptions& o = options_.search;
   if (o.sigmas <= 0.0) return from_prior;
-  if (from_prior && window.x() <= o.trigger_window_m && window.y() <= o.trigger_window_rad) {
+  // Below the trigger the prior is left to ICP: a correction beyond a window of centimetres is
+  // ICP's own scatter more often than a wrong prior (searching wide there cost a long corridor's
+  // log 0.14 m; docs/studies/front-end-search.md).
+  if (from_prior && model_window.x() <= o.trigger_window_m &&
+      model_window.y() <= o.trigger_window_rad) {
     return from_prior;
   }
   ++counts_.searched;
+  // ICP from the prior failed, or it moved the prior farther than the window (by more than a
+  // raster cell or a yaw step): the prior is farther off than the noise model says (an odometry
+  // that under-reports a turn puts the truth outside a window drawn around the reported turn, and
+  // ICP from there finds a neighbouring minimum). The search then runs over the wide window.
+  const double yaw_step = o.resolution_m / 10.0;
+  bool doubted = !from_prior;
+  if (from_prior) {
+    const Pose2 correction = prior.Between(from_prior->pose);
+    doubted = correction.translation().norm() > model_window.x() + o.resolution_m ||
+              std::abs(correction.theta()) > model_window.y() + yaw_step;
+  }
+  const Eigen::Vector2d window =
+      doubted ? model_window.cwiseMax(Eigen::Vector2d(o.wide_window_m, o.wide_window_rad))
+              : model_window;
+  counts_.widened += doubted ? 1 : 0;
   if (!raster_) raster_ = RasterOf(matcher_->reference(), o.resolution_m, o.blur_m);
   const std::vector<Eigen::Vector2d> query = Thinned(points, o.resolution_m);
   // The yaw step: a point 10 m out moves one raster cell; ICP takes the rest.
   const CorrelativeMatcherOptions search{.linear_window_m = window.x(),
                                          .angular_window_rad = window.y(),
-                                         .angular_step_rad = o.resolution_m / 10.0,
+                                         .angular_step_rad = yaw_step,
                                          .branch_and_bound_depth = 5,
                                          .min_score = 0.05};
   const std::optional<MatchResult> coarse =
@@ -244,6 +266,7 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
     match = SearchedMatch(points, prior, step.window, std::move(match));
     step.searched = counts_.searched > before.searched;
     step.search_chosen = counts_.search_chosen > before.search_chosen;
+    step.search_widened = counts_.widened > before.widened;
   }
 
   // Failed unless the match below says otherwise (also with no local map yet).

@@ -28,8 +28,16 @@ struct IcpOdometrySearchOptions {
   double trigger_window_rad = 0.1;  ///< ... in yaw, or when ICP's match from the prior failed
   double max_window_m = 2.0;        ///< the window is at most this wide ...
   double max_window_rad = 1.0;      ///< ... and this in yaw
-  double resolution_m = 0.1;        ///< the local map's raster for the search ...
-  double blur_m = 0.1;              ///< ... each point blurred by a Gaussian of this sigma
+  /// When ICP from the prior fails, or moves the prior farther than the window (by more than a
+  /// raster cell or a yaw step), the prior is doubted and the window is at least this wide in x
+  /// and y ... (0: the noise model's: a doubted prior is a heading's, and a wider translation
+  /// window finds a long corridor's aliases; docs/studies/front-end-search.md)
+  double wide_window_m = 0.0;
+  /// ... and this in yaw: an odometry that under-reports a turn puts the truth outside a window
+  /// drawn around the reported one. 0: the noise model's.
+  double wide_window_rad = 1.0;
+  double resolution_m = 0.1;  ///< the local map's raster for the search ...
+  double blur_m = 0.1;        ///< ... each point blurred by a Gaussian of this sigma
   /// The searched match replaces the one from the prior when its posterior is higher by this
   /// much: the points' fit to the raster (mean raster value) less prior_weight times the squared
   /// Mahalanobis distance from the prior (sigma = window / sigmas); the prior's match wins ties.
@@ -116,10 +124,11 @@ struct IcpOdometryStep {
   Pose2 prior;         ///< odom_from_base the scan was matched from (the odometry increment's)
   /// The prior's search window (x and y in m, yaw in rad): +-sigmas of its measured noise.
   Eigen::Vector2d window = Eigen::Vector2d::Zero();
-  bool searched = false;       ///< a correlative search ran before ICP for this scan ...
-  bool search_chosen = false;  ///< ... and its match replaced the one from the prior
-  bool keyframe = false;       ///< the scan joined the local map
-  int keyframe_id = -1;        ///< its number as a keyframe (0, 1, ...); -1 when it did not join
+  bool searched = false;        ///< a correlative search ran before ICP for this scan ...
+  bool search_chosen = false;   ///< ... and its match replaced the one from the prior
+  bool search_widened = false;  ///< the prior was doubted: the search ran over the wide window
+  bool keyframe = false;        ///< the scan joined the local map
+  int keyframe_id = -1;         ///< its number as a keyframe (0, 1, ...); -1 when it did not join
   /// When it joined: the share in the map's frame (FrameWeights, at the scan's pose) of every
   /// keyframe in the map it was matched against, as this scan saw it; what moves the frame
   /// (KeyframeErrors). Empty for point-to-point ICP.
@@ -135,6 +144,7 @@ struct IcpOdometryCounts {
   int no_points = 0;
   int searched = 0;       ///< scans searched correlatively before ICP
   int search_chosen = 0;  ///< ... whose searched match replaced the one from the prior
+  int widened = 0;        ///< scans searched over the wide window (the prior doubted)
 };
 
 /// Scan-to-local-map ICP odometry with the wheel odometry as the prior: each scan is matched by

@@ -113,6 +113,37 @@ TEST(IcpOdometryTest, SearchesBeyondIcpsBasinWhenTheOdometryIsPoor) {
   EXPECT_GT(icp_rmse, 4.0 * searched_rmse);
 }
 
+// Turning on the spot in a room corner, 0.5 rad a scan, the odometry once reports 0.2 of a 0.9 rad
+// turn (a wheel skids): the truth is 0.7 rad off the prior, far outside the noise model's window
+// around the reported turn (+-0.13 rad). ICP from there finds a neighbouring minimum or fails;
+// either way the prior is doubted and the search over the wide window finds the heading. With the
+// wide window off, it is lost.
+TEST(IcpOdometryTest, DoubtsAPriorThatUnderReportsATurn) {
+  const SegmentWorld world = SegmentWorld::Office();
+  auto run = [&](double wide_window_rad) {
+    RandomEngine rng(29);
+    IcpOdometryOptions options;
+    options.search.wide_window_rad = wide_window_rad;
+    IcpOdometry icp(options);
+    const Pose2 start(3.0, 2.5, 0.0);
+    IcpOdometryStep step;
+    int widened = 0;
+    for (int k = 0; k < 8; ++k) {
+      const double reported = k == 0 ? 0.0 : (k == 4 ? 0.2 : 0.5);
+      const double yaw = 0.5 * k + (k >= 4 ? 0.4 : 0.0);
+      step = icp.Add(world.Scan(start * Pose2(0.0, 0.0, yaw), Time(), RangeFinderSpec{}, &rng),
+                     Pose2(0.0, 0.0, reported));
+      widened += step.search_widened ? 1 : 0;
+    }
+    return std::make_pair(std::abs(NormalizeAngle(step.pose.theta() - 3.9)), widened);
+  };
+  const auto [wide_error, wide_count] = run(1.0);
+  const auto [narrow_error, narrow_count] = run(0.0);
+  EXPECT_LT(wide_error, 0.01);
+  EXPECT_GE(wide_count, 1);
+  EXPECT_GT(narrow_error, 0.1);
+}
+
 // In a featureless corridor the match is degenerate along the axis: the pose follows odometry
 // along it and the scans across it, and every such scan is counted.
 TEST(IcpOdometryTest, FallsBackToOdometryAlongADegenerateCorridor) {

@@ -38,6 +38,8 @@ void VisitFields(V& v, IcpOdometrySearchOptions& o) {
   v("trigger_window_rad", o.trigger_window_rad);
   v("max_window_m", o.max_window_m);
   v("max_window_rad", o.max_window_rad);
+  v("wide_window_m", o.wide_window_m);
+  v("wide_window_rad", o.wide_window_rad);
   v("resolution_m", o.resolution_m);
   v("blur_m", o.blur_m);
   v("min_gain", o.min_gain);

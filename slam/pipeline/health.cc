@@ -88,6 +88,7 @@ bool FrontEndHealth::Judge(const IcpOdometryStep& step, std::vector<TraceValue>*
   trace->push_back({"match_score_ratio", ratio});
   trace->push_back({"match_conditioning", conditioning});
   trace->push_back({"searched", step.searched ? (step.search_chosen ? 2.0 : 1.0) : 0.0});
+  trace->push_back({"search_widened", step.search_widened ? 1.0 : 0.0});
   trace->push_back({"correction_xy_of_window", correction.x()});
   trace->push_back({"correction_yaw_of_window", correction.y()});
   // Lost: the match failed (the scan placed by the odometry alone, blind) or the match score's

@@ -157,7 +157,7 @@ TEST(HealthTest, FrontEndIsLostOnAFailedMatchAndOnAFallingScore) {
   for (const TraceValue& v : trace) names.push_back(v.name);
   EXPECT_EQ(names, (std::vector<std::string>{
                        "match_score", "match_score_ratio", "match_conditioning", "searched",
-                       "correction_xy_of_window", "correction_yaw_of_window"}));
+                       "search_widened", "correction_xy_of_window", "correction_yaw_of_window"}));
   EXPECT_DOUBLE_EQ(trace[2].value, 1.0);  // an isotropic covariance: well conditioned
   EXPECT_TRUE(health.Judge(Step(IcpOdometryOutcome::kMatchFailed, 0.0), &trace));
   EXPECT_TRUE(health.Judge(Step(IcpOdometryOutcome::kNoPoints, 0.0), &trace));

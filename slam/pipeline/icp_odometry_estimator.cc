@@ -33,8 +33,8 @@ ScanEstimate IcpOdometryEstimator::AddScan(const SyncedScan& scan) {
 }
 
 const std::vector<std::string>& IcpOdometryEstimator::StatisticNames() {
-  static const std::vector<std::string> names = {"matched", "degenerate", "failed", "lost",
-                                                 "diverged"};
+  static const std::vector<std::string> names = {"matched", "degenerate", "failed",
+                                                 "widened", "lost",       "diverged"};
   return names;
 }
 
@@ -43,6 +43,7 @@ std::map<std::string, double> IcpOdometryEstimator::Statistics() const {
   return {{"matched", c.matched},
           {"degenerate", c.degenerate},
           {"failed", c.failed + c.no_points},
+          {"widened", c.widened},
           {"lost", health_.losses()},
           // Every loss stays in the estimate: an odometry closes no loops that could measure it.
           {"diverged", health_.Diverged() || health_.losses() > 0 ? 1.0 : 0.0}};
