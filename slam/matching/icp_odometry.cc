@@ -113,21 +113,21 @@ std::optional<MatchResult> IcpOdometry::SearchedMatch(const std::vector<Eigen::V
                                                       std::optional<MatchResult> from_prior) {
   const IcpOdometrySearchOptions& o = options_.search;
   if (o.sigmas <= 0.0) return from_prior;
-  // Below the trigger the prior is left to ICP: a correction beyond a window of centimetres is
-  // ICP's own scatter more often than a wrong prior (searching wide there cost a long corridor's
-  // log 0.14 m; docs/studies/front-end-search.md).
-  if (from_prior && model_window.x() <= o.trigger_window_m &&
-      model_window.y() <= o.trigger_window_rad) {
-    return from_prior;
-  }
+  // Below the trigger the prior is left to ICP: a correction beyond a window of centimetres, or a
+  // failed match there, is ICP's own scatter or a scan too poor to match more often than a wrong
+  // prior (searching wide there cost a long corridor's log 0.14 m, and a log without odometry
+  // 0.7 m; docs/studies/front-end-search.md).
+  const bool above_trigger =
+      model_window.x() > o.trigger_window_m || model_window.y() > o.trigger_window_rad;
+  if (from_prior && !above_trigger) return from_prior;
   ++counts_.searched;
   // ICP from the prior failed, or it moved the prior farther than the window (by more than a
   // raster cell or a yaw step): the prior is farther off than the noise model says (an odometry
   // that under-reports a turn puts the truth outside a window drawn around the reported turn, and
   // ICP from there finds a neighbouring minimum). The search then runs over the wide window.
   const double yaw_step = o.resolution_m / 10.0;
-  bool doubted = !from_prior;
-  if (from_prior) {
+  bool doubted = above_trigger && !from_prior;
+  if (above_trigger && from_prior) {
     const Pose2 correction = prior.Between(from_prior->pose);
     doubted = correction.translation().norm() > model_window.x() + o.resolution_m ||
               std::abs(correction.theta()) > model_window.y() + yaw_step;

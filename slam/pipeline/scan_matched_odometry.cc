@@ -23,6 +23,9 @@ IcpOdometryOptions WideGates() {
   o.sigma_yaw_floor_rad = 0.25;
   o.search.sigmas = 3.0;
   o.search.adapt_rate = 0.0;
+  // The windows are the prediction's own, every scan: a failed or far-moved match is a robot's
+  // change of mind, not a wheel's under-reported turn to search wider for.
+  o.search.wide_window_rad = 0.0;
   o.calibration.enabled = false;
   return o;
 }
