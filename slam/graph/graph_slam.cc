@@ -98,6 +98,8 @@ Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment,
                        step.outcome == IcpOdometryOutcome::kDegenerate;
   const bool doubtful = matched && step.score < options_.node_below_match_score;
   failed_since_node_ = failed_since_node_ || step.outcome == IcpOdometryOutcome::kMatchFailed;
+  blind_since_node_ = blind_since_node_ || step.outcome == IcpOdometryOutcome::kMatchFailed ||
+                      step.outcome == IcpOdometryOutcome::kNoPoints;
   std::optional<std::vector<Eigen::Vector2d>> node_points;
   if (first || since.translation().norm() >= options_.keyframe_distance_m ||
       std::abs(since.theta()) >= options_.keyframe_angle_rad || doubtful) {
@@ -118,13 +120,20 @@ Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment,
   // optimisation move it from there), and the scans after it see where that put it.
   const Pose2 online = first ? Pose2() : graph_.pose(nodes_decided_ - 1) * since;
   const bool node_doubtful = doubtful || failed_since_node_;
+  // Where the front end went blind since the last node the edge is the wheels' (calibrated)
+  // increment: it carries their noise, as the front end measured it, not ICP's.
+  std::optional<Eigen::Vector2d> blind_noise;
+  if (blind_since_node_ && options_.blind_edge_odometry_noise) {
+    blind_noise = odometry_.noise_scale();
+  }
   failed_since_node_ = false;
+  blind_since_node_ = false;
   newest_node_odom_pose_ = last_step_.pose;
   scan_node_.push_back(nodes_decided_++);
   scan_from_node_.push_back(Pose2());
-  auto place = [this, index, pose = last_step_.pose, node_doubtful,
+  auto place = [this, index, pose = last_step_.pose, node_doubtful, blind_noise,
                 points = std::move(*node_points)]() mutable {
-    AddNode(index, pose, node_doubtful, std::move(points));
+    AddNode(index, pose, node_doubtful, blind_noise, std::move(points));
     SearchLoops();
     const int added = static_cast<int>(nodes_.size()) - nodes_at_last_optimization_;
     if (pending_closure_ && added >= options_.optimize_every_keyframes) Optimize();
@@ -212,6 +221,7 @@ std::vector<LoopClosure> GraphSlam::UnstrainedLoopClosures() const {
 }
 
 void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
+                        const std::optional<Eigen::Vector2d>& blind_noise,
                         std::vector<Eigen::Vector2d> points) {
   const int id = static_cast<int>(nodes_.size());
   Node node{scan, odom_pose, std::move(points), Eigen::Vector2d::Zero(), Pose2()};
@@ -226,9 +236,15 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
         icp_relative, nodes_.back().rematch_offset * icp_relative, doubtful, node.points);
     node.rematch_offset = relative.Inverse() * icp_relative;
     const double d = relative.translation().norm();
-    const double sxy = options_.edge_sigma_xy_per_m * d + options_.edge_sigma_xy_floor_m;
-    const double syaw = options_.edge_sigma_yaw_per_rad * std::abs(relative.theta()) +
-                        options_.edge_sigma_yaw_per_m * d + options_.edge_sigma_yaw_floor_rad;
+    double sxy = options_.edge_sigma_xy_per_m * d + options_.edge_sigma_xy_floor_m;
+    double syaw = options_.edge_sigma_yaw_per_rad * std::abs(relative.theta()) +
+                  options_.edge_sigma_yaw_per_m * d + options_.edge_sigma_yaw_floor_rad;
+    if (blind_noise) {
+      const IcpOdometryOptions& o = options_.odometry;
+      sxy = std::max(sxy, blind_noise->x() * (o.sigma_xy_per_m * d + o.sigma_xy_floor_m));
+      syaw = std::max(syaw, blind_noise->y() * (o.sigma_yaw_per_rad * std::abs(relative.theta()) +
+                                                o.sigma_yaw_per_m * d + o.sigma_yaw_floor_rad));
+    }
     node.edge_variance = {sxy * sxy, syaw * syaw};
     graph_.AddVertex(id, graph_.pose(id - 1) * relative);
     PoseGraphEdge edge{

@@ -132,6 +132,7 @@ class GraphSlam {
   // Variances (xy, yaw) along the least uncertain graph path from the newest node to every node.
   std::vector<Eigen::Vector2d> PathVariances() const;
   void AddNode(int scan, const Pose2& odom_pose, bool doubtful,
+               const std::optional<Eigen::Vector2d>& blind_noise,
                std::vector<Eigen::Vector2d> points);
   // The pose of `points` in the newest node's frame: `relative` (ICP odometry's), or the
   // odometry check's re-match when it fits the last nodes clearly better (from the better fitting
@@ -175,6 +176,7 @@ class GraphSlam {
 
   // The front end's side, on the caller's thread only.
   bool failed_since_node_ = false;  // an ICP odometry match failed since the newest node
+  bool blind_since_node_ = false;   // ... or a scan had no points (the odometry stood in)
   int nodes_decided_ = 0;           // nodes made, placed by the back end or still to be
   Pose2 newest_node_odom_pose_;     // the newest node's IcpOdometry pose
   bool last_scan_is_node_ = false;

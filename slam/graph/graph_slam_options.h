@@ -55,6 +55,11 @@ struct GraphSlamOptions {
   double edge_sigma_yaw_per_rad = 0.05;
   double edge_sigma_yaw_per_m = 0.005;
   double edge_sigma_yaw_floor_rad = 0.002;
+  /// An edge over which the front end went blind (a failed match, a scan without points: the
+  /// wheels' increment stood in) takes at least the odometry's noise: IcpOdometry's increment
+  /// model (odometry.sigma_*) times the noise it measured, so that a loop closure bends the
+  /// graph there, not along the matched stretches (docs/studies/graph.md).
+  bool blind_edge_odometry_noise = true;
   /// Odometry check: each new node's ICP-odometry pose is re-searched by the correlative matcher
   /// against the last odometry_check_nodes nodes' points (0: off), within +-window of it, and
   /// refined by loop_icp; the re-match replaces the edge when its blurred-raster score beats the
@@ -152,6 +157,7 @@ void VisitFields(V& v, GraphSlamOptions& o) {
   v("edge_sigma_yaw_per_rad", o.edge_sigma_yaw_per_rad);
   v("edge_sigma_yaw_per_m", o.edge_sigma_yaw_per_m);
   v("edge_sigma_yaw_floor_rad", o.edge_sigma_yaw_floor_rad);
+  v("blind_edge_odometry_noise", o.blind_edge_odometry_noise);
   v("odometry_check_nodes", o.odometry_check_nodes);
   v("odometry_check_window_m", o.odometry_check_window_m);
   v("odometry_check_window_rad", o.odometry_check_window_rad);

@@ -315,5 +315,50 @@ TEST(GraphSlamTest, WideOdometryCheckRecoversAMissedTurn) {
   EXPECT_LT(error_on.translation().norm(), 0.05);
 }
 
+// A stretch where the lidar returns nothing (every beam at its maximum range: scans without
+// points, so no node either): the odometry stands in, and the edge over it carries at least the
+// odometry's noise model, whose heading drift per metre is four times the graph's own; with the
+// option off, and on every matched edge, the graph's model holds.
+TEST(GraphSlamTest, AnEdgeOverABlindStretchCarriesTheOdometrysNoise) {
+  const testing::SegmentWorld world = RoomWithDeskAndPillar();
+  const testing::RangeFinderSpec lidar = Lidar181();
+  auto run = [&](bool blind_noise) {
+    GraphSlamOptions options;
+    options.keyframe_distance_m = 0.3;
+    options.loop_max_candidates = 0;
+    options.blind_edge_odometry_noise = blind_noise;
+    GraphSlam slam{options};
+    RandomEngine rng(7);
+    Pose2 pose(1.0, 1.2, 0.0);
+    for (int k = 0; k < 40; ++k) {
+      LaserScan scan =
+          world.Scan(pose, Time{static_cast<std::int64_t>(k) * 100'000'000}, lidar, &rng);
+      if (k >= 15 && k < 25) {
+        std::fill(scan.ranges_m.begin(), scan.ranges_m.end(), scan.range_max_m);
+      }
+      slam.Add(scan, k == 0 ? Pose2() : Pose2(0.1, 0.0, 0.0));
+      pose = pose * Pose2(0.1, 0.0, 0.0);
+    }
+    slam.Finish();
+    // Each odometry edge's heading sigma over the graph model's for its length and turn.
+    std::vector<double> ratios;
+    for (const PoseGraphEdge& e : slam.graph().edges()) {
+      if (e.kind != EdgeKind::kOdometry) continue;
+      const double d = e.measurement.translation().norm();
+      const double model = options.edge_sigma_yaw_per_rad * std::abs(e.measurement.theta()) +
+                           options.edge_sigma_yaw_per_m * d + options.edge_sigma_yaw_floor_rad;
+      ratios.push_back(1.0 / std::sqrt(e.information(2, 2)) / model);
+    }
+    return ratios;
+  };
+  const std::vector<double> on = run(true), off = run(false);
+  ASSERT_GE(on.size(), 8u);
+  // The edges before the stretch matched (the model); the one over it (about 1.2 m) is the
+  // odometry's: (0.02 * 1.2 + 0.002) / (0.005 * 1.2 + 0.002) = 3.25 times, at least.
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR(on[i], 1.0, 1e-9) << i;
+  EXPECT_GT(*std::max_element(on.begin(), on.end()), 3.0);
+  for (std::size_t i = 0; i < off.size(); ++i) EXPECT_NEAR(off[i], 1.0, 1e-9) << i;
+}
+
 }  // namespace
 }  // namespace slamrig::slam
