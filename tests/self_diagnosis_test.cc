@@ -86,9 +86,10 @@ TEST(SelfDiagnosisTest, GraphCallsAnUnrepairedFrontEndLossDiverged) {
   EXPECT_GE(repaired["lost_intervals"].as<double>(), 1.0);
   EXPECT_EQ(repaired["unrepaired_losses"].as<double>(), 0.0);
   EXPECT_EQ(repaired["diverged"].as<double>(), 0.0);
-  // The same with three scans in ten dropped: a loss no closure spans.
+  // The same with half the scans dropped: a loss no closure spans. (With three in ten dropped
+  // the front end's search over a doubted prior now holds the route, 0.10 m.)
   const YAML::Node noisy =
-      GraphOnIntelStart(dir, log, "noisy", noisy_odometry + " --perturb scans.drop_fraction=0.3");
+      GraphOnIntelStart(dir, log, "noisy", noisy_odometry + " --perturb scans.drop_fraction=0.5");
   EXPECT_GT(noisy["ate_rmse_m"].as<double>(), 1.0);  // the failure the verdict must see
   EXPECT_GE(noisy["lost_intervals"].as<double>(), 1.0);
   EXPECT_GE(noisy["unrepaired_losses"].as<double>(), 1.0);
