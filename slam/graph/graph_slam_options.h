@@ -47,11 +47,10 @@ struct GraphSlamOptions {
   /// Odometry edge noise between consecutive nodes (d: distance, |turn|: heading change):
   /// sigma_xy = edge_sigma_xy_per_m * d + edge_sigma_xy_floor_m, sigma_yaw =
   /// edge_sigma_yaw_per_rad * |turn| + edge_sigma_yaw_per_m * d + edge_sigma_yaw_floor_rad. The
-  /// information is its inverse (the floors keep it regular). The translation term is ICP's
-  /// (2 % of the distance; an edge over which the front end went blind takes the wheels' own,
-  /// below), the turn term IcpOdometry's increment noise model, the heading drift per metre ICP's,
-  /// far below the wheels'.
-  double edge_sigma_xy_per_m = 0.02;
+  /// information is its inverse (the floors keep it regular). The translation and turn terms
+  /// are IcpOdometry's own increment noise model; heading drift per metre is ICP's, far below
+  /// the wheels'.
+  double edge_sigma_xy_per_m = 0.05;
   double edge_sigma_xy_floor_m = 0.005;
   double edge_sigma_yaw_per_rad = 0.05;
   double edge_sigma_yaw_per_m = 0.005;
