@@ -240,10 +240,10 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
     double syaw = options_.edge_sigma_yaw_per_rad * std::abs(relative.theta()) +
                   options_.edge_sigma_yaw_per_m * d + options_.edge_sigma_yaw_floor_rad;
     if (blind_noise) {
-      const IcpOdometryOptions& o = options_.odometry;
-      sxy = std::max(sxy, blind_noise->x() * (o.sigma_xy_per_m * d + o.sigma_xy_floor_m));
-      syaw = std::max(syaw, blind_noise->y() * (o.sigma_yaw_per_rad * std::abs(relative.theta()) +
-                                                o.sigma_yaw_per_m * d + o.sigma_yaw_floor_rad));
+      const Eigen::Vector2d wheels =
+          blind_noise->cwiseProduct(options_.odometry.IncrementSigmas(relative));
+      sxy = std::max(sxy, wheels.x());
+      syaw = std::max(syaw, wheels.y());
     }
     node.edge_variance = {sxy * sxy, syaw * syaw};
     graph_.AddVertex(id, graph_.pose(id - 1) * relative);

@@ -68,23 +68,22 @@ const std::vector<Eigen::Vector2d>& IcpOdometry::local_map() const {
 }
 
 Eigen::Matrix3d IcpOdometry::IncrementCovariance(const Pose2& increment) const {
-  const Eigen::Vector2d sigma = ModelSigmas(increment).cwiseProduct(noise_scale_);
+  const Eigen::Vector2d sigma = options_.IncrementSigmas(increment).cwiseProduct(noise_scale_);
   return Eigen::Vector3d(sigma.x() * sigma.x(), sigma.x() * sigma.x(), sigma.y() * sigma.y())
       .asDiagonal();
 }
 
-Eigen::Vector2d IcpOdometry::ModelSigmas(const Pose2& increment) const {
+Eigen::Vector2d IcpOdometryOptions::IncrementSigmas(const Pose2& increment) const {
   const double d = increment.translation().norm();
-  return {options_.sigma_xy_per_m * d + options_.sigma_xy_floor_m,
-          options_.sigma_yaw_per_rad * std::abs(increment.theta()) + options_.sigma_yaw_per_m * d +
-              options_.sigma_yaw_floor_rad};
+  return {sigma_xy_per_m * d + sigma_xy_floor_m, sigma_yaw_per_rad * std::abs(increment.theta()) +
+                                                     sigma_yaw_per_m * d + sigma_yaw_floor_rad};
 }
 
 void IcpOdometry::MeasureNoise(const Pose2& prior, const Pose2& matched, const Pose2& increment) {
   const double rate = options_.search.adapt_rate;
   if (rate <= 0.0) return;
   const Pose2 correction = prior.Between(matched);
-  const Eigen::Vector2d sigma = ModelSigmas(increment);
+  const Eigen::Vector2d sigma = options_.IncrementSigmas(increment);
   // The corrections' sizes in units of the model's sigma (per axis in x and y: a 2D Gaussian's
   // distance has mean sigma sqrt(pi / 2)), averaged: a mean of sizes, not of squares, so that a
   // rare wrong match moves it little; each clipped to the current search window for the same
@@ -102,7 +101,7 @@ void IcpOdometry::MeasureNoise(const Pose2& prior, const Pose2& matched, const P
 
 Eigen::Vector2d IcpOdometry::SearchWindow(const Pose2& increment) const {
   const IcpOdometrySearchOptions& o = options_.search;
-  const Eigen::Vector2d sigma = ModelSigmas(increment).cwiseProduct(noise_scale_);
+  const Eigen::Vector2d sigma = options_.IncrementSigmas(increment).cwiseProduct(noise_scale_);
   return {std::min(o.max_window_m, o.sigmas * sigma.x()),
           std::min(o.max_window_rad, o.sigmas * sigma.y())};
 }

@@ -100,6 +100,10 @@ struct IcpOdometryOptions {
   /// icp-odometry: the figures with and without it).
   OdometryCalibrationOptions calibration = {.enabled = true};
 
+  /// The noise model's standard deviations (x and y, yaw) of `increment`, before any measured
+  /// noise scales them (sigma_xy_* and sigma_yaw_* above).
+  Eigen::Vector2d IncrementSigmas(const Pose2& increment) const;
+
   /// One message per broken rule (prefixed "icp_odometry."; the ICP and point options' own).
   std::vector<std::string> Validate() const;
 };
@@ -188,8 +192,6 @@ class IcpOdometry {
   /// them (IcpOdometryStep::frame_weights).
   std::pair<int, std::vector<KeyframeShareOf>> AddKeyframe(
       const std::vector<Eigen::Vector2d>& points_base);
-  /// The noise model's standard deviations (x and y, yaw) of `increment`.
-  Eigen::Vector2d ModelSigmas(const Pose2& increment) const;
   /// The increment's noise model, scaled by the measured noise, in the previous base frame.
   Eigen::Matrix3d IncrementCovariance(const Pose2& increment) const;
   /// The search window (x and y, yaw) of `increment`'s prior: +-sigmas of its measured noise.
