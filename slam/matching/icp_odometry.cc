@@ -125,12 +125,12 @@ std::optional<MatchResult> IcpOdometry::SearchedMatch(const std::vector<Eigen::V
   // that under-reports a turn puts the truth outside a window drawn around the reported turn, and
   // ICP from there finds a neighbouring minimum). The search then runs over the wide window.
   const double yaw_step = o.resolution_m / 10.0;
-  bool doubted = above_trigger && !from_prior;
-  if (above_trigger && from_prior) {
-    const Pose2 correction = prior.Between(from_prior->pose);
-    doubted = correction.translation().norm() > model_window.x() + o.resolution_m ||
-              std::abs(correction.theta()) > model_window.y() + yaw_step;
-  }
+  auto beyond_window = [&](const MatchResult& match) {
+    const Pose2 correction = prior.Between(match.pose);
+    return correction.translation().norm() > model_window.x() + o.resolution_m ||
+           std::abs(correction.theta()) > model_window.y() + yaw_step;
+  };
+  const bool doubted = above_trigger && (!from_prior || beyond_window(*from_prior));
   const Eigen::Vector2d window =
       doubted ? model_window.cwiseMax(Eigen::Vector2d(o.wide_window_m, o.wide_window_rad))
               : model_window;
