@@ -59,7 +59,7 @@ LinesFit FitLines(const std::vector<Eigen::Vector2d>& hits) {
 // A cluster of hits (laser frame) becomes a landmark when a small circle fits it well.
 void FitCluster(const std::vector<Eigen::Vector2d>& hits, std::size_t first_beam,
                 const LaserScan& scan, const LandmarkExtractionOptions& o,
-                const BaseVelocity& velocity, std::vector<LandmarkObservation>* out) {
+                std::vector<LandmarkObservation>* out) {
   if (static_cast<int>(hits.size()) < o.min_points) return;
   // A cluster wider than the largest pillar is a wall, whatever a circle makes of it.
   if ((hits.back() - hits.front()).norm() > 2.0 * o.max_radius_m) return;
@@ -86,13 +86,10 @@ void FitCluster(const std::vector<Eigen::Vector2d>& hits, std::size_t first_beam
   const Pose2& mount = scan.base_from_laser;
   const Eigen::Matrix2d rotation = mount.Rotation();
   const Eigen::Vector2d center_then = mount.translation() + rotation * fit->center;
-  // base_link at the scan's time from base_link at the middle beam's: an arc at constant speed.
-  const double dt = static_cast<double>(first_beam + hits.size() / 2) * scan.time_increment_s;
-  const double turn = velocity.yaw_rate_rad_s * dt;
-  const double travel = velocity.forward_m_s * dt;
-  const Pose2 start_from_then(travel * std::cos(0.5 * turn), travel * std::sin(0.5 * turn), turn);
+  // base_link at the scan's time from base_link at the middle beam's.
+  const Pose2 start_from_then = scan.SweepPose(first_beam + hits.size() / 2);
   const Eigen::Vector2d center = start_from_then * center_then;
-  const Eigen::Matrix2d turn_rotation = RotationMatrix(turn);
+  const Eigen::Matrix2d turn_rotation = start_from_then.Rotation();
   const Eigen::Matrix2d center_covariance = turn_rotation * rotation * fit->center_covariance *
                                             rotation.transpose() * turn_rotation.transpose();
   LandmarkObservation z;
@@ -142,8 +139,7 @@ std::vector<std::string> LandmarkExtractionOptions::Validate() const {
 }
 
 std::vector<LandmarkObservation> ExtractLandmarks(const LaserScan& scan,
-                                                  const LandmarkExtractionOptions& options,
-                                                  const BaseVelocity& velocity) {
+                                                  const LandmarkExtractionOptions& options) {
   SLAMRIG_CHECK_VALID(options, "LandmarkExtractionOptions");
   std::vector<LandmarkObservation> out;
   std::vector<Eigen::Vector2d> cluster;
@@ -153,14 +149,14 @@ std::vector<LandmarkObservation> ExtractLandmarks(const LaserScan& scan,
   // kept too: the scan's edge cuts them like an occlusion would.
   for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
     if (!scan.IsHit(i) || !std::isfinite(scan.ranges_m[i])) {
-      FitCluster(cluster, first, scan, options, velocity, &out);
+      FitCluster(cluster, first, scan, options, &out);
       cluster.clear();
       continue;
     }
     const double range = scan.ranges_m[i];
     if (!cluster.empty() &&
         std::abs(range - previous_range) > options.jump_m + options.jump_rel * range) {
-      FitCluster(cluster, first, scan, options, velocity, &out);
+      FitCluster(cluster, first, scan, options, &out);
       cluster.clear();
     }
     if (cluster.empty()) first = i;
@@ -168,7 +164,7 @@ std::vector<LandmarkObservation> ExtractLandmarks(const LaserScan& scan,
     cluster.emplace_back(range * std::cos(angle), range * std::sin(angle));
     previous_range = range;
   }
-  FitCluster(cluster, first, scan, options, velocity, &out);
+  FitCluster(cluster, first, scan, options, &out);
   return out;
 }
 

@@ -80,19 +80,11 @@ struct LandmarkObservation {
   int points = 0;  ///< hits in the cluster
 };
 
-/// The robot's motion while a scan sweeps: forward speed and yaw rate, taken as constant.
-struct BaseVelocity {
-  double forward_m_s = 0.0;
-  double yaw_rate_rad_s = 0.0;
-};
-
 /// The round landmarks of `scan`, in beam order, in base_link at the scan's time (beam 0): each
 /// centre, fitted in base_link at the time of its cluster's middle beam, is moved back by the
-/// motion `velocity` makes in between (at 1 m/s a 270 degree sweep moves the robot ~2 cm, a
-/// bias that repeats at every scan and that no covariance would otherwise hold). `options` must
-/// be valid.
+/// scan's SweepPose there (at 1 m/s a 270 degree sweep moves the robot ~2 cm, a bias that repeats
+/// at every scan and that no covariance would otherwise hold). `options` must be valid.
 std::vector<LandmarkObservation> ExtractLandmarks(const LaserScan& scan,
-                                                  const LandmarkExtractionOptions& options,
-                                                  const BaseVelocity& velocity = {});
+                                                  const LandmarkExtractionOptions& options);
 
 }  // namespace slamrig::slam

@@ -67,6 +67,20 @@ TEST(OccupancyGridTest, RespectsPoseAndLaserMount) {
   EXPECT_EQ(grid.LogOdds(grid.WorldToCell({3.05, 3.2})), 0.0f);  // behind the laser
 }
 
+// Two beams both straight ahead, the second taken 1 s later after the base has turned a quarter
+// turn on the spot: the second hit is 90 degrees to the left of the first, as the world has it.
+TEST(OccupancyGridTest, ASweepingScansHitsLandWhereTheBaseWasAtEachBeam) {
+  OccupancyGrid grid(Options());
+  LaserScan scan = FanScan(2, 2.0f);
+  scan.angle_min_rad = 0.0;
+  scan.angle_increment_rad = 0.0;
+  scan.time_increment_s = 1.0;
+  scan.sweep_velocity = {.forward_m_s = 0.0, .yaw_rate_rad_s = std::numbers::pi / 2};
+  grid.InsertScan(scan, Pose2(0.05, 0.05, 0.0));
+  EXPECT_EQ(grid.State(grid.WorldToCell({2.05, 0.05})), CellState::kOccupied);
+  EXPECT_EQ(grid.State(grid.WorldToCell({0.05, 2.05})), CellState::kOccupied);
+}
+
 TEST(OccupancyGridTest, HitBehindAWallWithinTheNoiseMarksTheWall) {
   // The wall cell [2.0, 2.1) first; then a beam ending at 2.17, in [2.1, 2.2). With 5 cm range
   // noise the window (2.5 sigma) reaches back to 2.045: the wall's cell takes the hit and the cell

@@ -124,6 +124,8 @@ int TiledGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_base) {
   const Eigen::Vector2d origin_world = world_from_laser.translation();
   const double max_hit_range = std::min(scan.range_max_m, options_.max_range_m);
   const double clear_range = std::min(max_hit_range, options_.no_return_clear_range_m);
+  const bool sweeps = scan.Sweeps();
+  const Pose2 base_from_world = world_from_base.Inverse();
 
   // Beam end points in the world and which are hits: OccupancyGrid::InsertScan's computation.
   std::vector<std::pair<Eigen::Vector2d, bool>> ends;
@@ -136,8 +138,10 @@ int TiledGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_base) {
     const double length = hit ? r : clear_range;
     if (length <= 0.0) continue;
     const double angle = world_from_laser.theta() + scan.BeamAngle(i);
-    const Eigen::Vector2d end =
-        origin_world + length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    Eigen::Vector2d end = origin_world + length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    // A sweeping scan's beam ends where the base was at the beam's time; the ray still starts at
+    // the laser at the scan's time (the base moves centimetres in a sweep).
+    if (sweeps) end = world_from_base * (scan.SweepPose(i) * (base_from_world * end));
     if (!end.allFinite()) continue;
     bounds.extend(end);
     ends.emplace_back(end, hit);

@@ -56,7 +56,11 @@ TEST(TiledGridTest, InsertScanMatchesOccupancyGridCellForCellOnRandomScans) {
     std::mt19937 rng(7);
     int hits = 0;
     for (int trial = 0; trial < 40; ++trial) {
-      const RandomScan r = MakeRandomScan(rng);
+      RandomScan r = MakeRandomScan(rng);
+      if (trial % 2 == 1) {  // every other scan sweeps while the base drives an arc
+        r.scan.time_increment_s = 1e-3;
+        r.scan.sweep_velocity = {.forward_m_s = 0.7, .yaw_rate_rad_s = -1.3};
+      }
       const int expected = reference.InsertScan(r.scan, r.pose);
       EXPECT_EQ(tiled.InsertScan(r.scan, r.pose), expected);
       hits += expected;

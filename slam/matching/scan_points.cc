@@ -24,13 +24,15 @@ std::vector<Eigen::Vector2d> ScanToBasePoints(const LaserScan& scan,
   points.reserve(scan.ranges_m.size() / static_cast<std::size_t>(options.beam_stride) + 1);
   const double min_range = std::max(options.min_range_m, scan.range_min_m);
   const double max_range = std::min(options.max_range_m, scan.range_max_m);
+  const bool sweeps = scan.Sweeps();
   for (std::size_t i = 0; i < scan.ranges_m.size();
        i += static_cast<std::size_t>(options.beam_stride)) {
     const double r = scan.ranges_m[i];
     if (!(r >= min_range && r < max_range)) continue;
     const double angle = scan.BeamAngle(i);
-    points.push_back(scan.base_from_laser *
-                     Eigen::Vector2d(r * std::cos(angle), r * std::sin(angle)));
+    const Eigen::Vector2d point =
+        scan.base_from_laser * Eigen::Vector2d(r * std::cos(angle), r * std::sin(angle));
+    points.push_back(sweeps ? scan.SweepPose(i) * point : point);
   }
   if (options.voxel_size_m <= 0.0 || points.empty()) return points;
 

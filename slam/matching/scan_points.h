@@ -30,7 +30,8 @@ void VisitFields(V& v, ScanPointsOptions& o) {
   v("voxel_size_m", o.voxel_size_m);
 }
 
-/// The scan's hit points in the base_link frame (through scan.base_from_laser), in beam order.
+/// The scan's hit points in the base_link frame at the scan's time (through scan.base_from_laser,
+/// and each beam's SweepPose when the scan sweeps), in beam order.
 std::vector<Eigen::Vector2d> ScanToBasePoints(const LaserScan& scan,
                                               const ScanPointsOptions& options);
 

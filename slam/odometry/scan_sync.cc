@@ -101,6 +101,14 @@ std::vector<SyncedScan> ScanSynchronizer::Flush() {
   return out;
 }
 
+void ScanSynchronizer::SetSweepVelocity(SyncedScan* synced) const {
+  if (!options_.deskew || !(synced->dt_s > 0.0) || synced->scan.time_increment_s == 0.0) return;
+  // distance_m is unsigned from odometry poses: the increment says forwards or backwards.
+  const double distance = std::copysign(synced->distance_m, synced->increment.x());
+  synced->scan.sweep_velocity = {.forward_m_s = distance / synced->dt_s,
+                                 .yaw_rate_rad_s = synced->yaw_change_rad / synced->dt_s};
+}
+
 // Encoder counts summed and gyro rates averaged over the interval since the previous scan.
 SyncedScan ScanSynchronizer::CompleteTicks(const LaserScan& scan) {
   SyncedScan synced;
@@ -115,6 +123,7 @@ SyncedScan ScanSynchronizer::CompleteTicks(const LaserScan& scan) {
     synced.distance_m = motion.distance_m;
     synced.yaw_change_rad = motion.yaw_rad;
     synced.increment = DiffDriveIncrement(synced.distance_m, motion.yaw_rad, options_.integration);
+    SetSweepVelocity(&synced);
     pose_ = pose_ * synced.increment;
     if (!interval_.has_ticks()) ++scans_without_odometry_;
     if (!ticks_since_scan_ && last_ticks_time_) {
@@ -140,6 +149,7 @@ SyncedScan ScanSynchronizer::CompleteWithPose(const LaserScan& scan, const Pose2
     synced.increment = previous_scan_pose_->Between(pose);
     synced.distance_m = RotTransRot::FromIncrement(synced.increment).trans_m;
     synced.yaw_change_rad = synced.increment.theta();
+    SetSweepVelocity(&synced);
   }
   previous_scan_pose_ = pose;
   last_scan_time_ = scan.time;

@@ -26,6 +26,10 @@ struct ScanSyncOptions {
   DiffDriveParams robot;  ///< used for wheel ticks
   bool use_gyro = true;   ///< yaw from the IMU's mean z rate when it has samples in the interval
   DiffDriveIntegration integration = DiffDriveIntegration::kExactArc;
+  /// Give each scan the velocity of the interval before it (LaserScan::sweep_velocity), so that
+  /// a scan whose beams are taken over time (time_increment_s > 0) is undistorted by the motion
+  /// during its sweep. A constant-velocity guess; no effect on scans with simultaneous beams.
+  bool deskew = true;
 
   /// One message per broken rule (prefixed "sync.").
   std::vector<std::string> Validate() const;
@@ -41,6 +45,7 @@ void VisitFields(V& v, ScanSyncOptions& o) {
           {OdometrySource::kOdometryPoses, "poses"},
           {OdometrySource::kNone, "none"}});
   v("use_gyro", o.use_gyro);
+  v("deskew", o.deskew);
   v.Enum("integration", o.integration,
          {{DiffDriveIntegration::kExactArc, "exact_arc"}, {DiffDriveIntegration::kEuler, "euler"}});
 }
@@ -93,6 +98,8 @@ class ScanSynchronizer {
  private:
   SyncedScan CompleteTicks(const LaserScan& scan);
   SyncedScan CompleteWithPose(const LaserScan& scan, const Pose2& pose);
+  /// The interval's velocity into synced->scan.sweep_velocity (options_.deskew).
+  void SetSweepVelocity(SyncedScan* synced) const;
   void CompletePending(const OdometryPose* next, std::vector<SyncedScan>* out);
 
   ScanSyncOptions options_;

@@ -124,6 +124,44 @@ TEST(ScanSyncTest, OdometryPosesAreInterpolatedToScanTimes) {
   EXPECT_NEAR(composed.y(), result.scans.back().odom_from_base.y(), 1e-9);
 }
 
+// A sweeping scan (time_increment_s > 0) gets the velocity of its interval for undistortion: on
+// a circle driven at 0.8 m/s and 0.4 rad/s, forwards or backwards; a scan with simultaneous beams,
+// or with `deskew` off, gets none.
+TEST(ScanSyncTest, ASweepingScanGetsItsIntervalsVelocity) {
+  for (const double direction : {1.0, -1.0}) {
+    const double radius = 2.0, omega = 0.4 * direction;
+    auto circle = [&](double t) {
+      const double phi = omega * t;
+      return Pose2(radius * std::sin(phi), radius * (1.0 - std::cos(phi)), phi);
+    };
+    for (const bool deskew : {true, false}) {
+      std::vector<Record> records;
+      for (int k = 0; k <= 200; ++k)
+        records.push_back(OdometryPose{Time::FromSeconds(0.05 * k), circle(0.05 * k)});
+      for (int k = 0; k < 20; ++k) {
+        LaserScan scan = Scan(0.013 + k / 7.0);
+        scan.time_increment_s = k % 2 == 0 ? 1e-4 : 0.0;
+        records.push_back(scan);
+      }
+      ScanSyncOptions options;
+      options.deskew = deskew;
+      const ScanSyncResult result = SyncToScans(SortedByTime(std::move(records)), options);
+      ASSERT_EQ(result.scans.size(), 20u);
+      EXPECT_EQ(result.scans[0].scan.sweep_velocity.forward_m_s, 0.0);  // no interval yet
+      for (std::size_t k = 1; k < result.scans.size(); ++k) {
+        const BaseVelocity& v = result.scans[k].scan.sweep_velocity;
+        if (deskew && k % 2 == 0) {
+          EXPECT_NEAR(v.forward_m_s, 0.8 * direction, 1e-3) << k;  // the chord, not the arc
+          EXPECT_NEAR(v.yaw_rate_rad_s, omega, 1e-9) << k;
+        } else {
+          EXPECT_EQ(v.forward_m_s, 0.0) << k;
+          EXPECT_EQ(v.yaw_rate_rad_s, 0.0) << k;
+        }
+      }
+    }
+  }
+}
+
 // Odometry poses at 20 Hz with nothing between 5 s and 8 s, scans at 7 Hz: a scan whose interval
 // holds no sample is said to follow a gap as long as the silence it was interpolated across (3 s);
 // every other scan, including the first in the hole (its interval still holds the sample at 5 s),

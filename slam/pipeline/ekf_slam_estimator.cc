@@ -40,18 +40,8 @@ ScanEstimate EkfSlamEstimator::AddScan(const SyncedScan& scan) {
                            scan.increment.theta());
   }
   ++scans_;
-  // The robot's velocity over the last scan interval (the odometry's), to undo the sweep's motion.
-  BaseVelocity velocity;
-  if (previous_scan_time_) {
-    const double dt = SecondsBetween(scan.scan.time, *previous_scan_time_);
-    if (dt > 0.0) {
-      velocity.forward_m_s = scan.increment.x() / dt;
-      velocity.yaw_rate_rad_s = scan.increment.theta() / dt;
-    }
-  }
-  previous_scan_time_ = scan.scan.time;
   const std::vector<LandmarkObservation> observations =
-      ExtractLandmarks(scan.scan, options_.filter.extraction, velocity);
+      ExtractLandmarks(scan.scan, options_.filter.extraction);
   const LandmarkUpdate update = slam_.Observe(observations, scan.scan.range_max_m);
   observations_ += update.observations;
   pairings_ += update.pairings;

@@ -63,7 +63,6 @@ class EkfSlamEstimator final : public Estimator {
   OccupancyGrid map_;
   std::vector<LandmarkSighting> sightings_;
   int scans_ = 0;
-  std::optional<Time> previous_scan_time_;
   int observations_ = 0;
   int pairings_ = 0;
   int ambiguous_ = 0;

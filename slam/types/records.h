@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <variant>
 #include <vector>
@@ -10,6 +11,12 @@
 #include "slam/types/time.h"
 
 namespace slamrig {
+
+/// The robot's motion while a scan sweeps: forward speed and yaw rate, taken as constant.
+struct BaseVelocity {
+  double forward_m_s = 0.0;
+  double yaw_rate_rad_s = 0.0;
+};
 
 /// One sweep of a planar range finder (REP-117 semantics).
 /// Beam i points at `angle_min_rad + i * angle_increment_rad` in the laser frame and was taken at
@@ -24,10 +31,31 @@ struct LaserScan {
   double range_max_m = 0.0;          ///< readings at or beyond this are "no return"
   std::vector<float> ranges_m;       ///< one range per beam, metres
   Pose2 base_from_laser;             ///< mounting pose of the laser on the robot
+  /// The base's velocity while the beams were taken, as the receiver estimates it: sources leave
+  /// it zero and the scan synchroniser sets it from the odometry. With time_increment_s it moves
+  /// beam i to SweepPose(i); zero keeps every beam at the pose of `time`.
+  BaseVelocity sweep_velocity;
 
   /// Angle of beam `i` in the laser frame.
   double BeamAngle(std::size_t i) const {
     return angle_min_rad + static_cast<double>(i) * angle_increment_rad;
+  }
+  /// True when the beams were taken from a moving base (see SweepPose).
+  bool Sweeps() const {
+    return time_increment_s != 0.0 &&
+           (sweep_velocity.forward_m_s != 0.0 || sweep_velocity.yaw_rate_rad_s != 0.0);
+  }
+  /// base_link at `time` from base_link when beam `i` was taken: the arc `sweep_velocity` drives
+  /// in i * time_increment_s (the identity when the scan does not sweep). A point p seen from
+  /// the base at beam i is SweepPose(i) * p in base_link at `time`.
+  Pose2 SweepPose(std::size_t i) const {
+    const double t = static_cast<double>(i) * time_increment_s;
+    const double turn = sweep_velocity.yaw_rate_rad_s * t;
+    const double half = 0.5 * turn;
+    // The chord of the arc: travel * sin(half) / half, exact for a constant velocity.
+    const double chord = sweep_velocity.forward_m_s * t *
+                         (std::abs(half) < 1e-6 ? 1.0 - half * half / 6.0 : std::sin(half) / half);
+    return Pose2(chord * std::cos(half), chord * std::sin(half), turn);
   }
   /// True if beam `i` is a real return (a hit on an obstacle).
   bool IsHit(std::size_t i) const {
