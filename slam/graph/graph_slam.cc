@@ -43,6 +43,8 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
       .Positive("odometry_check_window_m", odometry_check_window_m)
       .Positive("odometry_check_window_rad", odometry_check_window_rad)
       .NonNegative("odometry_check_min_gain", odometry_check_min_gain)
+      .InRange("odometry_check_wheel_confidence", odometry_check_wheel_confidence, 0.5, 1.0,
+               Ends::kOpenLow)
       .NonNegative("odometry_check_wide_below", odometry_check_wide_below)
       .NonNegative("node_below_match_score", node_below_match_score)
       .Positive("odometry_check_wide_window_m", odometry_check_wide_window_m)
@@ -89,6 +91,7 @@ Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment,
                      double odometry_gap_s) {
   // The front end, beside the back end's work on the previous node: ICP odometry never reads the
   // graph, and what decides a node is the front end's own.
+  wheel_pose_ = wheel_pose_ * odometry_.calibration().Correct(odometry_increment);
   IcpOdometryStep step = odometry_.Add(scan, odometry_increment, odometry_gap_s);
   const bool first = nodes_decided_ == 0;
   const Pose2 since = first ? Pose2() : newest_node_odom_pose_.Between(step.pose);
@@ -126,14 +129,19 @@ Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment,
   if (blind_since_node_ && options_.blind_edge_odometry_noise) {
     blind_noise = odometry_.noise_scale();
   }
+  WheelMotion wheels;
+  wheels.relative = newest_node_wheel_pose_.Between(wheel_pose_);
+  wheels.sigmas =
+      options_.odometry.IncrementSigmas(wheels.relative).cwiseProduct(odometry_.noise_scale());
   failed_since_node_ = false;
   blind_since_node_ = false;
   newest_node_odom_pose_ = last_step_.pose;
+  newest_node_wheel_pose_ = wheel_pose_;
   scan_node_.push_back(nodes_decided_++);
   scan_from_node_.push_back(Pose2());
-  auto place = [this, index, pose = last_step_.pose, node_doubtful, blind_noise,
+  auto place = [this, index, pose = last_step_.pose, node_doubtful, blind_noise, wheels,
                 points = std::move(*node_points)]() mutable {
-    AddNode(index, pose, node_doubtful, blind_noise, std::move(points));
+    AddNode(index, pose, node_doubtful, blind_noise, wheels, std::move(points));
     SearchLoops();
     const int added = static_cast<int>(nodes_.size()) - nodes_at_last_optimization_;
     if (pending_closure_ && added >= options_.optimize_every_keyframes) Optimize();
@@ -222,7 +230,7 @@ std::vector<LoopClosure> GraphSlam::UnstrainedLoopClosures() const {
 
 void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
                         const std::optional<Eigen::Vector2d>& blind_noise,
-                        std::vector<Eigen::Vector2d> points) {
+                        const WheelMotion& wheels, std::vector<Eigen::Vector2d> points) {
   const int id = static_cast<int>(nodes_.size());
   Node node{scan, odom_pose, std::move(points), Eigen::Vector2d::Zero(), Pose2()};
   if (nodes_.empty()) {
@@ -233,7 +241,7 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
     // before): both are tried.
     const Pose2 icp_relative = nodes_.back().odom_pose.Between(odom_pose);
     const Pose2 relative = CheckedRelative(
-        icp_relative, nodes_.back().rematch_offset * icp_relative, doubtful, node.points);
+        icp_relative, nodes_.back().rematch_offset * icp_relative, doubtful, wheels, node.points);
     node.rematch_offset = relative.Inverse() * icp_relative;
     const double d = relative.translation().norm();
     double sxy = options_.edge_sigma_xy_per_m * d + options_.edge_sigma_xy_floor_m;
@@ -260,6 +268,7 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
 }
 
 Pose2 GraphSlam::CheckedRelative(const Pose2& icp_relative, const Pose2& alternative, bool doubtful,
+                                 const WheelMotion& wheels,
                                  const std::vector<Eigen::Vector2d>& points) {
   const int newest = static_cast<int>(nodes_.size()) - 1;
   if (options_.odometry_check_nodes == 0 || points.size() < 10) return icp_relative;
@@ -290,9 +299,32 @@ Pose2 GraphSlam::CheckedRelative(const Pose2& icp_relative, const Pose2& alterna
     }
     return fine->pose;
   };
+  // The wheels' distance as a yardstick: a re-match may not put the node farther from the
+  // previous one, or nearer, than the wheels say by more (in their sigmas) than ICP odometry's pose
+  // did, or than the gate. Where the scans leave a direction nearly free (a long wall seen past a
+  // glass facade, which answers only beside the robot) a re-match can fit the last nodes better
+  // by standing still, one or two node spacings back, which the wheels' distance rules out. Which
+  // way the wheels went is no yardstick: a turn logged a scan late (edmonton) or missed in a gap
+  // puts it off by tenths of a radian where the re-match is right. Distances are signed, forwards
+  // or backwards in the previous node's frame: a re-match two node spacings back is as far as the
+  // wheels say, the wrong way.
+  auto signed_distance = [](const Pose2& p) {
+    return std::copysign(p.translation().norm(), p.translation().x());
+  };
+  auto wheel_chi2 = [&](const Pose2& p) {
+    const double sxy = std::max(wheels.sigmas.x(), 1e-6);
+    const double e = signed_distance(p) - signed_distance(wheels.relative);
+    return e * e / (sxy * sxy);
+  };
+  const double allowed_chi2 =
+      options_.odometry_check_wheel_confidence >= 1.0
+          ? std::numeric_limits<double>::infinity()
+          : std::max(wheel_chi2(icp_relative),
+                     ChiSquareQuantile(options_.odometry_check_wheel_confidence, 1.0));
+  auto plausible = [&](const Pose2& p) { return wheel_chi2(p) <= allowed_chi2; };
   Pose2 relative = icp_relative;
   double best_score = RasterScore(raster, query, relative);
-  if (!(alternative == icp_relative)) {
+  if (!(alternative == icp_relative) && plausible(alternative)) {
     const double score = RasterScore(raster, query, alternative);
     if (score > best_score) {
       relative = alternative;
@@ -303,7 +335,7 @@ Pose2 GraphSlam::CheckedRelative(const Pose2& icp_relative, const Pose2& alterna
   if (const std::optional<Pose2> local = rematch(relative, options_.odometry_check_window_m,
                                                  options_.odometry_check_window_rad, false)) {
     const double score = RasterScore(raster, query, *local);
-    if (score > best_score + options_.odometry_check_min_gain) {
+    if (score > best_score + options_.odometry_check_min_gain && plausible(*local)) {
       best = *local;
       best_score = score;
     }
@@ -313,7 +345,7 @@ Pose2 GraphSlam::CheckedRelative(const Pose2& icp_relative, const Pose2& alterna
             rematch(relative, options_.odometry_check_wide_window_m, std::numbers::pi, true)) {
       const double score = RasterScore(raster, query, *wide);
       if (score >= options_.odometry_check_wide_min_score &&
-          score > best_score + options_.odometry_check_min_gain) {
+          score > best_score + options_.odometry_check_min_gain && plausible(*wide)) {
         best = *wide;
         best_score = score;
       }

@@ -127,19 +127,26 @@ class GraphSlam {
     // odometry check re-placed it, when it carries the next edge over from the previous node.
     Pose2 rematch_offset;
   };
+  // The wheels' motion between two nodes and its noise (sigma xy, sigma yaw), for the odometry
+  // check: a re-match may not stray from it further than ICP odometry's own pose did.
+  struct WheelMotion {
+    Pose2 relative;
+    Eigen::Vector2d sigmas{0, 0};
+  };
   // Waits until the back end has placed every node decided so far; rethrows what it threw.
   void JoinBackEnd() const;
   // Variances (xy, yaw) along the least uncertain graph path from the newest node to every node.
   std::vector<Eigen::Vector2d> PathVariances() const;
   void AddNode(int scan, const Pose2& odom_pose, bool doubtful,
-               const std::optional<Eigen::Vector2d>& blind_noise,
+               const std::optional<Eigen::Vector2d>& blind_noise, const WheelMotion& wheels,
                std::vector<Eigen::Vector2d> points);
   // The pose of `points` in the newest node's frame: `relative` (ICP odometry's), or the
   // odometry check's re-match when it fits the last nodes clearly better (from the better fitting
   // of `relative` and `alternative`, a local search, and
-  // over every heading when ICP odometry's match was `doubtful` and the best so far fits poorly).
+  // over every heading when ICP odometry's match was `doubtful` and the best so far fits poorly),
+  // never one farther from the wheels' motion (in their sigmas) than `relative` or the gate.
   Pose2 CheckedRelative(const Pose2& relative, const Pose2& alternative, bool doubtful,
-                        const std::vector<Eigen::Vector2d>& points);
+                        const WheelMotion& wheels, const std::vector<Eigen::Vector2d>& points);
   void SearchLoops();
   std::optional<PoseGraphEdge> TryClosure(int candidate, const Eigen::Vector2d& variance);
   // Adds an accepted closure to the graph, or with pairwise consistency to the hypotheses,
@@ -179,6 +186,8 @@ class GraphSlam {
   bool blind_since_node_ = false;   // ... or a scan had no points (the odometry stood in)
   int nodes_decided_ = 0;           // nodes made, placed by the back end or still to be
   Pose2 newest_node_odom_pose_;     // the newest node's IcpOdometry pose
+  Pose2 wheel_pose_;                // the wheels' (calibrated) increments composed, every scan
+  Pose2 newest_node_wheel_pose_;    // ... at the newest node
   bool last_scan_is_node_ = false;
   // The back end's thread, when it has one (destroyed first: it waits for the task in hand).
   mutable BackgroundWorker back_end_;

@@ -69,6 +69,12 @@ struct GraphSlamOptions {
   double odometry_check_window_m = 0.3;
   double odometry_check_window_rad = 0.35;
   double odometry_check_min_gain = 0.1;
+  /// A re-match's distance from the previous node must stay within this chi-square confidence
+  /// (1 dof) of the wheels' distance since it, in the front end's increment noise
+  /// (IcpOdometryOptions::IncrementSigmas times the noise it measured), unless ICP odometry's own
+  /// pose strayed farther: then as far as that. 1 = no such limit, as in a run without the
+  /// robot's own odometry (its increments are scan matches themselves).
+  double odometry_check_wheel_confidence = 0.999;
   /// When ICP odometry's match was doubtful (see node_below_match_score) or failed since the last
   /// node, and the best of those
   /// scores below odometry_check_wide_below (0: never), the search is
@@ -162,6 +168,7 @@ void VisitFields(V& v, GraphSlamOptions& o) {
   v("odometry_check_window_m", o.odometry_check_window_m);
   v("odometry_check_window_rad", o.odometry_check_window_rad);
   v("odometry_check_min_gain", o.odometry_check_min_gain);
+  v("odometry_check_wheel_confidence", o.odometry_check_wheel_confidence);
   v("odometry_check_wide_below", o.odometry_check_wide_below);
   v("odometry_check_wide_window_m", o.odometry_check_wide_window_m);
   v("odometry_check_wide_min_score", o.odometry_check_wide_min_score);

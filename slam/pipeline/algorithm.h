@@ -30,6 +30,10 @@ struct EstimatorContext {
   /// The source's gyro noise as its robot file states it, where there is one (a simulated
   /// robot); nullopt for logs, whose gyro is not characterised.
   std::optional<GyroNoiseModel> gyro;
+  /// Whether the scans' increments are the robot's own odometry (wheels, a gyro, a platform's
+  /// poses); false when the source has none and they come from scan matching
+  /// (ScanMatchedOdometry), which is no independent yardstick for a scan match.
+  bool own_odometry = true;
 };
 
 /// One algorithm's options behind one interface: a plain options struct with a VisitFields

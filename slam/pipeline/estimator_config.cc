@@ -104,7 +104,8 @@ void WriteEstimatorConfigJson(const EstimatorConfig& config, JsonWriter* json) {
   copy.options->Visit(writer);
 }
 
-std::unique_ptr<Estimator> MakeEstimator(const EstimatorConfig& config, std::uint64_t run_seed) {
+std::unique_ptr<Estimator> MakeEstimator(const EstimatorConfig& config, std::uint64_t run_seed,
+                                         bool own_odometry) {
   const std::vector<std::string> errors = config.options->Validate();
   if (!errors.empty()) throw ConfigError(config.name + ": " + errors.front());
   EstimatorContext context;
@@ -112,6 +113,7 @@ std::unique_ptr<Estimator> MakeEstimator(const EstimatorConfig& config, std::uin
   context.robot = config.odometry.robot;
   context.use_gyro = config.odometry.use_gyro;
   context.gyro = config.gyro;
+  context.own_odometry = own_odometry;
   return config.options->MakeEstimator(context);
 }
 

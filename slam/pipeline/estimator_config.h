@@ -63,6 +63,7 @@ void WriteEstimatorConfig(const EstimatorConfig& config, YAML::Emitter* out);
 void WriteEstimatorConfigJson(const EstimatorConfig& config, JsonWriter* json);
 
 /// A new estimator for `config`; its seed is the stream "slam.<name>" of `run_seed`.
-std::unique_ptr<Estimator> MakeEstimator(const EstimatorConfig& config, std::uint64_t run_seed);
+std::unique_ptr<Estimator> MakeEstimator(const EstimatorConfig& config, std::uint64_t run_seed,
+                                         bool own_odometry = true);
 
 }  // namespace slamrig::slam

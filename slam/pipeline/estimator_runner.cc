@@ -37,7 +37,9 @@ void CheckDeclaredStatistics(const std::string& algorithm,
 
 EstimatorRunner::EstimatorRunner(const EstimatorConfig& config, OdometrySource source,
                                  std::uint64_t run_seed)
-    : config_(config), sync_(config.odometry, source), estimator_(MakeEstimator(config, run_seed)) {
+    : config_(config),
+      sync_(config.odometry, source),
+      estimator_(MakeEstimator(config, run_seed, source != OdometrySource::kNone)) {
   run_.name = config.name;
   run_.algorithm = config.algorithm;
   run_.odometry_source = source;

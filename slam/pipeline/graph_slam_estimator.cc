@@ -12,9 +12,22 @@ std::vector<std::string> GraphSlamEstimatorOptions::Validate() const {
   return rules.errors();
 }
 
+namespace {
+
+// Without the robot's own odometry the increments are scan matches: the odometry check has no
+// wheels to hold a re-match to.
+GraphSlamOptions GraphOptions(const GraphSlamEstimatorOptions& options,
+                              const EstimatorContext& context) {
+  GraphSlamOptions graph = options.graph;
+  if (!context.own_odometry) graph.odometry_check_wheel_confidence = 1.0;
+  return graph;
+}
+
+}  // namespace
+
 GraphSlamEstimator::GraphSlamEstimator(const GraphSlamEstimatorOptions& options,
-                                       const EstimatorContext& /*context*/)
-    : options_(options), slam_(options.graph), map_(options.map) {}
+                                       const EstimatorContext& context)
+    : options_(options), slam_(GraphOptions(options, context)), map_(options.map) {}
 
 ScanEstimate GraphSlamEstimator::AddScan(const SyncedScan& scan) {
   const Pose2 pose = slam_.Add(scan.scan, scan.increment, scan.odometry_gap_s);
