@@ -248,10 +248,10 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
     double syaw = options_.edge_sigma_yaw_per_rad * std::abs(relative.theta()) +
                   options_.edge_sigma_yaw_per_m * d + options_.edge_sigma_yaw_floor_rad;
     if (blind_noise) {
-      const Eigen::Vector2d wheels =
+      const Eigen::Vector2d odometry_sigmas =
           blind_noise->cwiseProduct(options_.odometry.IncrementSigmas(relative));
-      sxy = std::max(sxy, wheels.x());
-      syaw = std::max(syaw, wheels.y());
+      sxy = std::max(sxy, odometry_sigmas.x());
+      syaw = std::max(syaw, odometry_sigmas.y());
     }
     node.edge_variance = {sxy * sxy, syaw * syaw};
     graph_.AddVertex(id, graph_.pose(id - 1) * relative);
