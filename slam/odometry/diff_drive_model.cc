@@ -5,23 +5,14 @@
 //  - Euler: Kansal, "Particle Filter SLAM and Texture Mapping" (ECE276A), Sec. III-A.
 #include "slam/odometry/diff_drive_model.h"
 
-#include <cmath>
-
 namespace slamrig::slam {
-
-double Sinc(double x) {
-  if (std::abs(x) < 1e-4) return 1.0 - x * x / 6.0;
-  return std::sin(x) / x;
-}
 
 Pose2 DiffDriveIncrement(double distance_m, double yaw_change_rad,
                          DiffDriveIntegration integration) {
   if (integration == DiffDriveIntegration::kEuler) {
     return Pose2(distance_m, 0.0, yaw_change_rad);
   }
-  const double half = 0.5 * yaw_change_rad;
-  const double chord = distance_m * Sinc(half);
-  return Pose2(chord * std::cos(half), chord * std::sin(half), yaw_change_rad);
+  return ArcIncrement(distance_m, yaw_change_rad);
 }
 
 Pose2 IntegrateDiffDrive(const Pose2& world_from_base, double distance_m, double yaw_change_rad,

@@ -13,9 +13,6 @@ enum class DiffDriveIntegration {
   kEuler,
 };
 
-/// sin(x) / x, with its Taylor series near 0.
-double Sinc(double x);
-
 /// Moves `world_from_base` by `distance_m` along the robot's x axis while its heading changes by
 /// `yaw_change_rad`. For a velocity input (v, omega) over tau seconds pass v * tau and omega * tau.
 Pose2 IntegrateDiffDrive(const Pose2& world_from_base, double distance_m, double yaw_change_rad,

@@ -75,4 +75,19 @@ class Pose2 {
   double theta_ = 0.0;
 };
 
+/// sin(x) / x, with its Taylor series near 0.
+inline double Sinc(double x) {
+  if (std::abs(x) < 1e-4) return 1.0 - x * x / 6.0;
+  return std::sin(x) / x;
+}
+
+/// The pose reached by driving `distance_m` along a circular arc that turns the heading by
+/// `turn_rad` (a constant forward speed and yaw rate), in the frame of its start: the chord
+/// distance * sinc(turn / 2) at half the turn.
+inline Pose2 ArcIncrement(double distance_m, double turn_rad) {
+  const double half = 0.5 * turn_rad;
+  const double chord = distance_m * Sinc(half);
+  return Pose2(chord * std::cos(half), chord * std::sin(half), turn_rad);
+}
+
 }  // namespace slamrig

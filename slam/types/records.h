@@ -1,7 +1,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <cmath>
 #include <cstdint>
 #include <variant>
 #include <vector>
@@ -50,12 +49,7 @@ struct LaserScan {
   /// the base at beam i is SweepPose(i) * p in base_link at `time`.
   Pose2 SweepPose(std::size_t i) const {
     const double t = static_cast<double>(i) * time_increment_s;
-    const double turn = sweep_velocity.yaw_rate_rad_s * t;
-    const double half = 0.5 * turn;
-    // The chord of the arc: travel * sin(half) / half, exact for a constant velocity.
-    const double chord = sweep_velocity.forward_m_s * t *
-                         (std::abs(half) < 1e-6 ? 1.0 - half * half / 6.0 : std::sin(half) / half);
-    return Pose2(chord * std::cos(half), chord * std::sin(half), turn);
+    return ArcIncrement(sweep_velocity.forward_m_s * t, sweep_velocity.yaw_rate_rad_s * t);
   }
   /// True if beam `i` is a real return (a hit on an obstacle).
   bool IsHit(std::size_t i) const {
