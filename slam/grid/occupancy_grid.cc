@@ -183,18 +183,15 @@ std::vector<Eigen::Array2i> OccupancyGrid::TakeWallFlips() {
   return taken;
 }
 
-int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_base) {
+Eigen::AlignedBox2d BeamEnds(const LaserScan& scan, const Pose2& world_from_base,
+                             double max_hit_range, double clear_range,
+                             std::vector<std::pair<Eigen::Vector2d, bool>>* ends) {
   const Pose2 world_from_laser = world_from_base * scan.base_from_laser;
   const Eigen::Vector2d origin_world = world_from_laser.translation();
-  const double max_hit_range = std::min(scan.range_max_m, options_.max_range_m);
-  const double clear_range = std::min(max_hit_range, options_.no_return_clear_range_m);
   const bool sweeps = scan.Sweeps();
   const Pose2 base_from_world = world_from_base.Inverse();
-
-  // Beam end points in the world, and which of them are hits.
   Eigen::AlignedBox2d bounds(origin_world, origin_world);
-  std::vector<std::pair<Eigen::Vector2d, bool>>& ends = beam_ends_;
-  ends.clear();
+  ends->clear();
   for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
     const double r = scan.ranges_m[i];
     if (!(r >= scan.range_min_m)) continue;  // too short: no information
@@ -203,14 +200,20 @@ int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_bas
     if (length <= 0.0) continue;
     const double angle = world_from_laser.theta() + scan.BeamAngle(i);
     Eigen::Vector2d end = origin_world + length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
-    // A sweeping scan's beam ends where the base was at the beam's time; the ray still starts at
-    // the laser at the scan's time (the base moves centimetres in a sweep).
     if (sweeps) end = world_from_base * (scan.SweepPose(i) * (base_from_world * end));
     if (!end.allFinite()) continue;  // sources reject NaN; never index with one
     bounds.extend(end);
-    ends.emplace_back(end, hit);
+    ends->emplace_back(end, hit);
   }
-  EnsureContains(bounds);
+  return bounds;
+}
+
+int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_base) {
+  const Eigen::Vector2d origin_world = (world_from_base * scan.base_from_laser).translation();
+  const double max_hit_range = std::min(scan.range_max_m, options_.max_range_m);
+  const double clear_range = std::min(max_hit_range, options_.no_return_clear_range_m);
+  std::vector<std::pair<Eigen::Vector2d, bool>>& ends = beam_ends_;
+  EnsureContains(BeamEnds(scan, world_from_base, max_hit_range, clear_range, &ends));
 
   ++scan_count_;
   const bool once = options_.update_once_per_scan;

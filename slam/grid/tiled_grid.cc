@@ -120,32 +120,14 @@ void TiledGrid::Update(const Eigen::Array2i& cell, float delta) {
 }
 
 int TiledGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_base) {
-  const Pose2 world_from_laser = world_from_base * scan.base_from_laser;
-  const Eigen::Vector2d origin_world = world_from_laser.translation();
+  const Eigen::Vector2d origin_world = (world_from_base * scan.base_from_laser).translation();
   const double max_hit_range = std::min(scan.range_max_m, options_.max_range_m);
   const double clear_range = std::min(max_hit_range, options_.no_return_clear_range_m);
-  const bool sweeps = scan.Sweeps();
-  const Pose2 base_from_world = world_from_base.Inverse();
-
-  // Beam end points in the world and which are hits: OccupancyGrid::InsertScan's computation.
+  // OccupancyGrid::InsertScan's beams.
   std::vector<std::pair<Eigen::Vector2d, bool>> ends;
   ends.reserve(scan.ranges_m.size());
-  Eigen::AlignedBox2d bounds(origin_world, origin_world);
-  for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
-    const double r = scan.ranges_m[i];
-    if (!(r >= scan.range_min_m)) continue;
-    const bool hit = r < max_hit_range;
-    const double length = hit ? r : clear_range;
-    if (length <= 0.0) continue;
-    const double angle = world_from_laser.theta() + scan.BeamAngle(i);
-    Eigen::Vector2d end = origin_world + length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
-    // A sweeping scan's beam ends where the base was at the beam's time; the ray still starts at
-    // the laser at the scan's time (the base moves centimetres in a sweep).
-    if (sweeps) end = world_from_base * (scan.SweepPose(i) * (base_from_world * end));
-    if (!end.allFinite()) continue;
-    bounds.extend(end);
-    ends.emplace_back(end, hit);
-  }
+  const Eigen::AlignedBox2d bounds =
+      BeamEnds(scan, world_from_base, max_hit_range, clear_range, &ends);
   const Eigen::Array2i lo = WorldToCell(bounds.min());
   const Eigen::Array2i hi = WorldToCell(bounds.max());
   EnsureCells(lo, hi);
