@@ -91,7 +91,7 @@ Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment,
                      double odometry_gap_s) {
   // The front end, beside the back end's work on the previous node: ICP odometry never reads the
   // graph, and what decides a node is the front end's own.
-  wheel_pose_ = wheel_pose_ * odometry_.calibration().Correct(odometry_increment);
+  wheels_since_node_ = wheels_since_node_ * odometry_.calibration().Correct(odometry_increment);
   IcpOdometryStep step = odometry_.Add(scan, odometry_increment, odometry_gap_s);
   const bool first = nodes_decided_ == 0;
   const Pose2 since = first ? Pose2() : newest_node_odom_pose_.Between(step.pose);
@@ -130,13 +130,13 @@ Pose2 GraphSlam::Add(const LaserScan& scan, const Pose2& odometry_increment,
     blind_noise = odometry_.noise_scale();
   }
   WheelMotion wheels;
-  wheels.relative = newest_node_wheel_pose_.Between(wheel_pose_);
+  wheels.relative = wheels_since_node_;
   wheels.sigmas =
       options_.odometry.IncrementSigmas(wheels.relative).cwiseProduct(odometry_.noise_scale());
   failed_since_node_ = false;
   blind_since_node_ = false;
   newest_node_odom_pose_ = last_step_.pose;
-  newest_node_wheel_pose_ = wheel_pose_;
+  wheels_since_node_ = Pose2();
   scan_node_.push_back(nodes_decided_++);
   scan_from_node_.push_back(Pose2());
   auto place = [this, index, pose = last_step_.pose, node_doubtful, blind_noise, wheels,

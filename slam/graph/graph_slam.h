@@ -186,8 +186,7 @@ class GraphSlam {
   bool blind_since_node_ = false;   // ... or a scan had no points (the odometry stood in)
   int nodes_decided_ = 0;           // nodes made, placed by the back end or still to be
   Pose2 newest_node_odom_pose_;     // the newest node's IcpOdometry pose
-  Pose2 wheel_pose_;                // the wheels' (calibrated) increments composed, every scan
-  Pose2 newest_node_wheel_pose_;    // ... at the newest node
+  Pose2 wheels_since_node_;  // the wheels' (calibrated) increments since the newest node, composed
   bool last_scan_is_node_ = false;
   // The back end's thread, when it has one (destroyed first: it waits for the task in hand).
   mutable BackgroundWorker back_end_;
