@@ -210,7 +210,8 @@ void DefineTrajectoryAndGrid(py::module_& m) {
             return a;
           },
           "occupancy probability per cell (computed, a new array)")
-      .def("insert_scan", &OccupancyGrid::InsertScan, py::arg("scan"), py::arg("world_from_base"));
+      .def("insert_scan", &OccupancyGrid::InsertScan, py::arg("scan"), py::arg("world_from_base"),
+           py::arg("max_range_m") = py::none());
 }
 
 }  // namespace slamrig::python

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -156,7 +157,10 @@ class OccupancyGrid {
   /// Inserts one scan taken at `world_from_base`: each hit's end cell gains hit_log_odds and the
   /// cells before it lose miss_log_odds; a no-return beam only clears free space, up to
   /// no_return_clear_range_m. Returns the number of beams that produced a hit.
-  int InsertScan(const LaserScan& scan, const Pose2& world_from_base);
+  /// `max_range_m`, when given, replaces the options' max_range_m for this scan (a sparse scan's
+  /// SparseScanRange); the lidar's own range_max_m still bounds it.
+  int InsertScan(const LaserScan& scan, const Pose2& world_from_base,
+                 std::optional<double> max_range_m = std::nullopt);
 
   /// Adds `delta` to `cell` with clamping; the grid must contain the cell.
   void Update(const Eigen::Array2i& cell, float delta) {

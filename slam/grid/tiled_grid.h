@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "slam/grid/occupancy_grid.h"
@@ -94,7 +95,10 @@ class TiledGrid {
   void Update(const Eigen::Array2i& cell, float delta);
 
   /// OccupancyGrid::InsertScan on this grid: the same beams, cells and log-odds changes.
-  int InsertScan(const LaserScan& scan, const Pose2& world_from_base);
+  /// `max_range_m`, when given, replaces the options' max_range_m for this scan (a sparse scan's
+  /// SparseScanRange); the lidar's own range_max_m still bounds it.
+  int InsertScan(const LaserScan& scan, const Pose2& world_from_base,
+                 std::optional<double> max_range_m = std::nullopt);
 
   /// Tiles this grid holds (written at least once).
   int num_tiles() const;

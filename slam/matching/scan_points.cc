@@ -13,8 +13,23 @@ std::vector<std::string> ScanPointsOptions::Validate() const {
   rules.NonNegative("min_range_m", min_range_m)
       .Require(max_range_m > min_range_m, "max_range_m", max_range_m, "must be > min_range_m")
       .AtLeast("beam_stride", beam_stride, 1)
-      .NonNegative("voxel_size_m", voxel_size_m);
+      .NonNegative("voxel_size_m", voxel_size_m)
+      .Fraction("sparse_fraction", sparse_fraction);
   return rules.errors();
+}
+
+std::optional<double> SparseScanRange(const LaserScan& scan, const ScanPointsOptions& options) {
+  if (!(options.sparse_fraction > 0.0) || !(scan.range_max_m > options.max_range_m)) {
+    return std::nullopt;
+  }
+  const double min_range = std::max(options.min_range_m, scan.range_min_m);
+  std::size_t near = 0;
+  for (const float r : scan.ranges_m) near += r >= min_range && r < options.max_range_m;
+  if (static_cast<double>(near) >=
+      options.sparse_fraction * static_cast<double>(scan.ranges_m.size())) {
+    return std::nullopt;
+  }
+  return scan.range_max_m;
 }
 
 std::vector<Eigen::Vector2d> ScanToBasePoints(const LaserScan& scan,
@@ -23,7 +38,8 @@ std::vector<Eigen::Vector2d> ScanToBasePoints(const LaserScan& scan,
   std::vector<Eigen::Vector2d> points;
   points.reserve(scan.ranges_m.size() / static_cast<std::size_t>(options.beam_stride) + 1);
   const double min_range = std::max(options.min_range_m, scan.range_min_m);
-  const double max_range = std::min(options.max_range_m, scan.range_max_m);
+  const double max_range =
+      std::min(SparseScanRange(scan, options).value_or(options.max_range_m), scan.range_max_m);
   const bool sweeps = scan.Sweeps();
   for (std::size_t i = 0; i < scan.ranges_m.size();
        i += static_cast<std::size_t>(options.beam_stride)) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,11 @@ struct ScanPointsOptions {
   /// Keep the first point (in beam order) of each voxel of this size in the base frame, 0 = off.
   /// Cuts the near-range beams that pile into the same map cells.
   double voxel_size_m = 0.0;
+  /// A sparse scan, fewer than this fraction of whose beams return within max_range_m (an open
+  /// field, dark facades), keeps every return out to the lidar's own range instead: far points
+  /// place a scan where near ones are too few to, and max_range_m's reason (grazing and
+  /// see-through returns in buildings) does not arise where there is nothing near. 0: never.
+  double sparse_fraction = 0.0;
 
   /// One message per broken rule (prefixed "points.").
   std::vector<std::string> Validate() const;
@@ -28,7 +34,13 @@ void VisitFields(V& v, ScanPointsOptions& o) {
   v("max_range_m", o.max_range_m);
   v("beam_stride", o.beam_stride);
   v("voxel_size_m", o.voxel_size_m);
+  v("sparse_fraction", o.sparse_fraction);
 }
+
+/// The range out to which `scan`'s returns are used: the lidar's range_max_m when the scan is
+/// sparse (ScanPointsOptions::sparse_fraction), else none (max_range_m holds). The grids'
+/// InsertScan takes it, so that a map holds what its matcher reads.
+std::optional<double> SparseScanRange(const LaserScan& scan, const ScanPointsOptions& options);
 
 /// The scan's hit points in the base_link frame at the scan's time (through scan.base_from_laser,
 /// and each beam's SweepPose when the scan sweeps), in beam order.

@@ -122,5 +122,30 @@ TEST(ScanPointsTest, ValidateNamesFieldValueAndRule) {
   EXPECT_THAT(options.Validate(), testing::ElementsAre("beam_stride = 0; must be >= 1"));
 }
 
+TEST(ScanPointsTest, ASparseScanKeepsItsFarReturnsAndADenseOneDoesNot) {
+  // 100 beams on an 80 m lidar: k of them at 10 m, the rest at 50 m.
+  auto scan_with_near = [](int k) {
+    LaserScan scan = Arc(100, 50.0f);
+    scan.range_max_m = 80.0;
+    for (int i = 0; i < k; ++i) scan.ranges_m[static_cast<std::size_t>(i)] = 10.0f;
+    return scan;
+  };
+  ScanPointsOptions options;  // max_range_m 30
+  options.sparse_fraction = 0.25;
+  for (int k = 0; k <= 100; k += 5) {
+    const LaserScan scan = scan_with_near(k);
+    const bool sparse = k < 25;
+    EXPECT_EQ(SparseScanRange(scan, options).has_value(), sparse) << k;
+    EXPECT_EQ(ScanToBasePoints(scan, options).size(), sparse ? 100u : static_cast<std::size_t>(k))
+        << k;
+  }
+  // Off by default, and never beyond the lidar's own range.
+  EXPECT_FALSE(SparseScanRange(scan_with_near(0), ScanPointsOptions{}).has_value());
+  LaserScan short_lidar = scan_with_near(0);
+  short_lidar.range_max_m = 20.0;
+  EXPECT_FALSE(SparseScanRange(short_lidar, options).has_value());
+  EXPECT_DOUBLE_EQ(*SparseScanRange(scan_with_near(0), options), 80.0);
+}
+
 }  // namespace
 }  // namespace slamrig::slam

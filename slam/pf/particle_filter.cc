@@ -462,7 +462,7 @@ void ParticleFilter::GiveUpWhenLostTooLong(const LaserScan& scan, ParticleFilter
   ForgetSearch();
   tracked_updates_ = 0;
   step->lost = false;
-  map_.InsertScan(scan, step->best_pose);
+  map_.InsertScan(scan, step->best_pose, SparseScanRange(scan, options_.points));
 }
 
 ParticleFilter::ScoredPose ParticleFilter::LocalMatch(const std::vector<Eigen::Vector2d>& points,
@@ -646,7 +646,7 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
 ParticleFilterStep ParticleFilter::Start(const LaserScan& scan) {
   // Step 1 of Zafari's summary: particles at the origin; the first scan starts the map.
   started_ = true;
-  map_.InsertScan(scan, Pose2());
+  map_.InsertScan(scan, Pose2(), SparseScanRange(scan, options_.points));
   ParticleFilterStep step;
   step.neff = static_cast<double>(options_.num_particles);
   step.updated = true;
@@ -722,7 +722,8 @@ bool ParticleFilter::UpdateMapAndLostState(const LaserScan& scan,
   if (lost_) {
     // Lost since an earlier update: the map stays frozen until the filter resumes (the scan fits
     // where the filter is, or next to it, and is mapped as usual) or relocalises (a new cloud).
-    if (!Relocalise(points, scan, step)) map_.InsertScan(scan, step->best_pose);
+    if (!Relocalise(points, scan, step))
+      map_.InsertScan(scan, step->best_pose, SparseScanRange(scan, options_.points));
     return !step->relocalised;
   }
   // The lost test is made only when most of the scan lands where the map has been observed:
@@ -743,7 +744,7 @@ bool ParticleFilter::UpdateMapAndLostState(const LaserScan& scan,
   // would paint the new place onto the old one before the averages call the filter lost.
   const bool suspect = judged && TrackQuality(step->quality, scan.time);
   step->lost = lost_;
-  if (!suspect) map_.InsertScan(scan, step->best_pose);
+  if (!suspect) map_.InsertScan(scan, step->best_pose, SparseScanRange(scan, options_.points));
   // A scan that tracked as usual tells how sharp the map is; the field follows (its next
   // Follow recomputes it everywhere).
   if (!suspect && !lost_ && wall_distance) {

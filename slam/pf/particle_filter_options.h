@@ -161,8 +161,11 @@ struct ParticleFilterOptions {
 
   ObservationModel observation = ObservationModel::kLikelihoodField;
   /// The beams used for weighting (voxel-filtered).
-  ScanPointsOptions points{
-      .min_range_m = 0.1, .max_range_m = 30.0, .beam_stride = 1, .voxel_size_m = 0.05};
+  ScanPointsOptions points{.min_range_m = 0.1,
+                           .max_range_m = 30.0,
+                           .beam_stride = 1,
+                           .voxel_size_m = 0.05,
+                           .sparse_fraction = 0.5};
   /// The shift search: 9x9 cells and 9 yaws 0.0075 rad apart. With kLikelihoodField its `value`
   /// must be kRawValue.
   MapCorrelatorOptions correlation{.xy_half_width_cells = 4,

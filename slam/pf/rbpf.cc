@@ -140,7 +140,7 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
   particle.pose = drawn;
   particle.log_weight += weight_exponent * log_eta_weight;
   particle.path_log_likelihood += log_eta;
-  particle.map.InsertScan(scan, drawn);
+  particle.map.InsertScan(scan, drawn, SparseScanRange(scan, options_.points));
   particle.history = std::make_shared<RbpfPoseNode>(drawn, std::move(particle.history));
 }
 
@@ -348,7 +348,7 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
     RbpfParticle first{Pose2(), 0.0, 0.0, TiledGrid(options_.map),
                        std::make_shared<RbpfPoseNode>(Pose2(), nullptr)};
     first.map.RecordHitMeans(options_.cell_hit_means);
-    first.map.InsertScan(scan, Pose2());
+    first.map.InsertScan(scan, Pose2(), SparseScanRange(scan, options_.points));
     particles_.assign(static_cast<std::size_t>(options_.num_particles), first);
     update_count_ = 1;
     step.neff = options_.num_particles;

@@ -43,8 +43,11 @@ struct RbpfOptions {
   std::uint64_t seed = 1;  ///< seeds one stream per particle and step, and the resampling
 
   /// The beams used for matching (voxel-filtered).
-  ScanPointsOptions points{
-      .min_range_m = 0.1, .max_range_m = 30.0, .beam_stride = 1, .voxel_size_m = 0.05};
+  ScanPointsOptions points{.min_range_m = 0.1,
+                           .max_range_m = 30.0,
+                           .beam_stride = 1,
+                           .voxel_size_m = 0.05,
+                           .sparse_fraction = 0.5};
   RbpfMatcherOptions matcher;
   RbpfMotionNoise motion;
   /// The proposal's sample points: a 3 x 3 x 3 grid of these steps around the match (GMapping's

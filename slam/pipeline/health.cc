@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "slam/eval/chi_square.h"
+#include "slam/pf/solution_remapping.h"
 #include "slam/types/check.h"
 
 namespace slamrig::slam {
@@ -47,6 +48,70 @@ void NisWindow::Add(double nis, int dimension) {
 double NisWindow::ratio() const {
   if (window_.empty()) return 0.0;
   return nis_sum_ / ChiSquareQuantile(kProbability, dimension_sum_);
+}
+
+double Observability(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& direction) {
+  constexpr double kNeighbourM = 0.3;
+  const double norm = direction.norm();
+  if (points.empty() || !(norm > 0.0)) return 0.0;
+  const MatchConstraints c =
+      DecomposeInformation(ScanInformation(points, SurfaceNormals(points, kNeighbourM)));
+  const double strongest = c.eigenvalues.y();
+  if (!(strongest > 0.0)) return 0.0;
+  const Eigen::Vector2d along = c.eigenvectors.transpose() * (direction / norm);
+  const double information =
+      along.x() * along.x() * c.eigenvalues.x() + along.y() * along.y() * c.eigenvalues.y();
+  return std::clamp(information / strongest, 0.0, 1.0);
+}
+
+bool WheelAgreement::Add(const Pose2& estimate_increment, const Pose2& wheel_increment,
+                         double observability) {
+  if (observability >= kObservable) return false;
+  const Eigen::Vector2d wheels = wheel_increment.translation();
+  const double wheels_m = wheels.norm();
+  // The estimate's own motion along the wheels' direction.
+  const double estimate_m =
+      wheels_m > 0.0 ? estimate_increment.translation().dot(wheels / wheels_m) : 0.0;
+  window_.push_back({wheels_m, estimate_m, false});
+  wheels_m_ += wheels_m;
+  estimate_m_ += estimate_m;
+  // The window: the fewest latest scans that still cover kWindowM of wheel travel.
+  while (window_.size() > 1 && wheels_m_ - window_.front().wheels_m >= kWindowM) {
+    wheels_m_ -= window_.front().wheels_m;
+    estimate_m_ -= window_.front().estimate_m;
+    window_.pop_front();
+  }
+  const bool flagged = std::abs(ratio() - 1.0) > kTolerance;
+  if (!flagged) {
+    CloseStretch();
+    return false;
+  }
+  // The stretch's displacement: every scan of the window not yet counted (the first flag's whole
+  // window, then each new scan).
+  if (in_stretch_) stretch_travel_m_ += wheels_m;
+  in_stretch_ = true;
+  for (Step& step : window_) {
+    if (step.counted) continue;
+    stretch_m_ += step.estimate_m - step.wheels_m;
+    step.counted = true;
+  }
+  return true;
+}
+
+void WheelAgreement::CloseStretch() {
+  contradicted_m_ += Persistent() ? std::abs(stretch_m_) : 0.0;
+  stretch_m_ = stretch_travel_m_ = 0.0;
+  in_stretch_ = false;
+}
+
+void WheelAgreement::Reset() {
+  CloseStretch();
+  window_.clear();
+  wheels_m_ = estimate_m_ = 0.0;
+}
+
+double WheelAgreement::ratio() const {
+  return wheels_m_ >= kWindowM ? estimate_m_ / wheels_m_ : 1.0;
 }
 
 void HealthRecord::Add(bool lost) {

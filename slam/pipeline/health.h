@@ -9,12 +9,15 @@
 // rule; and the verdict `diverged` from the lost flags. The runner turns consecutive lost scans
 // into LostIntervals. docs/estimators.md ("How each estimator judges itself") lists the rules.
 
+#include <Eigen/Core>
+#include <cmath>
 #include <deque>
 #include <utility>
 #include <vector>
 
 #include "slam/matching/icp_odometry.h"
 #include "slam/pipeline/estimator.h"
+#include "slam/types/pose2.h"
 #include "slam/types/time.h"
 #include "slam/types/trajectory.h"
 
@@ -75,6 +78,74 @@ class NisWindow {
   double nis_sum_ = 0.0;
   int dimension_sum_ = 0;
 };
+
+/// An estimator whose estimate contradicted its wheels (WheelAgreement) by more than this in
+/// total calls its run diverged: a filter has no loop closure to take such a displacement back,
+/// and it is tens of times a scan match's error.
+inline constexpr double kDivergedContradictionM = 1.0;
+
+/// Whether an estimate's motion agrees with the wheels' over the last stretch of driving: the
+/// distance the estimate moved along the wheels' direction, summed over the scans of the last
+/// kWindowM metres of wheel travel, over the wheels' own distance there. A scan matcher that
+/// holds the robot still while the wheels roll on (a map written from a stopped estimate fits a
+/// stopped estimate best: a featureless corridor), or that races ahead of them, contradicts them
+/// by far more than any wheel's scale error or slip over that stretch: outside
+/// [1 - kTolerance, 1 + kTolerance] the estimate is not following the robot. The heading is left
+/// out: raw odometry's heading drifts (degrees per metre) where its distance holds.
+///
+/// Only scans that observe the motion poorly are judged (Observability below kObservable): where
+/// the scan's own geometry pins the robot along the wheels' direction, the scan is the better
+/// witness (wheels slip, spin, or log the wrong sign when reversing), and an estimate that
+/// follows it is right to leave the wheels. The window is the last kWindowM of wheel travel over
+/// the judged scans.
+class WheelAgreement {
+ public:
+  static constexpr double kWindowM = 2.0;      ///< metres of wheel travel judged together
+  static constexpr double kTolerance = 0.5;    ///< the distance ratio's allowed departure from 1
+  static constexpr double kObservable = 0.25;  ///< a scan this observable is not judged
+
+  /// Adds one scan's increments since the previous scan, both in the robot's frame there: the
+  /// estimate's own (an estimator that revises its choice of hypothesis, like an RBPF switching
+  /// particles, gives the chosen hypothesis's own motion) and the wheels'. True when the window
+  /// is full and its ratio lies outside the tolerance. `observability`: the scan's along the
+  /// wheels' direction (Observability); at kObservable or above the scan is not judged (false).
+  bool Add(const Pose2& estimate_increment, const Pose2& wheel_increment,
+           double observability = 0.0);
+  /// Forgets the window: after a gap in the odometry or a jump the estimator made on purpose (a
+  /// relocalisation), the motion before it says nothing about the motion after.
+  void Reset();
+  /// The window's distance ratio (1 while the window is not full).
+  double ratio() const;
+  /// The estimate's displacement against the wheels over the persistent flagged stretches: per
+  /// stretch of consecutive flagged scans, the estimate's distance less the wheels' (from the
+  /// window that first flagged it to its last scan), summed in magnitude. A stretch persists when
+  /// it stays flagged over more than kWindowM of wheel travel after its first flag: one jump of
+  /// the estimate (a correction) leaves the window within that, a stopped or racing estimate
+  /// does not.
+  double contradicted_m() const {
+    return contradicted_m_ + (Persistent() ? std::abs(stretch_m_) : 0.0);
+  }
+
+ private:
+  struct Step {
+    double wheels_m, estimate_m;
+    bool counted;  // in a stretch's displacement
+  };
+  bool Persistent() const { return stretch_travel_m_ > kWindowM; }
+  void CloseStretch();
+  std::deque<Step> window_;
+  double wheels_m_ = 0.0, estimate_m_ = 0.0;
+  bool in_stretch_ = false;
+  double stretch_m_ = 0.0;         // the open stretch's signed displacement
+  double stretch_travel_m_ = 0.0;  // and its wheel travel after its first flag
+  double contradicted_m_ = 0.0;    // the closed stretches'
+};
+
+/// How well a scan's own geometry observes translation along `direction` (robot frame): the
+/// point-to-line information along it, the yaw left free (DecomposeInformation of
+/// ScanInformation, normals from neighbours within 0.3 m), over the strongest direction's: about
+/// 1 in a room, near 0 along a corridor's axis; 0 for a scan without geometry or a zero direction.
+double Observability(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& direction);
 
 /// An estimator's per-scan lost flags, counted: the statistics `lost` (losses) and `diverged`.
 class HealthRecord {

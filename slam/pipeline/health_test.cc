@@ -169,5 +169,113 @@ TEST(HealthTest, FrontEndIsLostOnAFailedMatchAndOnAFallingScore) {
   EXPECT_TRUE(lost);
 }
 
+// Drives `steps` wheel increments of `step_m` on a random curvy path; the estimate moves by the
+// wheels' increment times `scale`, plus jitter and a heading error (the estimate's own). The
+// scans WheelAgreement flags.
+std::vector<bool> Judged(WheelAgreement* agreement, std::mt19937* rng, int steps, double step_m,
+                         double scale, double jitter_m) {
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::uniform_real_distribution<double> turn(-0.2, 0.2);
+  std::vector<bool> flags;
+  for (int i = 0; i < steps; ++i) {
+    const Pose2 wheels(step_m, 0.0, turn(*rng));
+    const double along = noise(*rng), across = noise(*rng), yaw = noise(*rng);
+    const Pose2 moved(scale * step_m + jitter_m * along, jitter_m * across,
+                      wheels.theta() + 0.01 * yaw);
+    flags.push_back(agreement->Add(moved, wheels));
+  }
+  return flags;
+}
+
+TEST(HealthTest, WheelAgreementHoldsForAnEstimateThatFollowsTheRobot) {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 200; ++trial) {
+    WheelAgreement agreement;
+    // Wheels 20 % off in scale, a centimetre of jitter per 0.1-0.5 m step: never flagged.
+    const double step_m = 0.1 + 0.4 * (trial % 5) / 4.0;
+    const double scale = 0.8 + 0.4 * (trial % 7) / 6.0;
+    const std::vector<bool> flags = Judged(&agreement, &rng, 200, step_m, scale, 0.01);
+    EXPECT_EQ(std::count(flags.begin(), flags.end(), true), 0) << trial;
+    EXPECT_NEAR(agreement.ratio(), scale, 0.1) << trial;
+    EXPECT_EQ(agreement.contradicted_m(), 0.0) << trial;
+  }
+}
+
+TEST(HealthTest, WheelAgreementFlagsAnEstimateThatStopsOrRaces) {
+  std::mt19937 rng(11);
+  for (const double scale : {0.0, 0.3, 1.7, 3.0}) {
+    WheelAgreement agreement;
+    std::vector<bool> flags = Judged(&agreement, &rng, 20, 0.3, 1.0, 0.005);
+    EXPECT_EQ(std::count(flags.begin(), flags.end(), true), 0);
+    EXPECT_EQ(agreement.contradicted_m(), 0.0);
+    // 20 steps of 0.3 m at `scale`: flagged once the window (2 m) is mostly that stretch.
+    flags = Judged(&agreement, &rng, 20, 0.3, scale, 0.005);
+    EXPECT_TRUE(flags.back()) << scale;
+    EXPECT_NEAR(agreement.ratio(), scale, 0.15) << scale;
+    // The estimate follows again: the flag clears once the window has left the stretch.
+    flags = Judged(&agreement, &rng, 10, 0.3, 1.0, 0.005);
+    EXPECT_FALSE(flags.back()) << scale;
+    // The whole stretch's displacement against the wheels, the scans before the flag included.
+    EXPECT_NEAR(agreement.contradicted_m(), 6.0 * std::abs(1.0 - scale), 0.05) << scale;
+  }
+  {
+    // One jump of the estimate (a correction) is flagged while it is in the window, but it does
+    // not persist: no contradiction.
+    WheelAgreement agreement;
+    Judged(&agreement, &rng, 20, 0.3, 1.0, 0.005);
+    EXPECT_TRUE(agreement.Add(Pose2(-1.2, 0.0, 0.0), Pose2(0.3, 0.0, 0.0)));
+    const std::vector<bool> flags = Judged(&agreement, &rng, 20, 0.3, 1.0, 0.005);
+    EXPECT_GT(std::count(flags.begin(), flags.end(), true), 3);
+    EXPECT_FALSE(flags.back());
+    EXPECT_EQ(agreement.contradicted_m(), 0.0);
+  }
+  // Less than the window's wheel travel is never judged; a reset forgets the window.
+  WheelAgreement agreement;
+  std::vector<bool> flags = Judged(&agreement, &rng, 6, 0.3, 0.0, 0.0);  // 1.8 m
+  EXPECT_EQ(std::count(flags.begin(), flags.end(), true), 0);
+  EXPECT_DOUBLE_EQ(agreement.ratio(), 1.0);
+  flags = Judged(&agreement, &rng, 2, 0.3, 0.0, 0.0);
+  EXPECT_TRUE(flags.back());
+  agreement.Reset();
+  EXPECT_DOUBLE_EQ(agreement.ratio(), 1.0);
+  EXPECT_FALSE(agreement.Add(Pose2(), Pose2(0.3, 0.0, 0.0)));
+  EXPECT_DOUBLE_EQ(agreement.ratio(), 1.0);
+}
+
+// Points every 5 cm along the segment from a to b.
+void Wall(const Eigen::Vector2d& a, const Eigen::Vector2d& b, std::vector<Eigen::Vector2d>* out) {
+  const int n = static_cast<int>((b - a).norm() / 0.05);
+  for (int i = 0; i <= n; ++i) out->push_back(a + (b - a) * (static_cast<double>(i) / n));
+}
+
+TEST(HealthTest, ObservabilityIsLowOnlyAlongACorridorsAxis) {
+  std::vector<Eigen::Vector2d> corridor;
+  Wall({-8.0, 1.0}, {8.0, 1.0}, &corridor);
+  Wall({8.0, -1.0}, {-8.0, -1.0}, &corridor);
+  EXPECT_LT(Observability(corridor, {1.0, 0.0}), 0.01);
+  EXPECT_NEAR(Observability(corridor, {0.0, -2.0}), 1.0, 1e-9);
+  // At 45 degrees to the axis: half the across-axis information.
+  EXPECT_NEAR(Observability(corridor, {1.0, 1.0}), 0.5, 0.01);
+  std::vector<Eigen::Vector2d> room;
+  Wall({-2.0, -2.0}, {2.0, -2.0}, &room);
+  Wall({2.0, -2.0}, {2.0, 2.0}, &room);
+  Wall({2.0, 2.0}, {-2.0, 2.0}, &room);
+  Wall({-2.0, 2.0}, {-2.0, -2.0}, &room);
+  EXPECT_NEAR(Observability(room, {1.0, 0.0}), 1.0, 0.05);
+  EXPECT_EQ(Observability({}, {1.0, 0.0}), 0.0);
+  EXPECT_EQ(Observability(room, {0.0, 0.0}), 0.0);
+  // Scans that observe the motion are not judged: a stopped estimate there is the scan's word.
+  WheelAgreement agreement;
+  for (int i = 0; i < 20; ++i) {
+    EXPECT_FALSE(agreement.Add(Pose2(), Pose2(0.3, 0.0, 0.0), Observability(room, {1.0, 0.0})));
+  }
+  EXPECT_DOUBLE_EQ(agreement.ratio(), 1.0);
+  bool flagged = false;
+  for (int i = 0; i < 20; ++i) {
+    flagged = agreement.Add(Pose2(), Pose2(0.3, 0.0, 0.0), Observability(corridor, {1.0, 0.0}));
+  }
+  EXPECT_TRUE(flagged);
+}
+
 }  // namespace
 }  // namespace slamrig::slam

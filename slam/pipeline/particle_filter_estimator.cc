@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "slam/matching/scan_points.h"
+
 namespace slamrig::slam {
 
 ParticleFilterOptions ParticleFilterEstimator::Seeded(ParticleFilterOptions options,
@@ -12,7 +14,7 @@ ParticleFilterOptions ParticleFilterEstimator::Seeded(ParticleFilterOptions opti
 
 ParticleFilterEstimator::ParticleFilterEstimator(const ParticleFilterOptions& options,
                                                  const EstimatorContext& context)
-    : filter_(Seeded(options, context.seed)) {}
+    : filter_(Seeded(options, context.seed)), judge_wheels_(context.own_odometry) {}
 
 ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
   const ParticleFilterStep step = filter_.AddScan(scan.scan, scan.increment, scan.odometry_gap_s);
@@ -27,15 +29,35 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
     relocalised_at_s_ = t;
   }
   was_lost_ = step.lost;
-  ScanEstimate estimate{
-      step.best_pose,
-      step.mean_pose,
-      {{"neff", step.neff}, {"match_quality", step.quality}, {"lost", step.lost ? 1.0 : 0.0}},
-      std::nullopt,
-      step.lost};
-  // The filter's own lost test: the short-term average of the match quality below lost_ratio
-  // times its long-term one (ParticleFilterOptions::relocalisation).
-  health_.Add(step.lost);
+  // Lost by the filter's own test (the short-term average of the match quality below lost_ratio
+  // times its long-term one, ParticleFilterOptions::relocalisation), or the estimate's motion
+  // contradicts the wheels' (WheelAgreement); a relocalisation, a gap in the odometry or a
+  // search after one moves the estimate on purpose and restarts that comparison.
+  if (step.relocalised || step.gap_corrected ||
+      scan.odometry_gap_s > filter_.options().relocalisation.odometry_gap_s) {
+    wheels_.Reset();
+  }
+  // How well the scan sees motion along the wheels' direction: only poorly observed motion is
+  // judged against the wheels.
+  double observability = 0.0;
+  if (judge_wheels_ && !scan.increment.translation().isZero()) {
+    observability = Observability(ScanToBasePoints(scan.scan, filter_.options().points),
+                                  scan.increment.translation());
+  }
+  const bool contradicts = judge_wheels_ && wheels_.Add(previous_estimate_.Between(step.best_pose),
+                                                        scan.increment, observability);
+  previous_estimate_ = step.best_pose;
+  const bool lost = step.lost || contradicts;
+  ScanEstimate estimate{step.best_pose,
+                        step.mean_pose,
+                        {{"neff", step.neff},
+                         {"match_quality", step.quality},
+                         {"wheel_distance_ratio", wheels_.ratio()},
+                         {"motion_observability", observability},
+                         {"lost", lost ? 1.0 : 0.0}},
+                        std::nullopt,
+                        lost};
+  health_.Add(lost);
   if (filter_.options().adaptive_sigma.enabled) {
     estimate.trace.push_back({"field_sigma_m", filter_.field_sigma_m()});
   }
@@ -43,10 +65,19 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
 }
 
 const std::vector<std::string>& ParticleFilterEstimator::StatisticNames() {
-  static const std::vector<std::string> names = {
-      "mean_neff",       "resamples",       "updates",   "lost",
-      "relocalisations", "resumed",         "lost_at_s", "relocalised_at_s",
-      "field_sigma_m",   "wall_distance_m", "diverged",  "gap_corrections"};
+  static const std::vector<std::string> names = {"mean_neff",
+                                                 "resamples",
+                                                 "updates",
+                                                 "lost",
+                                                 "relocalisations",
+                                                 "resumed",
+                                                 "lost_at_s",
+                                                 "relocalised_at_s",
+                                                 "field_sigma_m",
+                                                 "wall_distance_m",
+                                                 "diverged",
+                                                 "gap_corrections",
+                                                 "wheel_contradiction_m"};
   return names;
 }
 
@@ -62,7 +93,12 @@ std::map<std::string, double> ParticleFilterEstimator::Statistics() const {
           {"relocalised_at_s", relocalised_at_s_},
           {"field_sigma_m", filter_.field_sigma_m()},
           {"wall_distance_m", filter_.wall_distance_m()},
-          {"diverged", health_.Diverged() ? 1.0 : 0.0}};
+          {"wheel_contradiction_m", wheels_.contradicted_m()},
+          {"diverged", Diverged() ? 1.0 : 0.0}};
+}
+
+bool ParticleFilterEstimator::Diverged() const {
+  return health_.Diverged() || wheels_.contradicted_m() > kDivergedContradictionM;
 }
 
 EstimatorView ParticleFilterEstimator::View() const {

@@ -30,6 +30,9 @@ class ParticleFilterEstimator final : public Estimator {
   EstimatorView View() const override;
 
  private:
+  // Lost at the end or on more than kDivergedLostShare of the scans, or the estimate contradicted
+  // the wheels by more than kDivergedContradictionM in total.
+  bool Diverged() const;
   static ParticleFilterOptions Seeded(ParticleFilterOptions options, std::uint64_t seed);
 
   ParticleFilter filter_;
@@ -41,6 +44,10 @@ class ParticleFilterEstimator final : public Estimator {
   double lost_at_s_ = NAN;
   double relocalised_at_s_ = NAN;
   HealthRecord health_;
+  // The estimate's distance against the wheels' (off without the robot's own odometry).
+  bool judge_wheels_ = true;
+  WheelAgreement wheels_;
+  Pose2 previous_estimate_;
 };
 
 }  // namespace slamrig::slam

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "slam/matching/scan_points.h"
 #include "slam/types/check.h"
 
 namespace slamrig::slam {
@@ -14,10 +15,21 @@ RbpfOptions RbpfEstimator::Seeded(RbpfOptions options, std::uint64_t seed) {
 }
 
 RbpfEstimator::RbpfEstimator(const RbpfOptions& options, const EstimatorContext& context)
-    : filter_(Seeded(options, context.seed)), map_(options.map) {}
+    : filter_(Seeded(options, context.seed)),
+      judge_wheels_(context.own_odometry),
+      map_(options.map) {}
 
 ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
   const RbpfStep step = filter_.AddScan(scan.scan, scan.increment, scan.odometry_gap_s);
+  // The best particle's own motion since the previous scan: from where its own path put the
+  // previous scan (its pose at the previous update, moved by the odometry since) at an update,
+  // the odometry between updates. Not the step from the previous best particle to this one: a
+  // switch of particles revises the path, it is not motion.
+  Pose2 estimate_increment = scan.increment;
+  if (step.updated && !filter_.particles().empty() && filter_.best().history &&
+      filter_.best().history->parent) {
+    estimate_increment = (filter_.best().history->parent->pose * offset_).Between(step.best_pose);
+  }
   offset_ = step.updated ? Pose2() : offset_ * scan.increment;
   scan_offsets_.emplace_back(filter_.update_count() - 1, offset_);
   neff_sum_ += step.neff;
@@ -25,9 +37,23 @@ ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
   failed_matches_ += step.failed_matches;
   if (step.updated) exponent_sum_ += step.weight_exponent;
   // Lost: the best particle's matched fraction, averaged over the last few updates, below half
-  // its long-term level (the pf's lost_ratio rule on the RBPF's own quality).
+  // its long-term level (the pf's lost_ratio rule on the RBPF's own quality), or the estimate's
+  // motion contradicts the wheels' (WheelAgreement). A gap in the odometry, or the filter's own
+  // odometry check replacing the wheels' increment, restarts that comparison.
   if (step.updated) lost_ = matched_ratio_.Add(step.matched_fraction) < kLostRatio;
-  health_.Add(lost_);
+  if (step.odometry_rejected || scan.odometry_gap_s > filter_.options().odometry_gap_s) {
+    wheels_.Reset();
+  }
+  // How well the scan sees motion along the wheels' direction: only poorly observed motion is
+  // judged against the wheels.
+  double observability = 0.0;
+  if (judge_wheels_ && !scan.increment.translation().isZero()) {
+    observability = Observability(ScanToBasePoints(scan.scan, filter_.options().points),
+                                  scan.increment.translation());
+  }
+  const bool contradicts =
+      judge_wheels_ && wheels_.Add(estimate_increment, scan.increment, observability);
+  health_.Add(lost_ || contradicts);
   const double particles =
       static_cast<double>(std::max<std::size_t>(filter_.particles().size(), 1));
   ScanEstimate estimate{step.best_pose,
@@ -36,9 +62,11 @@ ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
                          {"neff_ratio", step.neff / particles},
                          {"matched_fraction", step.matched_fraction},
                          {"matched_fraction_ratio", matched_ratio_.ratio()},
-                         {"failed_match_share", step.failed_matches / particles}},
+                         {"failed_match_share", step.failed_matches / particles},
+                         {"wheel_distance_ratio", wheels_.ratio()},
+                         {"motion_observability", observability}},
                         std::nullopt,
-                        lost_};
+                        lost_ || contradicts};
   return estimate;
 }
 
@@ -73,7 +101,8 @@ const std::vector<std::string>& RbpfEstimator::StatisticNames() {
                                                  "map_tiles",
                                                  "map_tiles_per_particle",
                                                  "lost",
-                                                 "diverged"};
+                                                 "diverged",
+                                                 "wheel_contradiction_m"};
   return names;
 }
 
@@ -93,7 +122,12 @@ std::map<std::string, double> RbpfEstimator::Statistics() const {
                ? 0.0
                : static_cast<double>(tiles) / static_cast<double>(filter_.particles().size())},
           {"lost", health_.losses()},
-          {"diverged", health_.Diverged() ? 1.0 : 0.0}};
+          {"wheel_contradiction_m", wheels_.contradicted_m()},
+          {"diverged", Diverged() ? 1.0 : 0.0}};
+}
+
+bool RbpfEstimator::Diverged() const {
+  return health_.Diverged() || wheels_.contradicted_m() > kDivergedContradictionM;
 }
 
 EstimatorView RbpfEstimator::View() const {

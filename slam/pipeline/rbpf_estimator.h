@@ -35,6 +35,9 @@ class RbpfEstimator final : public Estimator {
   EstimatorView View() const override;
 
  private:
+  // Lost at the end or on more than kDivergedLostShare of the scans, or the estimate contradicted
+  // the wheels by more than kDivergedContradictionM in total.
+  bool Diverged() const;
   static RbpfOptions Seeded(RbpfOptions options, std::uint64_t seed);
 
   Rbpf filter_;
@@ -49,6 +52,9 @@ class RbpfEstimator final : public Estimator {
   QualityRatio matched_ratio_{0.3, 0.02, 20, 0.5};
   bool lost_ = false;  // at the last update; held between updates
   HealthRecord health_;
+  // The estimate's distance against the wheels' (off without the robot's own odometry).
+  bool judge_wheels_ = true;
+  WheelAgreement wheels_;
   mutable OccupancyGrid map_;
   mutable int map_version_ = -1;  // update count the map was converted at
 };
