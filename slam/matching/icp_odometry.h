@@ -62,7 +62,7 @@ struct IcpOdometryOptions {
   /// (intel: up to ~0.5 m), light trimming and a Cauchy weight.
   IcpOptions icp = {
       .max_correspondence_distance_m = 1.0, .trim_fraction = 0.95, .kernel = RobustKernel::kCauchy};
-  ScanPointsOptions points = {.voxel_size_m = 0.05};  ///< scan to points
+  ScanPointsOptions points = {.voxel_size_m = 0.05, .sparse_fraction = 0.5};  ///< scan to points
   int local_map_keyframes = 10;      ///< the local map holds the points of the last N keyframes ...
   double local_map_voxel_m = 0.05;   ///< ... thinned to one point (the newest) per voxel
   double keyframe_distance_m = 0.3;  ///< a scan becomes a keyframe after moving this far ...
