@@ -85,6 +85,7 @@ TEST(SelfDiagnosisTest, GraphCallsAnUnrepairedFrontEndLossDiverged) {
   EXPECT_LT(repaired["ate_rmse_m"].as<double>(), 0.2);
   EXPECT_GE(repaired["lost_intervals"].as<double>(), 1.0);
   EXPECT_EQ(repaired["unrepaired_losses"].as<double>(), 0.0);
+  EXPECT_EQ(repaired["unrepaired_error_bound_m"].as<double>(), 0.0);
   EXPECT_EQ(repaired["diverged"].as<double>(), 0.0);
   // The same with half the scans dropped: a loss no closure spans. (With three in ten dropped
   // the front end's search over a doubted prior now holds the route, 0.10 m.)
@@ -93,6 +94,8 @@ TEST(SelfDiagnosisTest, GraphCallsAnUnrepairedFrontEndLossDiverged) {
   EXPECT_GT(noisy["ate_rmse_m"].as<double>(), 1.0);  // the failure the verdict must see
   EXPECT_GE(noisy["lost_intervals"].as<double>(), 1.0);
   EXPECT_GE(noisy["unrepaired_losses"].as<double>(), 1.0);
+  // What the blind stretch may have left, at the odometry noise the front end measured.
+  EXPECT_GT(noisy["unrepaired_error_bound_m"].as<double>(), 1.0);
   EXPECT_EQ(noisy["diverged"].as<double>(), 1.0);
 }
 

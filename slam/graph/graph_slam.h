@@ -108,6 +108,8 @@ class GraphSlam {
     JoinBackEnd();
     return counts_;
   }
+  /// The scan-to-local-map front end (its measured odometry noise, noise_scale()).
+  const IcpOdometry& front_end() const { return odometry_; }
   const PoseGraph& graph() const {
     JoinBackEnd();
     return graph_;

@@ -40,7 +40,20 @@ ScanEstimate GraphSlamEstimator::AddScan(const SyncedScan& scan) {
   ScanEstimate estimate;
   estimate.pose = pose;
   estimate.lost = front_end_health_.Judge(slam_.last_step(), &estimate.trace);
+  const int losses = health_.losses();
   health_.Add(*estimate.lost);
+  if (*estimate.lost) {
+    // A lost scan is placed by the odometry: the bound on what its loss left grows by the
+    // odometry's noise over its increment (the front end's model, scaled by the noise it
+    // measured on its clear matches).
+    if (health_.losses() > losses) {
+      blind_.Start();
+      loss_bounds_m_.push_back(0.0);
+    }
+    blind_.Add(scan.increment, options_.graph.odometry.IncrementSigmas(scan.increment)
+                                   .cwiseProduct(slam_.front_end().noise_scale()));
+    loss_bounds_m_.back() = blind_.bound_m();
+  }
   return estimate;
 }
 
@@ -65,16 +78,22 @@ EstimatorView GraphSlamEstimator::View() const {
   return view;
 }
 
-int GraphSlamEstimator::UnrepairedLosses() const {
+std::vector<double> GraphSlamEstimator::UnrepairedLossBounds() const {
   const std::vector<LoopClosure> closures = slam_.UnstrainedLoopClosures();
-  int unrepaired = 0;
-  for (const auto& loss : health_.loss_scans()) {
+  std::vector<double> bounds;
+  const std::vector<std::pair<int, int>>& losses = health_.loss_scans();
+  for (std::size_t i = 0; i < losses.size(); ++i) {
     // A closure repairs the loss when it spans it: from a scan before it to one after it.
-    unrepaired += std::none_of(closures.begin(), closures.end(), [&](const LoopClosure& c) {
-      return c.from_scan < loss.first && c.to_scan > loss.second;
+    const bool repaired = std::any_of(closures.begin(), closures.end(), [&](const LoopClosure& c) {
+      return c.from_scan < losses[i].first && c.to_scan > losses[i].second;
     });
+    if (!repaired) bounds.push_back(i < loss_bounds_m_.size() ? loss_bounds_m_[i] : 0.0);
   }
-  return unrepaired;
+  return bounds;
+}
+
+int GraphSlamEstimator::UnrepairedLosses() const {
+  return static_cast<int>(UnrepairedLossBounds().size());
 }
 
 const std::vector<std::string>& GraphSlamEstimator::StatisticNames() {
@@ -95,13 +114,16 @@ const std::vector<std::string>& GraphSlamEstimator::StatisticNames() {
                                                  "diverged",
                                                  "lost",
                                                  "chi2_ratio",
-                                                 "unrepaired_losses"};
+                                                 "unrepaired_losses",
+                                                 "unrepaired_error_bound_m"};
   return names;
 }
 
 std::map<std::string, double> GraphSlamEstimator::Statistics() const {
   const GraphSlamCounts& c = slam_.counts();
-  const int unrepaired_losses = UnrepairedLosses();
+  const std::vector<double> unrepaired = UnrepairedLossBounds();
+  const double bound_m =
+      unrepaired.empty() ? 0.0 : *std::max_element(unrepaired.begin(), unrepaired.end());
   return {{"keyframes", c.keyframes},
           {"loop_closures", c.loop_closures},
           {"loop_candidates", c.loop_candidates},
@@ -116,10 +138,11 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"certified", c.certified ? 1.0 : 0.0},
           {"certificate_lambda_min", c.certificate_lambda_min},
           {"strained_edges", c.strained_edges},
-          {"diverged", c.diverged || health_.Diverged() || unrepaired_losses > 0 ? 1.0 : 0.0},
+          {"diverged", c.diverged || bound_m > kDivergedErrorM ? 1.0 : 0.0},
           {"lost", health_.losses()},
           {"chi2_ratio", c.chi2_ratio},
-          {"unrepaired_losses", unrepaired_losses}};
+          {"unrepaired_losses", static_cast<double>(unrepaired.size())},
+          {"unrepaired_error_bound_m", bound_m}};
 }
 
 }  // namespace slamrig::slam

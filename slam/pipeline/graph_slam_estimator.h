@@ -59,6 +59,12 @@ class GraphSlamEstimator final : public Estimator {
   /// spans (from a scan before the loss to one after it). A lost scan is placed by the odometry
   /// alone; only such a closure measures, and so corrects, the error it left in the estimate.
   int UnrepairedLosses() const;
+  /// After Finish(): for each unrepaired loss, the 99 % bound on the position error its
+  /// odometry-only stretch may have left (BlindStretchBound with the front end's odometry noise
+  /// model). The run is diverged when one exceeds kDivergedErrorM; how many scans were lost is
+  /// not the verdict: a loss a closure repaired left no error, and one that none did is judged
+  /// by what it may have left.
+  std::vector<double> UnrepairedLossBounds() const;
 
  private:
   GraphSlamEstimatorOptions options_;
@@ -66,7 +72,9 @@ class GraphSlamEstimator final : public Estimator {
   OccupancyGrid map_;
   std::vector<LaserScan> node_scans_;  // the scan of each graph node (vertex id), for the map
   FrontEndHealth front_end_health_;
-  HealthRecord health_;  // its loss_scans() are the repair test's
+  HealthRecord health_;                // its loss_scans() are the repair test's
+  BlindStretchBound blind_;            // over the current loss
+  std::vector<double> loss_bounds_m_;  // per loss (health_.loss_scans()), its bound at its end
 };
 
 }  // namespace slamrig::slam

@@ -114,6 +114,31 @@ double WheelAgreement::ratio() const {
   return wheels_m_ >= kWindowM ? estimate_m_ / wheels_m_ : 1.0;
 }
 
+void BlindStretchBound::Start() {
+  covariance_.setZero();
+  heading_ = 0.0;
+}
+
+void BlindStretchBound::Add(const Pose2& increment, const Eigen::Vector2d& sigmas) {
+  const double c = std::cos(heading_), s = std::sin(heading_);
+  const double ux = increment.x(), uy = increment.y();
+  Eigen::Matrix3d by_pose = Eigen::Matrix3d::Identity();
+  by_pose(0, 2) = -(s * ux + c * uy);
+  by_pose(1, 2) = c * ux - s * uy;
+  Eigen::Matrix3d by_increment = Eigen::Matrix3d::Identity();
+  by_increment.topLeftCorner<2, 2>() << c, -s, s, c;
+  const Eigen::Vector3d variances(sigmas.x() * sigmas.x(), sigmas.x() * sigmas.x(),
+                                  sigmas.y() * sigmas.y());
+  covariance_ = by_pose * covariance_ * by_pose.transpose() +
+                by_increment * variances.asDiagonal() * by_increment.transpose();
+  heading_ += increment.theta();
+}
+
+double BlindStretchBound::bound_m() const {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(covariance_.topLeftCorner<2, 2>());
+  return std::sqrt(ChiSquareQuantile(0.99, 2) * std::max(eig.eigenvalues()[1], 0.0));
+}
+
 void HealthRecord::Add(bool lost) {
   if (lost) {
     ++lost_scans_;

@@ -10,6 +10,7 @@
 // into LostIntervals. docs/estimators.md ("How each estimator judges itself") lists the rules.
 
 #include <Eigen/Core>
+#include <Eigen/Dense>
 #include <cmath>
 #include <deque>
 #include <utility>
@@ -79,10 +80,10 @@ class NisWindow {
   int dimension_sum_ = 0;
 };
 
-/// An estimator whose estimate contradicted its wheels (WheelAgreement) by more than this in
-/// total calls its run diverged: a filter has no loop closure to take such a displacement back,
-/// and it is tens of times a scan match's error.
-inline constexpr double kDivergedContradictionM = 1.0;
+/// An error an estimator can neither rule out nor take back, above which it calls its run
+/// diverged: the filters' displacement against the wheels (WheelAgreement), graph SLAM's bound on
+/// what an unrepaired blind stretch left (BlindStretchBound). Tens of times a scan match's error.
+inline constexpr double kDivergedErrorM = 1.0;
 
 /// Whether an estimate's motion agrees with the wheels' over the last stretch of driving: the
 /// distance the estimate moved along the wheels' direction, summed over the scans of the last
@@ -146,6 +147,25 @@ class WheelAgreement {
 /// ScanInformation, normals from neighbours within 0.3 m), over the strongest direction's: about
 /// 1 in a room, near 0 along a corridor's axis; 0 for a scan without geometry or a zero direction.
 double Observability(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& direction);
+
+/// The error a stretch placed by the odometry alone may have left: its pose covariance from the
+/// odometry's noise per increment, compounded from zero at the stretch's start (first-order
+/// SE(2) propagation), and the position's 99 % bound, sqrt(chi2_2(0.99) x the largest
+/// eigenvalue of the position block).
+class BlindStretchBound {
+ public:
+  /// Starts a new stretch at zero error.
+  void Start();
+  /// Adds one increment (robot frame) and its noise: standard deviations of x and y alike, and of
+  /// the yaw.
+  void Add(const Pose2& increment, const Eigen::Vector2d& sigmas);
+  /// The 99 % bound on the position error so far, metres.
+  double bound_m() const;
+
+ private:
+  Eigen::Matrix3d covariance_ = Eigen::Matrix3d::Zero();
+  double heading_ = 0.0;  // from the stretch's start
+};
 
 /// An estimator's per-scan lost flags, counted: the statistics `lost` (losses) and `diverged`.
 class HealthRecord {

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 namespace slamrig::slam {
@@ -275,6 +277,55 @@ TEST(HealthTest, ObservabilityIsLowOnlyAlongACorridorsAxis) {
     flagged = agreement.Add(Pose2(), Pose2(0.3, 0.0, 0.0), Observability(corridor, {1.0, 0.0}));
   }
   EXPECT_TRUE(flagged);
+}
+
+TEST(HealthTest, BlindStretchBoundMatchesTheClosedFormOnAStraightLine) {
+  // N steps of d straight ahead. Translation noise alone: variance N sx^2 along and across.
+  const int n = 40;
+  const double d = 0.25, sx = 0.01, syaw = 0.004;
+  const double q99 = 9.2103403719761836;  // chi-square, 2 dof, 0.99
+  BlindStretchBound bound;
+  bound.Start();
+  for (int i = 0; i < n; ++i) bound.Add(Pose2(d, 0.0, 0.0), {sx, 0.0});
+  EXPECT_NEAR(bound.bound_m(), std::sqrt(q99 * n * sx * sx), 1e-9);
+  // Yaw noise alone: step i's yaw error moves the n - i steps after it across the line.
+  bound.Start();
+  for (int i = 0; i < n; ++i) bound.Add(Pose2(d, 0.0, 0.0), {0.0, syaw});
+  double across = 0.0;
+  for (int i = 1; i <= n; ++i) across += std::pow((n - i) * d * syaw, 2);
+  EXPECT_NEAR(bound.bound_m(), std::sqrt(q99 * across), 1e-9);
+  bound.Start();
+  EXPECT_EQ(bound.bound_m(), 0.0);
+}
+
+TEST(HealthTest, BlindStretchBoundAgreesWithSampledPathsOnACurve) {
+  // A curve of 60 steps; the bound's covariance against 4000 sampled noisy paths.
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  const Pose2 step(0.2, 0.0, 0.03);
+  const Eigen::Vector2d sigmas(0.01, 0.005);
+  BlindStretchBound bound;
+  bound.Start();
+  Pose2 truth;
+  for (int i = 0; i < 60; ++i) {
+    bound.Add(step, sigmas);
+    truth = truth * step;
+  }
+  Eigen::Matrix2d sampled = Eigen::Matrix2d::Zero();
+  const int samples = 4000;
+  for (int k = 0; k < samples; ++k) {
+    Pose2 pose;
+    for (int i = 0; i < 60; ++i) {
+      const double nx = noise(rng), ny = noise(rng), nt = noise(rng);
+      pose = pose * Pose2(step.x() + sigmas.x() * nx, step.y() + sigmas.x() * ny,
+                          step.theta() + sigmas.y() * nt);
+    }
+    const Eigen::Vector2d e = pose.translation() - truth.translation();
+    sampled += e * e.transpose() / samples;
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(sampled);
+  const double sampled_bound = std::sqrt(9.2103403719761836 * eig.eigenvalues()[1]);
+  EXPECT_NEAR(bound.bound_m(), sampled_bound, 0.06 * sampled_bound);
 }
 
 }  // namespace

@@ -98,7 +98,7 @@ std::map<std::string, double> ParticleFilterEstimator::Statistics() const {
 }
 
 bool ParticleFilterEstimator::Diverged() const {
-  return health_.Diverged() || wheels_.contradicted_m() > kDivergedContradictionM;
+  return health_.Diverged() || wheels_.contradicted_m() > kDivergedErrorM;
 }
 
 EstimatorView ParticleFilterEstimator::View() const {

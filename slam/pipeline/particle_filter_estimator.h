@@ -31,7 +31,7 @@ class ParticleFilterEstimator final : public Estimator {
 
  private:
   // Lost at the end or on more than kDivergedLostShare of the scans, or the estimate contradicted
-  // the wheels by more than kDivergedContradictionM in total.
+  // the wheels by more than kDivergedErrorM in total.
   bool Diverged() const;
   static ParticleFilterOptions Seeded(ParticleFilterOptions options, std::uint64_t seed);
 

@@ -127,7 +127,7 @@ std::map<std::string, double> RbpfEstimator::Statistics() const {
 }
 
 bool RbpfEstimator::Diverged() const {
-  return health_.Diverged() || wheels_.contradicted_m() > kDivergedContradictionM;
+  return health_.Diverged() || wheels_.contradicted_m() > kDivergedErrorM;
 }
 
 EstimatorView RbpfEstimator::View() const {

@@ -36,7 +36,7 @@ class RbpfEstimator final : public Estimator {
 
  private:
   // Lost at the end or on more than kDivergedLostShare of the scans, or the estimate contradicted
-  // the wheels by more than kDivergedContradictionM in total.
+  // the wheels by more than kDivergedErrorM in total.
   bool Diverged() const;
   static RbpfOptions Seeded(RbpfOptions options, std::uint64_t seed);
 
