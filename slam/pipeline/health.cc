@@ -5,7 +5,6 @@
 #include <cmath>
 
 #include "slam/eval/chi_square.h"
-#include "slam/pf/solution_remapping.h"
 #include "slam/types/check.h"
 
 namespace slamrig::slam {
@@ -50,17 +49,19 @@ double NisWindow::ratio() const {
   return nis_sum_ / ChiSquareQuantile(kProbability, dimension_sum_);
 }
 
-double Observability(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& direction) {
+MatchConstraints ScanGeometry(const std::vector<Eigen::Vector2d>& points) {
   constexpr double kNeighbourM = 0.3;
+  if (points.empty()) return MatchConstraints{};
+  return DecomposeInformation(ScanInformation(points, SurfaceNormals(points, kNeighbourM)));
+}
+
+double Observability(const MatchConstraints& geometry, const Eigen::Vector2d& direction) {
   const double norm = direction.norm();
-  if (points.empty() || !(norm > 0.0)) return 0.0;
-  const MatchConstraints c =
-      DecomposeInformation(ScanInformation(points, SurfaceNormals(points, kNeighbourM)));
-  const double strongest = c.eigenvalues.y();
-  if (!(strongest > 0.0)) return 0.0;
-  const Eigen::Vector2d along = c.eigenvectors.transpose() * (direction / norm);
-  const double information =
-      along.x() * along.x() * c.eigenvalues.x() + along.y() * along.y() * c.eigenvalues.y();
+  const double strongest = geometry.eigenvalues.y();
+  if (!(norm > 0.0) || !(strongest > 0.0)) return 0.0;
+  const Eigen::Vector2d along = geometry.eigenvectors.transpose() * (direction / norm);
+  const double information = along.x() * along.x() * geometry.eigenvalues.x() +
+                             along.y() * along.y() * geometry.eigenvalues.y();
   return std::clamp(information / strongest, 0.0, 1.0);
 }
 

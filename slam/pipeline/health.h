@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "slam/matching/icp_odometry.h"
+#include "slam/pf/solution_remapping.h"
 #include "slam/pipeline/estimator.h"
 #include "slam/types/pose2.h"
 #include "slam/types/time.h"
@@ -142,11 +143,15 @@ class WheelAgreement {
   double contradicted_m_ = 0.0;    // the closed stretches'
 };
 
-/// How well a scan's own geometry observes translation along `direction` (robot frame): the
-/// point-to-line information along it, the yaw left free (DecomposeInformation of
-/// ScanInformation, normals from neighbours within 0.3 m), over the strongest direction's: about
-/// 1 in a room, near 0 along a corridor's axis; 0 for a scan without geometry or a zero direction.
-double Observability(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& direction);
+/// The translation directions a scan's own geometry constrains (MatchConstraints: the
+/// point-to-line information, ScanInformation with normals from neighbours within 0.3 m, yaw left
+/// free).
+MatchConstraints ScanGeometry(const std::vector<Eigen::Vector2d>& points);
+
+/// How well that geometry observes translation along `direction` (robot frame): the information
+/// along it over the strongest direction's, about 1 in a room, near 0 along a corridor's axis; 0
+/// for a scan without geometry or a zero direction.
+double Observability(const MatchConstraints& geometry, const Eigen::Vector2d& direction);
 
 /// The error a stretch placed by the odometry alone may have left: its pose covariance from the
 /// odometry's noise per increment, compounded from zero at the stretch's start (first-order

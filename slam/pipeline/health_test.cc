@@ -254,27 +254,29 @@ TEST(HealthTest, ObservabilityIsLowOnlyAlongACorridorsAxis) {
   std::vector<Eigen::Vector2d> corridor;
   Wall({-8.0, 1.0}, {8.0, 1.0}, &corridor);
   Wall({8.0, -1.0}, {-8.0, -1.0}, &corridor);
-  EXPECT_LT(Observability(corridor, {1.0, 0.0}), 0.01);
-  EXPECT_NEAR(Observability(corridor, {0.0, -2.0}), 1.0, 1e-9);
+  EXPECT_LT(Observability(ScanGeometry(corridor), {1.0, 0.0}), 0.01);
+  EXPECT_NEAR(Observability(ScanGeometry(corridor), {0.0, -2.0}), 1.0, 1e-9);
   // At 45 degrees to the axis: half the across-axis information.
-  EXPECT_NEAR(Observability(corridor, {1.0, 1.0}), 0.5, 0.01);
+  EXPECT_NEAR(Observability(ScanGeometry(corridor), {1.0, 1.0}), 0.5, 0.01);
   std::vector<Eigen::Vector2d> room;
   Wall({-2.0, -2.0}, {2.0, -2.0}, &room);
   Wall({2.0, -2.0}, {2.0, 2.0}, &room);
   Wall({2.0, 2.0}, {-2.0, 2.0}, &room);
   Wall({-2.0, 2.0}, {-2.0, -2.0}, &room);
-  EXPECT_NEAR(Observability(room, {1.0, 0.0}), 1.0, 0.05);
-  EXPECT_EQ(Observability({}, {1.0, 0.0}), 0.0);
-  EXPECT_EQ(Observability(room, {0.0, 0.0}), 0.0);
+  EXPECT_NEAR(Observability(ScanGeometry(room), {1.0, 0.0}), 1.0, 0.05);
+  EXPECT_EQ(Observability(ScanGeometry({}), {1.0, 0.0}), 0.0);
+  EXPECT_EQ(Observability(ScanGeometry(room), {0.0, 0.0}), 0.0);
   // Scans that observe the motion are not judged: a stopped estimate there is the scan's word.
   WheelAgreement agreement;
   for (int i = 0; i < 20; ++i) {
-    EXPECT_FALSE(agreement.Add(Pose2(), Pose2(0.3, 0.0, 0.0), Observability(room, {1.0, 0.0})));
+    EXPECT_FALSE(agreement.Add(Pose2(), Pose2(0.3, 0.0, 0.0),
+                               Observability(ScanGeometry(room), {1.0, 0.0})));
   }
   EXPECT_DOUBLE_EQ(agreement.ratio(), 1.0);
   bool flagged = false;
   for (int i = 0; i < 20; ++i) {
-    flagged = agreement.Add(Pose2(), Pose2(0.3, 0.0, 0.0), Observability(corridor, {1.0, 0.0}));
+    flagged = agreement.Add(Pose2(), Pose2(0.3, 0.0, 0.0),
+                            Observability(ScanGeometry(corridor), {1.0, 0.0}));
   }
   EXPECT_TRUE(flagged);
 }

@@ -38,12 +38,13 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
     wheels_.Reset();
   }
   // How well the scan sees motion along the wheels' direction: only poorly observed motion is
-  // judged against the wheels.
-  double observability = 0.0;
-  if (judge_wheels_ && !scan.increment.translation().isZero()) {
-    observability = Observability(ScanToBasePoints(scan.scan, filter_.options().points),
-                                  scan.increment.translation());
+  // judged against the wheels. The geometry of the scan of the filter's last update holds until
+  // its next (the filter moves on the odometry alone in between).
+  if (judge_wheels_ && (step.updated || !geometry_seen_)) {
+    geometry_ = ScanGeometry(ScanToBasePoints(scan.scan, filter_.options().points));
+    geometry_seen_ = true;
   }
+  const double observability = Observability(geometry_, scan.increment.translation());
   const bool contradicts = judge_wheels_ && wheels_.Add(previous_estimate_.Between(step.best_pose),
                                                         scan.increment, observability);
   previous_estimate_ = step.best_pose;

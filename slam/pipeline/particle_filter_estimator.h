@@ -47,6 +47,8 @@ class ParticleFilterEstimator final : public Estimator {
   // The estimate's distance against the wheels' (off without the robot's own odometry).
   bool judge_wheels_ = true;
   WheelAgreement wheels_;
+  MatchConstraints geometry_;  // of the last update's scan (ScanGeometry)
+  bool geometry_seen_ = false;
   Pose2 previous_estimate_;
 };
 

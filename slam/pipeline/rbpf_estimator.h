@@ -55,6 +55,8 @@ class RbpfEstimator final : public Estimator {
   // The estimate's distance against the wheels' (off without the robot's own odometry).
   bool judge_wheels_ = true;
   WheelAgreement wheels_;
+  MatchConstraints geometry_;  // of the last update's scan (ScanGeometry)
+  bool geometry_seen_ = false;
   mutable OccupancyGrid map_;
   mutable int map_version_ = -1;  // update count the map was converted at
 };
