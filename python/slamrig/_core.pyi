@@ -114,7 +114,9 @@ class OccupancyGrid:
     def log_odds(self) -> npt.NDArray[np.float32]:
         """(H, W) read-only copy of the cells at the time of the call."""
     def probability(self) -> npt.NDArray[np.float64]: ...
-    def insert_scan(self, scan: LaserScan, world_from_base: Pose2) -> int: ...
+    def insert_scan(self, scan: LaserScan, world_from_base: Pose2,
+                    max_range_m: Optional[float] = None) -> int:
+        """max_range_m, when given, replaces the options' for this scan (a sparse scan's range)."""
 
 class Dataset:
     """A log: records in time order (len, index, iterate; each record views the dataset) and
