@@ -184,8 +184,11 @@ std::vector<Eigen::Array2i> OccupancyGrid::TakeWallFlips() {
 }
 
 Eigen::AlignedBox2d BeamEnds(const LaserScan& scan, const Pose2& world_from_base,
-                             double max_hit_range, double clear_range,
+                             const OccupancyGridOptions& options, std::optional<double> max_range_m,
                              std::vector<std::pair<Eigen::Vector2d, bool>>* ends) {
+  const double max_hit_range =
+      std::min(scan.range_max_m, max_range_m.value_or(options.max_range_m));
+  const double clear_range = std::min(max_hit_range, options.no_return_clear_range_m);
   const Pose2 world_from_laser = world_from_base * scan.base_from_laser;
   const Eigen::Vector2d origin_world = world_from_laser.translation();
   const bool sweeps = scan.Sweeps();
@@ -211,11 +214,8 @@ Eigen::AlignedBox2d BeamEnds(const LaserScan& scan, const Pose2& world_from_base
 int OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_base,
                               std::optional<double> max_range_m) {
   const Eigen::Vector2d origin_world = (world_from_base * scan.base_from_laser).translation();
-  const double max_hit_range =
-      std::min(scan.range_max_m, max_range_m.value_or(options_.max_range_m));
-  const double clear_range = std::min(max_hit_range, options_.no_return_clear_range_m);
   std::vector<std::pair<Eigen::Vector2d, bool>>& ends = beam_ends_;
-  EnsureContains(BeamEnds(scan, world_from_base, max_hit_range, clear_range, &ends));
+  EnsureContains(BeamEnds(scan, world_from_base, options_, max_range_m, &ends));
 
   ++scan_count_;
   const bool once = options_.update_once_per_scan;

@@ -69,6 +69,18 @@ void VisitFields(V& v, OccupancyGridOptions& o) {
 /// Occupancy state of a cell after thresholding its probability.
 enum class CellState : std::int8_t { kUnknown = -1, kFree = 0, kOccupied = 100 };
 
+/// The world end points of `scan`'s beams seen from `world_from_base`, and which are hits, in
+/// beam order into `ends` (cleared first): a return shorter than the hit range (`max_range_m` when
+/// given, else `options.max_range_m`, within the lidar's range_max_m) ends at its range, any other
+/// beam at the clear range (no_return_clear_range_m, within the hit range); beams below the scan's
+/// minimum range, of no length, or not finite are left out. A sweeping scan's beam ends where the
+/// base was at the beam's time (the ray still starts at the laser at the scan's time: the base
+/// moves centimetres in a sweep). Returns the box around the laser and every end.
+/// OccupancyGrid's and TiledGrid's InsertScan both start from it.
+Eigen::AlignedBox2d BeamEnds(const LaserScan& scan, const Pose2& world_from_base,
+                             const OccupancyGridOptions& options, std::optional<double> max_range_m,
+                             std::vector<std::pair<Eigen::Vector2d, bool>>* ends);
+
 /// A 2D log-odds occupancy grid (Thrun, Burgard, Fox, "Probabilistic Robotics", Table 9.1)
 /// that grows to fit the data. Cell (ix, iy) covers
 /// [origin.x + ix*res, origin.x + (ix+1)*res) x [origin.y + iy*res, ...), 0 <= ix < width(),
@@ -78,17 +90,6 @@ enum class CellState : std::int8_t { kUnknown = -1, kFree = 0, kOccupied = 100 }
 /// growing follow the ground the scans covered (a dense array was copied whole at every growth:
 /// docs/studies/large-maps.md). Readers take cells one by one (LogOdds) or a window as a dense
 /// raster (CopyLogOdds).
-/// The world end points of `scan`'s beams seen from `world_from_base`, and which are hits, in
-/// beam order into `ends` (cleared first): a return shorter than `max_hit_range` ends at its range,
-/// any other beam at `clear_range` (beams below the scan's minimum range, of no length, or not
-/// finite are left out); a sweeping scan's beam ends where the base was at the beam's time (the
-/// ray still starts at the laser at the scan's time: the base moves centimetres in a sweep).
-/// Returns the box around the laser and every end. OccupancyGrid's and TiledGrid's InsertScan
-/// both start from it.
-Eigen::AlignedBox2d BeamEnds(const LaserScan& scan, const Pose2& world_from_base,
-                             double max_hit_range, double clear_range,
-                             std::vector<std::pair<Eigen::Vector2d, bool>>* ends);
-
 class OccupancyGrid {
  public:
   /// An empty grid; it takes its size from the first scan.

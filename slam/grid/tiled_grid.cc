@@ -122,14 +122,10 @@ void TiledGrid::Update(const Eigen::Array2i& cell, float delta) {
 int TiledGrid::InsertScan(const LaserScan& scan, const Pose2& world_from_base,
                           std::optional<double> max_range_m) {
   const Eigen::Vector2d origin_world = (world_from_base * scan.base_from_laser).translation();
-  const double max_hit_range =
-      std::min(scan.range_max_m, max_range_m.value_or(options_.max_range_m));
-  const double clear_range = std::min(max_hit_range, options_.no_return_clear_range_m);
   // OccupancyGrid::InsertScan's beams.
   std::vector<std::pair<Eigen::Vector2d, bool>> ends;
   ends.reserve(scan.ranges_m.size());
-  const Eigen::AlignedBox2d bounds =
-      BeamEnds(scan, world_from_base, max_hit_range, clear_range, &ends);
+  const Eigen::AlignedBox2d bounds = BeamEnds(scan, world_from_base, options_, max_range_m, &ends);
   const Eigen::Array2i lo = WorldToCell(bounds.min());
   const Eigen::Array2i hi = WorldToCell(bounds.max());
   EnsureCells(lo, hi);

@@ -50,7 +50,8 @@ Rbpf::Rbpf(const RbpfOptions& options)
 
 void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
                           const std::vector<MatchPoint>& points, const LaserScan& scan,
-                          double weight_exponent, std::uint64_t seed, bool* failed) const {
+                          std::optional<double> map_range_m, double weight_exponent,
+                          std::uint64_t seed, bool* failed) const {
   RandomEngine rng(seed);
   const Pose2 predicted = particle.pose * motion;
   // Not a structured binding: clang 14 (the fuzz build) refuses one captured by a lambda.
@@ -140,7 +141,7 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
   particle.pose = drawn;
   particle.log_weight += weight_exponent * log_eta_weight;
   particle.path_log_likelihood += log_eta;
-  particle.map.InsertScan(scan, drawn, SparseScanRange(scan, options_.points));
+  particle.map.InsertScan(scan, drawn, map_range_m);
   particle.history = std::make_shared<RbpfPoseNode>(drawn, std::move(particle.history));
 }
 
@@ -403,11 +404,13 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
     step.weight_exponent *= total / static_cast<double>(points.size());
   }
   std::vector<char> failed(static_cast<std::size_t>(n), 0);
+  const std::optional<double> map_range_m = SparseScanRange(scan, options_.points);
   auto update_block = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
       const auto k = static_cast<std::size_t>(i);
       bool f = false;
-      UpdateParticle(particles_[k], motion, points, scan, weight_exponent, seeds[k], &f);
+      UpdateParticle(particles_[k], motion, points, scan, map_range_m, weight_exponent, seeds[k],
+                     &f);
       failed[k] = f;
     }
   };

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -91,10 +92,12 @@ class Rbpf {
   const RbpfOptions& options() const { return options_; }
 
  private:
-  /// Moves particle `i` by `motion`, draws its pose from the proposal, updates its map.
+  /// Moves particle `i` by `motion`, draws its pose from the proposal, updates its map (with the
+  /// scan's returns out to `map_range_m` when given: SparseScanRange).
   void UpdateParticle(RbpfParticle& particle, const Pose2& motion,
                       const std::vector<MatchPoint>& points, const LaserScan& scan,
-                      double weight_exponent, std::uint64_t seed, bool* failed) const;
+                      std::optional<double> map_range_m, double weight_exponent, std::uint64_t seed,
+                      bool* failed) const;
   void Resample(const std::vector<double>& weights);
   /// The odometry check: `motion`, or the increment the best particle's wide match gives where
   /// the mixture model finds that more likely (then `*rejected` is set).

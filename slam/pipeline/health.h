@@ -10,7 +10,6 @@
 // into LostIntervals. docs/estimators.md ("How each estimator judges itself") lists the rules.
 
 #include <Eigen/Core>
-#include <Eigen/Dense>
 #include <cmath>
 #include <deque>
 #include <utility>
