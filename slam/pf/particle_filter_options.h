@@ -195,8 +195,12 @@ struct ParticleFilterOptions {
   /// largest keeps each particle's odometry prediction (solution remapping, Zhang et al. 2016),
   /// and the weights do not depend on it: along a corridor's axis the scan says nothing. There
   /// the estimate and the cloud's weighted mean also follow the odometry (the cloud is shifted
-  /// back along the axis after resampling; each particle keeps its own spread). 0 = off.
-  double degeneracy_ratio = 0.05;
+  /// back along the axis after resampling; each particle keeps its own spread). 0 = off. A
+  /// corridor's axis seen only through a few far door frames holds 5-20 % of the strongest
+  /// direction's information, and there the match pulls the estimate back to where the map was
+  /// written from, update after update; 15 % holds it, where a quarter starts to cost the real
+  /// logs (docs/studies/pf-corridor.md).
+  double degeneracy_ratio = 0.15;
   /// Beams meeting their surface at a larger incidence angle (beam to surface normal, the normal
   /// from the neighbouring points) are left out of the weighting and the degeneracy analysis.
   /// pi / 2 (the default) keeps every point: with the degeneracy handling on, dropping grazing
