@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <functional>
 #include <limits>
 #include <numbers>
@@ -25,6 +26,12 @@
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
+namespace {
+
+// chi2 with 3 degrees of freedom: its 99 % quantile.
+constexpr double kChi2Dof3P99 = 11.3449;
+
+}  // namespace
 
 std::vector<std::string> GraphSlamOptions::Validate() const {
   Rules rules;
@@ -157,13 +164,53 @@ void GraphSlam::JoinBackEnd() const {
 void GraphSlam::Finish() {
   JoinBackEnd();
   if (pending_closure_) Optimize();
+  if (options_.loop_drop_strained) DropStrainedClosures();
   CheckOptimality();
   JudgeConsistency();
 }
 
+void GraphSlam::DropStrainedClosures() {
+  while (true) {
+    double worst = kChi2Dof3P99;
+    std::optional<std::size_t> worst_closure;
+    for (std::size_t i = 0; i < closures_.size(); ++i) {
+      const std::size_t e = closure_edges_[i];
+      if (e < switches_.size() && switches_[e] < 0.5) continue;
+      const PoseGraphEdge& edge = graph_.edges()[e];
+      const Eigen::Vector3d error = EdgeError(graph_, edge);
+      const double chi2 = error.dot(edge.information * error);
+      if (chi2 > worst) {
+        worst = chi2;
+        worst_closure = i;
+      }
+    }
+    if (!worst_closure) return;
+    RemoveClosure(*worst_closure);
+    ++counts_.dropped_strained;
+    Optimize();
+  }
+}
+
+void GraphSlam::RemoveClosure(std::size_t i) {
+  const std::size_t removed = closure_edges_[i];
+  PoseGraph rebuilt;
+  for (const PoseGraphVertex& v : graph_.vertices()) rebuilt.AddVertex(v.id, v.pose, v.fixed);
+  std::vector<Eigen::Vector2d> variances;
+  for (std::size_t e = 0; e < graph_.edges().size(); ++e) {
+    if (e == removed) continue;
+    rebuilt.AddEdge(graph_.edges()[e]);
+    variances.push_back(edge_variances_[e]);
+  }
+  graph_ = std::move(rebuilt);
+  edge_variances_ = std::move(variances);
+  closure_edges_.erase(closure_edges_.begin() + static_cast<std::ptrdiff_t>(i));
+  for (std::size_t& e : closure_edges_) e -= e > removed;
+  closures_.erase(closures_.begin() + static_cast<std::ptrdiff_t>(i));
+  --counts_.loop_closures;
+  switches_.clear();
+}
+
 void GraphSlam::JudgeConsistency() {
-  // chi2 with 3 degrees of freedom: its 99 % quantile.
-  constexpr double kChi2Dof3P99 = 11.3449;
   int kept = 0, strained = 0;
   double chi2 = 0.0;
   const std::vector<PoseGraphEdge>& edges = graph_.edges();

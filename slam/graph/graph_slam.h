@@ -50,6 +50,10 @@ struct GraphSlamCounts {
   /// With pairwise consistency: closures that passed their own checks but are outside the
   /// largest pairwise-consistent set (so not in the graph).
   int inconsistent = 0;
+  /// At Finish(): accepted closures taken out because the final optimum left them strained (their
+  /// chi2 above chi2_3's 99 % quantile): the rest of the graph, every other closure included,
+  /// contradicts them; they no longer count as loop closures.
+  int dropped_strained = 0;
   /// After Finish(): whether the final graph's solution is certified globally optimal
   /// (optimality_certificate.h) for the graph with every robust edge weighted by its final
   /// robust-loss weight, and the certificate matrix's smallest eigenvalue (NaN before Finish()
@@ -160,6 +164,11 @@ class GraphSlam {
   void CheckOptimality();
   // The strained edges and the diverged verdict at the current poses, into counts_.
   void JudgeConsistency();
+  // Takes out, one at a time and re-optimising after each, the closure the optimum leaves most
+  // strained, while one is.
+  void DropStrainedClosures();
+  // Takes closure `i` (of closures_) out of the graph.
+  void RemoveClosure(std::size_t i);
 
   GraphSlamOptions options_;
   IcpOdometry odometry_;

@@ -217,17 +217,29 @@ TEST(GraphSlamTest, IdenticalRoomsYieldNoFalseClosure) {
 
 // With the chi2 gate against the graph opened wide, the aliased closures get through on their
 // own without pairwise consistency; with it (the default) they are rejected (room B's closures to
-// room A contradict room B's own closures through the odometry) and the true ones kept.
+// room A contradict room B's own closures through the odometry) and the true ones kept. Without
+// either, the final check still takes them out: the optimum leaves them strained.
 TEST(GraphSlamTest, PairwiseConsistencyRejectsAliasedClosuresWithoutTheGate) {
   GraphSlamOptions options;
   EXPECT_EQ(options.loop_consistency, LoopConsistency::kPairwise);
+  EXPECT_TRUE(options.loop_drop_strained);
   options.loop_chi2_gate = 1e9;
   options.loop_consistency = LoopConsistency::kNone;
+  options.loop_drop_strained = false;
   const IdenticalRoomsRun open = RunIdenticalRooms(options);
   ASSERT_GT(open.score.false_closures, 0);  // the gate was what kept them out
   // The false closures pull room B onto room A against the odometry: the graph says so.
   EXPECT_GT(open.counts.strained_edges, 0);
   EXPECT_TRUE(open.counts.diverged) << open.counts.strained_edges << " strained edges";
+
+  options.loop_drop_strained = true;
+  const IdenticalRoomsRun dropped = RunIdenticalRooms(options);
+  EXPECT_EQ(dropped.score.false_closures, 0);
+  EXPECT_GE(dropped.counts.dropped_strained, open.score.false_closures);
+  EXPECT_GE(dropped.score.recall, 0.8);
+  EXPECT_EQ(dropped.counts.strained_edges, 0);
+  EXPECT_FALSE(dropped.counts.diverged);
+  options.loop_drop_strained = false;
 
   options.loop_consistency = LoopConsistency::kPairwise;
   const IdenticalRoomsRun pairwise = RunIdenticalRooms(options);
