@@ -67,9 +67,10 @@ double Observability(const MatchConstraints& geometry, const Eigen::Vector2d& di
 
 bool WheelAgreement::Add(const Pose2& estimate_increment, const Pose2& wheel_increment,
                          double observability) {
-  if (observability >= kObservable) return false;
   const Eigen::Vector2d wheels = wheel_increment.translation();
   const double wheels_m = wheels.norm();
+  const bool turned = AddTurn(wheels_m, wheel_increment.theta(), estimate_increment.theta());
+  if (observability >= kObservable) return turned;
   // The estimate's own motion along the wheels' direction.
   const double estimate_m =
       wheels_m > 0.0 ? estimate_increment.translation().dot(wheels / wheels_m) : 0.0;
@@ -85,7 +86,7 @@ bool WheelAgreement::Add(const Pose2& estimate_increment, const Pose2& wheel_inc
   const bool flagged = std::abs(ratio() - 1.0) > kTolerance;
   if (!flagged) {
     CloseStretch();
-    return false;
+    return turned;
   }
   // The stretch's displacement: every scan of the window not yet counted (the first flag's whole
   // window, then each new scan).
@@ -99,6 +100,30 @@ bool WheelAgreement::Add(const Pose2& estimate_increment, const Pose2& wheel_inc
   return true;
 }
 
+bool WheelAgreement::AddTurn(double wheels_m, double wheels_rad, double estimate_rad) {
+  turns_.push_back({wheels_m, wheels_rad, estimate_rad});
+  turn_travel_m_ += wheels_m;
+  wheels_rad_ += wheels_rad;
+  wheels_abs_rad_ += std::abs(wheels_rad);
+  estimate_rad_ += estimate_rad;
+  while (turns_.size() > 1 && turn_travel_m_ - turns_.front().wheels_m >= kHeadingWindowM) {
+    const Turn& old = turns_.front();
+    turn_travel_m_ -= old.wheels_m;
+    wheels_rad_ -= old.wheels_rad;
+    wheels_abs_rad_ -= std::abs(old.wheels_rad);
+    estimate_rad_ -= old.estimate_rad;
+    turns_.pop_front();
+  }
+  const double difference = std::abs(turn_difference_rad());
+  if (!(difference > kHeadingToleranceRad + kHeadingSkidShare * wheels_abs_rad_)) return false;
+  heading_contradicted_rad_ = std::max(heading_contradicted_rad_, difference);
+  return true;
+}
+
+double WheelAgreement::turn_difference_rad() const {
+  return turn_travel_m_ >= kHeadingWindowM ? estimate_rad_ - wheels_rad_ : 0.0;
+}
+
 void WheelAgreement::CloseStretch() {
   contradicted_m_ += Persistent() ? std::abs(stretch_m_) : 0.0;
   stretch_m_ = stretch_travel_m_ = 0.0;
@@ -109,10 +134,50 @@ void WheelAgreement::Reset() {
   CloseStretch();
   window_.clear();
   wheels_m_ = estimate_m_ = 0.0;
+  turns_.clear();
+  turn_travel_m_ = wheels_rad_ = wheels_abs_rad_ = estimate_rad_ = 0.0;
 }
 
 double WheelAgreement::ratio() const {
   return wheels_m_ >= kWindowM ? estimate_m_ / wheels_m_ : 1.0;
+}
+
+WheelCheck::WheelCheck(bool enabled, const ScanPointsOptions& points)
+    : enabled_(enabled), points_(points) {}
+
+bool WheelCheck::Judge(const LaserScan& scan, const Pose2& wheel_increment,
+                       const Pose2& estimate_increment, bool updated) {
+  if (!enabled_) return false;
+  if (updated || !geometry_seen_) {
+    geometry_ = ScanGeometry(ScanToBasePoints(scan, points_));
+    geometry_seen_ = true;
+  }
+  // How well the scan sees motion along the wheels' direction: only poorly observed motion is
+  // judged against the wheels.
+  observability_ = Observability(geometry_, wheel_increment.translation());
+  return agreement_.Add(estimate_increment, wheel_increment, observability_);
+}
+
+void WheelCheck::AppendTrace(std::vector<TraceValue>* trace) const {
+  trace->push_back({"wheel_distance_ratio", agreement_.ratio()});
+  trace->push_back({"wheel_turn_difference_rad", agreement_.turn_difference_rad()});
+  trace->push_back({"motion_observability", observability_});
+}
+
+void WheelCheck::AppendStatistics(std::map<std::string, double>* statistics) const {
+  (*statistics)["wheel_contradiction_m"] = agreement_.contradicted_m();
+  (*statistics)["wheel_heading_contradiction_rad"] = agreement_.heading_contradicted_rad();
+}
+
+const std::vector<std::string>& WheelCheck::StatisticNames() {
+  static const std::vector<std::string> names = {"wheel_contradiction_m",
+                                                 "wheel_heading_contradiction_rad"};
+  return names;
+}
+
+bool WheelCheck::Diverged() const {
+  return agreement_.contradicted_m() > kDivergedErrorM ||
+         agreement_.heading_contradicted_rad() > 0.0;
 }
 
 void BlindStretchBound::Start() {

@@ -12,13 +12,17 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <deque>
+#include <map>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "slam/matching/icp_odometry.h"
+#include "slam/matching/scan_points.h"
 #include "slam/pf/solution_remapping.h"
 #include "slam/pipeline/estimator.h"
 #include "slam/types/pose2.h"
+#include "slam/types/records.h"
 #include "slam/types/time.h"
 #include "slam/types/trajectory.h"
 
@@ -99,17 +103,28 @@ inline constexpr double kDivergedErrorM = 1.0;
 /// witness (wheels slip, spin, or log the wrong sign when reversing), and an estimate that
 /// follows it is right to leave the wheels. The window is the last kWindowM of wheel travel over
 /// the judged scans.
+///
+/// The turns are compared too, on every scan and over a longer stretch (kHeadingWindowM of wheel
+/// travel): an estimate that turns more than kHeadingToleranceRad plus kHeadingSkidShare of the
+/// wheels' own turning away from them there (a scan matcher rotating on a few far landmarks while
+/// the robot drives straight) contradicts them by more than the wheels' heading drift on the
+/// straight (degrees per metre) and their skid in turns (the real logs: up to half the turn)
+/// explain, whatever the scans observe.
 class WheelAgreement {
  public:
   static constexpr double kWindowM = 2.0;      ///< metres of wheel travel judged together
   static constexpr double kTolerance = 0.5;    ///< the distance ratio's allowed departure from 1
   static constexpr double kObservable = 0.25;  ///< a scan this observable is not judged
+  static constexpr double kHeadingWindowM = 10.0;  ///< metres of wheel travel whose turns compare
+  static constexpr double kHeadingToleranceRad = 0.7853981633974483;  ///< 45 degrees ...
+  static constexpr double kHeadingSkidShare = 0.5;  ///< ... plus this share of the wheels' turning
 
   /// Adds one scan's increments since the previous scan, both in the robot's frame there: the
   /// estimate's own (an estimator that revises its choice of hypothesis, like an RBPF switching
   /// particles, gives the chosen hypothesis's own motion) and the wheels'. True when the window
-  /// is full and its ratio lies outside the tolerance. `observability`: the scan's along the
-  /// wheels' direction (Observability); at kObservable or above the scan is not judged (false).
+  /// is full and its ratio lies outside the tolerance, or the heading window is full and its
+  /// turns disagree. `observability`: the scan's along the wheels' direction (Observability); at
+  /// kObservable or above its distance is not judged.
   bool Add(const Pose2& estimate_increment, const Pose2& wheel_increment,
            double observability = 0.0);
   /// Forgets the window: after a gap in the odometry or a jump the estimator made on purpose (a
@@ -117,6 +132,11 @@ class WheelAgreement {
   void Reset();
   /// The window's distance ratio (1 while the window is not full).
   double ratio() const;
+  /// The heading window's turn, the estimate's less the wheels' (0 while it is not full), rad.
+  double turn_difference_rad() const;
+  /// The largest turn difference of a flagged heading window so far, in magnitude (0: none). A
+  /// heading lost by that much is not a wheel's error, and no later scan takes it back.
+  double heading_contradicted_rad() const { return heading_contradicted_rad_; }
   /// The estimate's displacement against the wheels over the persistent flagged stretches: per
   /// stretch of consecutive flagged scans, the estimate's distance less the wheels' (from the
   /// window that first flagged it to its last scan), summed in magnitude. A stretch persists when
@@ -132,8 +152,16 @@ class WheelAgreement {
     double wheels_m, estimate_m;
     bool counted;  // in a stretch's displacement
   };
+  struct Turn {
+    double wheels_m, wheels_rad, estimate_rad;
+  };
   bool Persistent() const { return stretch_travel_m_ > kWindowM; }
   void CloseStretch();
+  // Adds one judged scan's turns to the heading window; true when it is flagged.
+  bool AddTurn(double wheels_m, double wheels_rad, double estimate_rad);
+  std::deque<Turn> turns_;  // the heading window
+  double turn_travel_m_ = 0.0, wheels_rad_ = 0.0, wheels_abs_rad_ = 0.0, estimate_rad_ = 0.0;
+  double heading_contradicted_rad_ = 0.0;
   std::deque<Step> window_;
   double wheels_m_ = 0.0, estimate_m_ = 0.0;
   bool in_stretch_ = false;
@@ -151,6 +179,40 @@ MatchConstraints ScanGeometry(const std::vector<Eigen::Vector2d>& points);
 /// along it over the strongest direction's, about 1 in a room, near 0 along a corridor's axis; 0
 /// for a scan without geometry or a zero direction.
 double Observability(const MatchConstraints& geometry, const Eigen::Vector2d& direction);
+
+/// A filter's check of its estimate against the wheels (WheelAgreement), with the scan geometry
+/// it judges by: that of the scan of the filter's last update, which holds until its next (the
+/// filter moves on the odometry alone in between). Off without the robot's own odometry.
+class WheelCheck {
+ public:
+  /// `points`: how the filter turns a scan into points (its geometry is judged from them).
+  WheelCheck(bool enabled, const ScanPointsOptions& points);
+
+  /// Judges one scan: the wheels' increment since the previous scan, the estimate's own, and
+  /// whether the filter updated on this scan. True when the estimate contradicts the wheels.
+  bool Judge(const LaserScan& scan, const Pose2& wheel_increment, const Pose2& estimate_increment,
+             bool updated);
+  /// Forgets the motion so far (WheelAgreement::Reset): after a gap in the odometry or a jump the
+  /// filter made on purpose.
+  void Reset() { agreement_.Reset(); }
+  /// The last scan's health values: wheel_distance_ratio, wheel_turn_difference_rad,
+  /// motion_observability.
+  void AppendTrace(std::vector<TraceValue>* trace) const;
+  /// The statistics wheel_contradiction_m and wheel_heading_contradiction_rad.
+  void AppendStatistics(std::map<std::string, double>* statistics) const;
+  static const std::vector<std::string>& StatisticNames();
+  /// The estimate contradicted the wheels by more than kDivergedErrorM in distance, or lost its
+  /// heading against them (WheelAgreement::heading_contradicted_rad).
+  bool Diverged() const;
+
+ private:
+  bool enabled_;
+  ScanPointsOptions points_;
+  WheelAgreement agreement_;
+  MatchConstraints geometry_;
+  bool geometry_seen_ = false;
+  double observability_ = 0.0;
+};
 
 /// The error a stretch placed by the odometry alone may have left: its pose covariance from the
 /// odometry's noise per increment, compounded from zero at the stretch's start (first-order

@@ -244,6 +244,52 @@ TEST(HealthTest, WheelAgreementFlagsAnEstimateThatStopsOrRaces) {
   EXPECT_DOUBLE_EQ(agreement.ratio(), 1.0);
 }
 
+TEST(HealthTest, WheelAgreementComparesTurnsBeyondTheWheelsDriftAndSkid) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  // An estimate that follows the robot while the wheels drift up to 4 degrees per metre on the
+  // straight (40 over the window) and skid by up to 45 % of every turn (fast turns, 1 rad per
+  // metre): never flagged.
+  for (int trial = 0; trial < 200; ++trial) {
+    WheelAgreement agreement;
+    const double drift_rad_per_m = (2.0 * unit(rng) - 1.0) * 0.07;
+    const double skid = 1.0 + (2.0 * unit(rng) - 1.0) * 0.45;
+    const double curvature = (trial % 4) * 0.33;  // rad per metre
+    for (int i = 0; i < 300; ++i) {
+      const double step_m = 0.1 + 0.2 * unit(rng);
+      const double turn = (i / 20 % 2 == 0 ? 1.0 : -1.0) * curvature * step_m;
+      const Pose2 wheels(step_m, 0.0, turn * skid + drift_rad_per_m * step_m);
+      ASSERT_FALSE(agreement.Add(Pose2(step_m, 0.0, turn), wheels)) << trial << " " << i;
+    }
+    EXPECT_EQ(agreement.heading_contradicted_rad(), 0.0);
+  }
+  // An estimate that turns 13 degrees per metre while the robot drives straight (steps of 0.25 m,
+  // exact in binary): flagged once the heading window is full, holding 130 degrees of it, until
+  // the window has left the stretch.
+  WheelAgreement agreement;
+  const double rate = 13.0 * M_PI / 180.0;
+  int first = -1;
+  for (int i = 0; i < 48; ++i) {  // 12 m
+    if (agreement.Add(Pose2(0.25, 0.0, rate * 0.25), Pose2(0.25, 0.0, 0.0)) && first < 0) {
+      first = i;
+    }
+  }
+  EXPECT_EQ(first, 39);  // 10 m
+  EXPECT_NEAR(agreement.turn_difference_rad(), rate * 10.0, 1e-9);
+  bool flagged = true;
+  int cleared = -1;
+  for (int i = 0; i < 60 && cleared < 0; ++i) {
+    flagged = agreement.Add(Pose2(0.25, 0.0, 0.0), Pose2(0.25, 0.0, 0.0));
+    if (!flagged) cleared = i;
+  }
+  // 45 degrees is 3.46 m of the stretch: 3.5 m of it are left in the window after 26 straight
+  // steps (45.5 degrees, flagged), 3.25 m after 27 (cleared).
+  EXPECT_EQ(cleared, 26);
+  EXPECT_NEAR(agreement.heading_contradicted_rad(), rate * 10.0, 1e-9);
+  // The distance was right throughout: no distance contradiction.
+  EXPECT_EQ(agreement.contradicted_m(), 0.0);
+}
+
 // Points every 5 cm along the segment from a to b.
 void Wall(const Eigen::Vector2d& a, const Eigen::Vector2d& b, std::vector<Eigen::Vector2d>* out) {
   const int n = static_cast<int>((b - a).norm() / 0.05);

@@ -14,7 +14,8 @@ ParticleFilterOptions ParticleFilterEstimator::Seeded(ParticleFilterOptions opti
 
 ParticleFilterEstimator::ParticleFilterEstimator(const ParticleFilterOptions& options,
                                                  const EstimatorContext& context)
-    : filter_(Seeded(options, context.seed)), judge_wheels_(context.own_odometry) {}
+    : filter_(Seeded(options, context.seed)),
+      wheels_(context.own_odometry, filter_.options().points) {}
 
 ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
   const ParticleFilterStep step = filter_.AddScan(scan.scan, scan.increment, scan.odometry_gap_s);
@@ -37,27 +38,17 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
       scan.odometry_gap_s > filter_.options().relocalisation.odometry_gap_s) {
     wheels_.Reset();
   }
-  // How well the scan sees motion along the wheels' direction: only poorly observed motion is
-  // judged against the wheels. The geometry of the scan of the filter's last update holds until
-  // its next (the filter moves on the odometry alone in between).
-  if (judge_wheels_ && (step.updated || !geometry_seen_)) {
-    geometry_ = ScanGeometry(ScanToBasePoints(scan.scan, filter_.options().points));
-    geometry_seen_ = true;
-  }
-  const double observability = Observability(geometry_, scan.increment.translation());
-  const bool contradicts = judge_wheels_ && wheels_.Add(previous_estimate_.Between(step.best_pose),
-                                                        scan.increment, observability);
+  const bool contradicts = wheels_.Judge(scan.scan, scan.increment,
+                                         previous_estimate_.Between(step.best_pose), step.updated);
   previous_estimate_ = step.best_pose;
   const bool lost = step.lost || contradicts;
   ScanEstimate estimate{step.best_pose,
                         step.mean_pose,
-                        {{"neff", step.neff},
-                         {"match_quality", step.quality},
-                         {"wheel_distance_ratio", wheels_.ratio()},
-                         {"motion_observability", observability},
-                         {"lost", lost ? 1.0 : 0.0}},
+                        {{"neff", step.neff}, {"match_quality", step.quality}},
                         std::nullopt,
                         lost};
+  wheels_.AppendTrace(&estimate.trace);
+  estimate.trace.push_back({"lost", lost ? 1.0 : 0.0});
   health_.Add(lost);
   if (filter_.options().adaptive_sigma.enabled) {
     estimate.trace.push_back({"field_sigma_m", filter_.field_sigma_m()});
@@ -66,41 +57,36 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
 }
 
 const std::vector<std::string>& ParticleFilterEstimator::StatisticNames() {
-  static const std::vector<std::string> names = {"mean_neff",
-                                                 "resamples",
-                                                 "updates",
-                                                 "lost",
-                                                 "relocalisations",
-                                                 "resumed",
-                                                 "lost_at_s",
-                                                 "relocalised_at_s",
-                                                 "field_sigma_m",
-                                                 "wall_distance_m",
-                                                 "diverged",
-                                                 "gap_corrections",
-                                                 "wheel_contradiction_m"};
-  return names;
+  static const std::vector<std::string> names = {
+      "mean_neff",       "resamples",       "updates",   "lost",
+      "relocalisations", "resumed",         "lost_at_s", "relocalised_at_s",
+      "field_sigma_m",   "wall_distance_m", "diverged",  "gap_corrections"};
+  static const std::vector<std::string> all = [] {
+    std::vector<std::string> v = names;
+    for (const std::string& name : WheelCheck::StatisticNames()) v.push_back(name);
+    return v;
+  }();
+  return all;
 }
 
 std::map<std::string, double> ParticleFilterEstimator::Statistics() const {
-  return {{"mean_neff", scans_ > 0 ? neff_sum_ / scans_ : 0.0},
-          {"resamples", filter_.resample_count()},
-          {"updates", updates_},
-          {"lost", filter_.lost_count()},
-          {"relocalisations", filter_.relocalisation_count()},
-          {"resumed", filter_.resumed_count()},
-          {"lost_at_s", lost_at_s_},
-          {"gap_corrections", filter_.gap_correction_count()},
-          {"relocalised_at_s", relocalised_at_s_},
-          {"field_sigma_m", filter_.field_sigma_m()},
-          {"wall_distance_m", filter_.wall_distance_m()},
-          {"wheel_contradiction_m", wheels_.contradicted_m()},
-          {"diverged", Diverged() ? 1.0 : 0.0}};
+  std::map<std::string, double> statistics = {{"mean_neff", scans_ > 0 ? neff_sum_ / scans_ : 0.0},
+                                              {"resamples", filter_.resample_count()},
+                                              {"updates", updates_},
+                                              {"lost", filter_.lost_count()},
+                                              {"relocalisations", filter_.relocalisation_count()},
+                                              {"resumed", filter_.resumed_count()},
+                                              {"lost_at_s", lost_at_s_},
+                                              {"gap_corrections", filter_.gap_correction_count()},
+                                              {"relocalised_at_s", relocalised_at_s_},
+                                              {"field_sigma_m", filter_.field_sigma_m()},
+                                              {"wall_distance_m", filter_.wall_distance_m()},
+                                              {"diverged", Diverged() ? 1.0 : 0.0}};
+  wheels_.AppendStatistics(&statistics);
+  return statistics;
 }
 
-bool ParticleFilterEstimator::Diverged() const {
-  return health_.Diverged() || wheels_.contradicted_m() > kDivergedErrorM;
-}
+bool ParticleFilterEstimator::Diverged() const { return health_.Diverged() || wheels_.Diverged(); }
 
 EstimatorView ParticleFilterEstimator::View() const {
   EstimatorView view;

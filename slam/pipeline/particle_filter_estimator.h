@@ -31,7 +31,7 @@ class ParticleFilterEstimator final : public Estimator {
 
  private:
   // Lost at the end or on more than kDivergedLostShare of the scans, or the estimate contradicted
-  // the wheels by more than kDivergedErrorM in total.
+  // the wheels (WheelCheck::Diverged).
   bool Diverged() const;
   static ParticleFilterOptions Seeded(ParticleFilterOptions options, std::uint64_t seed);
 
@@ -44,11 +44,7 @@ class ParticleFilterEstimator final : public Estimator {
   double lost_at_s_ = NAN;
   double relocalised_at_s_ = NAN;
   HealthRecord health_;
-  // The estimate's distance against the wheels' (off without the robot's own odometry).
-  bool judge_wheels_ = true;
-  WheelAgreement wheels_;
-  MatchConstraints geometry_;  // of the last update's scan (ScanGeometry)
-  bool geometry_seen_ = false;
+  WheelCheck wheels_;
   Pose2 previous_estimate_;
 };
 

@@ -16,7 +16,7 @@ RbpfOptions RbpfEstimator::Seeded(RbpfOptions options, std::uint64_t seed) {
 
 RbpfEstimator::RbpfEstimator(const RbpfOptions& options, const EstimatorContext& context)
     : filter_(Seeded(options, context.seed)),
-      judge_wheels_(context.own_odometry),
+      wheels_(context.own_odometry, filter_.options().points),
       map_(options.map) {}
 
 ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
@@ -44,16 +44,8 @@ ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
   if (step.odometry_rejected || scan.odometry_gap_s > filter_.options().odometry_gap_s) {
     wheels_.Reset();
   }
-  // How well the scan sees motion along the wheels' direction: only poorly observed motion is
-  // judged against the wheels. The geometry of the scan of the filter's last update holds until
-  // its next (the filter moves on the odometry alone in between).
-  if (judge_wheels_ && (step.updated || !geometry_seen_)) {
-    geometry_ = ScanGeometry(ScanToBasePoints(scan.scan, filter_.options().points));
-    geometry_seen_ = true;
-  }
-  const double observability = Observability(geometry_, scan.increment.translation());
   const bool contradicts =
-      judge_wheels_ && wheels_.Add(estimate_increment, scan.increment, observability);
+      wheels_.Judge(scan.scan, scan.increment, estimate_increment, step.updated);
   health_.Add(lost_ || contradicts);
   const double particles =
       static_cast<double>(std::max<std::size_t>(filter_.particles().size(), 1));
@@ -63,11 +55,10 @@ ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
                          {"neff_ratio", step.neff / particles},
                          {"matched_fraction", step.matched_fraction},
                          {"matched_fraction_ratio", matched_ratio_.ratio()},
-                         {"failed_match_share", step.failed_matches / particles},
-                         {"wheel_distance_ratio", wheels_.ratio()},
-                         {"motion_observability", observability}},
+                         {"failed_match_share", step.failed_matches / particles}},
                         std::nullopt,
                         lost_ || contradicts};
+  wheels_.AppendTrace(&estimate.trace);
   return estimate;
 }
 
@@ -102,34 +93,38 @@ const std::vector<std::string>& RbpfEstimator::StatisticNames() {
                                                  "map_tiles",
                                                  "map_tiles_per_particle",
                                                  "lost",
-                                                 "diverged",
-                                                 "wheel_contradiction_m"};
-  return names;
+                                                 "diverged"};
+  static const std::vector<std::string> all = [] {
+    std::vector<std::string> v = names;
+    for (const std::string& name : WheelCheck::StatisticNames()) v.push_back(name);
+    return v;
+  }();
+  return all;
 }
 
 std::map<std::string, double> RbpfEstimator::Statistics() const {
   const int scans = static_cast<int>(scan_offsets_.size());
   const int tiles = filter_.particles().empty() ? 0 : filter_.DistinctTiles();
-  return {{"mean_neff", scans > 0 ? neff_sum_ / scans : 0.0},
-          {"resamples", filter_.resample_count()},
-          {"updates", updates_},
-          {"failed_matches", failed_matches_},
-          {"odometry_rejections", filter_.odometry_rejections()},
-          {"gap_corrections", filter_.gap_corrections()},
-          {"mean_weight_exponent", updates_ > 0 ? exponent_sum_ / updates_ : 0.0},
-          {"map_tiles", tiles},
-          {"map_tiles_per_particle",
-           filter_.particles().empty()
-               ? 0.0
-               : static_cast<double>(tiles) / static_cast<double>(filter_.particles().size())},
-          {"lost", health_.losses()},
-          {"wheel_contradiction_m", wheels_.contradicted_m()},
-          {"diverged", Diverged() ? 1.0 : 0.0}};
+  std::map<std::string, double> statistics = {
+      {"mean_neff", scans > 0 ? neff_sum_ / scans : 0.0},
+      {"resamples", filter_.resample_count()},
+      {"updates", updates_},
+      {"failed_matches", failed_matches_},
+      {"odometry_rejections", filter_.odometry_rejections()},
+      {"gap_corrections", filter_.gap_corrections()},
+      {"mean_weight_exponent", updates_ > 0 ? exponent_sum_ / updates_ : 0.0},
+      {"map_tiles", tiles},
+      {"map_tiles_per_particle",
+       filter_.particles().empty()
+           ? 0.0
+           : static_cast<double>(tiles) / static_cast<double>(filter_.particles().size())},
+      {"lost", health_.losses()},
+      {"diverged", Diverged() ? 1.0 : 0.0}};
+  wheels_.AppendStatistics(&statistics);
+  return statistics;
 }
 
-bool RbpfEstimator::Diverged() const {
-  return health_.Diverged() || wheels_.contradicted_m() > kDivergedErrorM;
-}
+bool RbpfEstimator::Diverged() const { return health_.Diverged() || wheels_.Diverged(); }
 
 EstimatorView RbpfEstimator::View() const {
   EstimatorView view;

@@ -36,7 +36,7 @@ class RbpfEstimator final : public Estimator {
 
  private:
   // Lost at the end or on more than kDivergedLostShare of the scans, or the estimate contradicted
-  // the wheels by more than kDivergedErrorM in total.
+  // the wheels (WheelCheck::Diverged).
   bool Diverged() const;
   static RbpfOptions Seeded(RbpfOptions options, std::uint64_t seed);
 
@@ -52,11 +52,7 @@ class RbpfEstimator final : public Estimator {
   QualityRatio matched_ratio_{0.3, 0.02, 20, 0.5};
   bool lost_ = false;  // at the last update; held between updates
   HealthRecord health_;
-  // The estimate's distance against the wheels' (off without the robot's own odometry).
-  bool judge_wheels_ = true;
-  WheelAgreement wheels_;
-  MatchConstraints geometry_;  // of the last update's scan (ScanGeometry)
-  bool geometry_seen_ = false;
+  WheelCheck wheels_;
   mutable OccupancyGrid map_;
   mutable int map_version_ = -1;  // update count the map was converted at
 };
