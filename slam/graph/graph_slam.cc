@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <functional>
 #include <limits>
 #include <numbers>
@@ -30,6 +29,12 @@ namespace {
 
 // chi2 with 3 degrees of freedom: its 99 % quantile.
 constexpr double kChi2Dof3P99 = 11.3449;
+
+// An edge's chi2 at the graph's current poses.
+double EdgeChi2(const PoseGraph& graph, const PoseGraphEdge& edge) {
+  const Eigen::Vector3d error = EdgeError(graph, edge);
+  return error.dot(edge.information * error);
+}
 
 }  // namespace
 
@@ -175,10 +180,8 @@ void GraphSlam::DropStrainedClosures() {
     std::optional<std::size_t> worst_closure;
     for (std::size_t i = 0; i < closures_.size(); ++i) {
       const std::size_t e = closure_edges_[i];
-      if (e < switches_.size() && switches_[e] < 0.5) continue;
-      const PoseGraphEdge& edge = graph_.edges()[e];
-      const Eigen::Vector3d error = EdgeError(graph_, edge);
-      const double chi2 = error.dot(edge.information * error);
+      if (SwitchedOff(e)) continue;
+      const double chi2 = EdgeChi2(graph_, graph_.edges()[e]);
       if (chi2 > worst) {
         worst = chi2;
         worst_closure = i;
@@ -191,23 +194,31 @@ void GraphSlam::DropStrainedClosures() {
   }
 }
 
-void GraphSlam::RemoveClosure(std::size_t i) {
-  const std::size_t removed = closure_edges_[i];
+void GraphSlam::KeepEdges(const std::function<bool(std::size_t)>& keep) {
   PoseGraph rebuilt;
   for (const PoseGraphVertex& v : graph_.vertices()) rebuilt.AddVertex(v.id, v.pose, v.fixed);
   std::vector<Eigen::Vector2d> variances;
   for (std::size_t e = 0; e < graph_.edges().size(); ++e) {
-    if (e == removed) continue;
+    if (!keep(e)) continue;
     rebuilt.AddEdge(graph_.edges()[e]);
     variances.push_back(edge_variances_[e]);
   }
   graph_ = std::move(rebuilt);
   edge_variances_ = std::move(variances);
+  switches_.clear();
+}
+
+bool GraphSlam::SwitchedOff(std::size_t e) const {
+  return e < switches_.size() && switches_[e] < 0.5;
+}
+
+void GraphSlam::RemoveClosure(std::size_t i) {
+  const std::size_t removed = closure_edges_[i];
+  KeepEdges([removed](std::size_t e) { return e != removed; });
   closure_edges_.erase(closure_edges_.begin() + static_cast<std::ptrdiff_t>(i));
   for (std::size_t& e : closure_edges_) e -= e > removed;
   closures_.erase(closures_.begin() + static_cast<std::ptrdiff_t>(i));
   --counts_.loop_closures;
-  switches_.clear();
 }
 
 void GraphSlam::JudgeConsistency() {
@@ -216,10 +227,9 @@ void GraphSlam::JudgeConsistency() {
   const std::vector<PoseGraphEdge>& edges = graph_.edges();
   strained_.assign(edges.size(), false);
   for (std::size_t e = 0; e < edges.size(); ++e) {
-    if (e < switches_.size() && switches_[e] < 0.5) continue;  // the back end switched it off
-    const Eigen::Vector3d error = EdgeError(graph_, edges[e]);
+    if (SwitchedOff(e)) continue;
     ++kept;
-    const double edge_chi2 = error.dot(edges[e].information * error);
+    const double edge_chi2 = EdgeChi2(graph_, edges[e]);
     chi2 += edge_chi2;
     strained_[e] = edge_chi2 > kChi2Dof3P99;
     strained += strained_[e];
@@ -257,7 +267,7 @@ std::vector<LoopClosure> GraphSlam::loop_closures() const {
   std::vector<LoopClosure> kept;
   for (std::size_t i = 0; i < closures_.size(); ++i) {
     const std::size_t e = closure_edges_[i];
-    if (e < switches_.size() && switches_[e] < 0.5) continue;
+    if (SwitchedOff(e)) continue;
     kept.push_back(closures_[i]);
   }
   return kept;
@@ -268,7 +278,7 @@ std::vector<LoopClosure> GraphSlam::UnstrainedLoopClosures() const {
   std::vector<LoopClosure> agreed;
   for (std::size_t i = 0; i < closures_.size(); ++i) {
     const std::size_t e = closure_edges_[i];
-    if (e < switches_.size() && switches_[e] < 0.5) continue;
+    if (SwitchedOff(e)) continue;
     if (e < strained_.size() && strained_[e]) continue;
     agreed.push_back(closures_[i]);
   }
@@ -506,19 +516,9 @@ void GraphSlam::AcceptClosure(const PoseGraphEdge& edge, const LoopClosure& clos
   }
   // The consistent set changed: the graph keeps its vertices (at their current estimates) and
   // odometry edges, and takes the kept closures in place of the ones it had.
-  PoseGraph rebuilt;
-  for (const PoseGraphVertex& v : graph_.vertices()) rebuilt.AddVertex(v.id, v.pose, v.fixed);
-  std::vector<Eigen::Vector2d> variances;
-  for (std::size_t e = 0; e < graph_.edges().size(); ++e) {
-    if (graph_.edges()[e].kind == EdgeKind::kLoopClosure) continue;
-    rebuilt.AddEdge(graph_.edges()[e]);
-    variances.push_back(edge_variances_[e]);
-  }
-  graph_ = std::move(rebuilt);
-  edge_variances_ = std::move(variances);
+  KeepEdges([this](std::size_t e) { return graph_.edges()[e].kind != EdgeKind::kLoopClosure; });
   closure_edges_.clear();
   closures_.clear();
-  switches_.clear();
   counts_.loop_closures = 0;
   for (const int k : kept) AddClosureEdge(hypothesis_edges_[k], hypothesis_closures_[k]);
   // At once: the estimate still bends to the closures just dropped, and the loop search reads it.
@@ -618,7 +618,7 @@ void GraphSlam::Optimize() {
   switches_ = summary.switches;
   counts_.switched_off = 0;
   for (const std::size_t e : closure_edges_) {
-    counts_.switched_off += e < switches_.size() && switches_[e] < 0.5;
+    counts_.switched_off += SwitchedOff(e);
   }
   ++counts_.optimizations;
   pending_closure_ = false;

@@ -11,6 +11,7 @@
 // Kümmerle et al. 2011) and a robust loss on loop closures.
 
 #include <Eigen/Core>
+#include <functional>
 #include <limits>
 #include <map>
 #include <optional>
@@ -169,6 +170,11 @@ class GraphSlam {
   void DropStrainedClosures();
   // Takes closure `i` (of closures_) out of the graph.
   void RemoveClosure(std::size_t i);
+  // Rebuilds the graph with its vertices (at their current estimates) and the edges `keep`
+  // accepts (by index), their variances with them; the switches are forgotten.
+  void KeepEdges(const std::function<bool(std::size_t)>& keep);
+  // Whether the last optimisation switched edge `e` off (below 0.5).
+  bool SwitchedOff(std::size_t e) const;
 
   GraphSlamOptions options_;
   IcpOdometry odometry_;

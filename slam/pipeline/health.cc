@@ -169,9 +169,9 @@ void WheelCheck::AppendStatistics(std::map<std::string, double>* statistics) con
   (*statistics)["wheel_heading_contradiction_rad"] = agreement_.heading_contradicted_rad();
 }
 
-const std::vector<std::string>& WheelCheck::StatisticNames() {
-  static const std::vector<std::string> names = {"wheel_contradiction_m",
-                                                 "wheel_heading_contradiction_rad"};
+std::vector<std::string> WheelCheck::WithStatisticNames(std::vector<std::string> names) {
+  names.push_back("wheel_contradiction_m");
+  names.push_back("wheel_heading_contradiction_rad");
   return names;
 }
 

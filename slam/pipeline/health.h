@@ -157,7 +157,7 @@ class WheelAgreement {
   };
   bool Persistent() const { return stretch_travel_m_ > kWindowM; }
   void CloseStretch();
-  // Adds one judged scan's turns to the heading window; true when it is flagged.
+  // Adds one scan's turns to the heading window; true when it is flagged.
   bool AddTurn(double wheels_m, double wheels_rad, double estimate_rad);
   std::deque<Turn> turns_;  // the heading window
   double turn_travel_m_ = 0.0, wheels_rad_ = 0.0, wheels_abs_rad_ = 0.0, estimate_rad_ = 0.0;
@@ -200,7 +200,8 @@ class WheelCheck {
   void AppendTrace(std::vector<TraceValue>* trace) const;
   /// The statistics wheel_contradiction_m and wheel_heading_contradiction_rad.
   void AppendStatistics(std::map<std::string, double>* statistics) const;
-  static const std::vector<std::string>& StatisticNames();
+  /// `names` with those statistics' names after them: an estimator's StatisticNames().
+  static std::vector<std::string> WithStatisticNames(std::vector<std::string> names);
   /// The estimate contradicted the wheels by more than kDivergedErrorM in distance, or lost its
   /// heading against them (WheelAgreement::heading_contradicted_rad).
   bool Diverged() const;

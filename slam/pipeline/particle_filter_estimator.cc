@@ -57,16 +57,10 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
 }
 
 const std::vector<std::string>& ParticleFilterEstimator::StatisticNames() {
-  static const std::vector<std::string> names = {
-      "mean_neff",       "resamples",       "updates",   "lost",
-      "relocalisations", "resumed",         "lost_at_s", "relocalised_at_s",
-      "field_sigma_m",   "wall_distance_m", "diverged",  "gap_corrections"};
-  static const std::vector<std::string> all = [] {
-    std::vector<std::string> v = names;
-    for (const std::string& name : WheelCheck::StatisticNames()) v.push_back(name);
-    return v;
-  }();
-  return all;
+  static const std::vector<std::string> names = WheelCheck::WithStatisticNames(
+      {"mean_neff", "resamples", "updates", "lost", "relocalisations", "resumed", "lost_at_s",
+       "relocalised_at_s", "field_sigma_m", "wall_distance_m", "diverged", "gap_corrections"});
+  return names;
 }
 
 std::map<std::string, double> ParticleFilterEstimator::Statistics() const {

@@ -83,23 +83,11 @@ const OccupancyGrid& RbpfEstimator::map() const {
 }
 
 const std::vector<std::string>& RbpfEstimator::StatisticNames() {
-  static const std::vector<std::string> names = {"mean_neff",
-                                                 "resamples",
-                                                 "updates",
-                                                 "failed_matches",
-                                                 "odometry_rejections",
-                                                 "gap_corrections",
-                                                 "mean_weight_exponent",
-                                                 "map_tiles",
-                                                 "map_tiles_per_particle",
-                                                 "lost",
-                                                 "diverged"};
-  static const std::vector<std::string> all = [] {
-    std::vector<std::string> v = names;
-    for (const std::string& name : WheelCheck::StatisticNames()) v.push_back(name);
-    return v;
-  }();
-  return all;
+  static const std::vector<std::string> names = WheelCheck::WithStatisticNames(
+      {"mean_neff", "resamples", "updates", "failed_matches", "odometry_rejections",
+       "gap_corrections", "mean_weight_exponent", "map_tiles", "map_tiles_per_particle", "lost",
+       "diverged"});
+  return names;
 }
 
 std::map<std::string, double> RbpfEstimator::Statistics() const {
