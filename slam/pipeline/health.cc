@@ -101,27 +101,47 @@ bool WheelAgreement::Add(const Pose2& estimate_increment, const Pose2& wheel_inc
 }
 
 bool WheelAgreement::AddTurn(double wheels_m, double wheels_rad, double estimate_rad) {
-  turns_.push_back({wheels_m, wheels_rad, estimate_rad});
-  turn_travel_m_ += wheels_m;
-  wheels_rad_ += wheels_rad;
-  wheels_abs_rad_ += std::abs(wheels_rad);
-  estimate_rad_ += estimate_rad;
-  while (turns_.size() > 1 && turn_travel_m_ - turns_.front().wheels_m >= kHeadingWindowM) {
+  turns_.Add({wheels_m, wheels_rad, estimate_rad});
+  long_turns_.Add({wheels_m, wheels_rad, estimate_rad});
+  bool flagged = false;
+  for (const TurnWindow* window : {&turns_, &long_turns_}) {
+    if (!window->Contradicted()) continue;
+    flagged = true;
+    heading_contradicted_rad_ =
+        std::max(heading_contradicted_rad_, std::abs(window->difference_rad()));
+  }
+  return flagged;
+}
+
+double WheelAgreement::turn_difference_rad() const { return turns_.difference_rad(); }
+
+void WheelAgreement::TurnWindow::Add(const Turn& turn) {
+  turns_.push_back(turn);
+  travel_m_ += turn.wheels_m;
+  wheels_rad_ += turn.wheels_rad;
+  wheels_abs_rad_ += std::abs(turn.wheels_rad);
+  estimate_rad_ += turn.estimate_rad;
+  while (turns_.size() > 1 && travel_m_ - turns_.front().wheels_m >= length_m_) {
     const Turn& old = turns_.front();
-    turn_travel_m_ -= old.wheels_m;
+    travel_m_ -= old.wheels_m;
     wheels_rad_ -= old.wheels_rad;
     wheels_abs_rad_ -= std::abs(old.wheels_rad);
     estimate_rad_ -= old.estimate_rad;
     turns_.pop_front();
   }
-  const double difference = std::abs(turn_difference_rad());
-  if (!(difference > kHeadingToleranceRad + kHeadingSkidShare * wheels_abs_rad_)) return false;
-  heading_contradicted_rad_ = std::max(heading_contradicted_rad_, difference);
-  return true;
 }
 
-double WheelAgreement::turn_difference_rad() const {
-  return turn_travel_m_ >= kHeadingWindowM ? estimate_rad_ - wheels_rad_ : 0.0;
+void WheelAgreement::TurnWindow::Clear() {
+  turns_.clear();
+  travel_m_ = wheels_rad_ = wheels_abs_rad_ = estimate_rad_ = 0.0;
+}
+
+double WheelAgreement::TurnWindow::difference_rad() const {
+  return travel_m_ >= kHeadingWindowM ? estimate_rad_ - wheels_rad_ : 0.0;
+}
+
+bool WheelAgreement::TurnWindow::Contradicted() const {
+  return std::abs(difference_rad()) > kHeadingToleranceRad + kHeadingSkidShare * wheels_abs_rad_;
 }
 
 void WheelAgreement::CloseStretch() {
@@ -134,8 +154,8 @@ void WheelAgreement::Reset() {
   CloseStretch();
   window_.clear();
   wheels_m_ = estimate_m_ = 0.0;
-  turns_.clear();
-  turn_travel_m_ = wheels_rad_ = wheels_abs_rad_ = estimate_rad_ = 0.0;
+  turns_.Clear();
+  long_turns_.Clear();
 }
 
 double WheelAgreement::ratio() const {

@@ -104,18 +104,23 @@ inline constexpr double kDivergedErrorM = 1.0;
 /// follows it is right to leave the wheels. The window is the last kWindowM of wheel travel over
 /// the judged scans.
 ///
-/// The turns are compared too, on every scan and over a longer stretch (kHeadingWindowM of wheel
-/// travel): an estimate that turns more than kHeadingToleranceRad plus kHeadingSkidShare of the
-/// wheels' own turning away from them there (a scan matcher rotating on a few far landmarks while
-/// the robot drives straight) contradicts them by more than the wheels' heading drift on the
-/// straight (degrees per metre) and their skid in turns (the real logs: up to half the turn)
-/// explain, whatever the scans observe.
+/// The turns are compared too, on every scan and over longer stretches (the last kHeadingWindowM
+/// of wheel travel, and the last kLongHeadingWindowM once kHeadingWindowM is held): an estimate
+/// that turns more than kHeadingToleranceRad plus kHeadingSkidShare of the wheels' own turning
+/// away from them there (a scan matcher rotating on a few far landmarks while the robot drives
+/// straight) contradicts them by more than the wheels' heading drift on the straight (the ten
+/// real logs and their copies with twice the odometry noise: at most 26 degrees over 10 m and 10
+/// beyond half the turn over 30 m) and their skid in turns (up to half the turn) explain, whatever
+/// the scans observe. The longer stretch catches a slow runaway (80 degrees over 15 m of straight
+/// driving, never 45 within 10 m) that the shorter one lets through.
 class WheelAgreement {
  public:
   static constexpr double kWindowM = 2.0;      ///< metres of wheel travel judged together
   static constexpr double kTolerance = 0.5;    ///< the distance ratio's allowed departure from 1
   static constexpr double kObservable = 0.25;  ///< a scan this observable is not judged
   static constexpr double kHeadingWindowM = 10.0;  ///< metres of wheel travel whose turns compare
+  /// ... and over up to this much (judged from kHeadingWindowM on): a slow runaway.
+  static constexpr double kLongHeadingWindowM = 30.0;
   static constexpr double kHeadingToleranceRad = 0.7853981633974483;  ///< 45 degrees ...
   static constexpr double kHeadingSkidShare = 0.5;  ///< ... plus this share of the wheels' turning
 
@@ -155,12 +160,27 @@ class WheelAgreement {
   struct Turn {
     double wheels_m, wheels_rad, estimate_rad;
   };
+  // The turns over the fewest latest scans that cover a length of wheel travel.
+  class TurnWindow {
+   public:
+    explicit TurnWindow(double length_m) : length_m_(length_m) {}
+    void Add(const Turn& turn);
+    void Clear();
+    // The estimate's turn less the wheels' (0 while it holds less than kHeadingWindowM), rad.
+    double difference_rad() const;
+    // Whether that difference is more than the wheels' drift and skid explain.
+    bool Contradicted() const;
+
+   private:
+    double length_m_;
+    std::deque<Turn> turns_;
+    double travel_m_ = 0.0, wheels_rad_ = 0.0, wheels_abs_rad_ = 0.0, estimate_rad_ = 0.0;
+  };
   bool Persistent() const { return stretch_travel_m_ > kWindowM; }
   void CloseStretch();
   // Adds one scan's turns to the heading window; true when it is flagged.
   bool AddTurn(double wheels_m, double wheels_rad, double estimate_rad);
-  std::deque<Turn> turns_;  // the heading window
-  double turn_travel_m_ = 0.0, wheels_rad_ = 0.0, wheels_abs_rad_ = 0.0, estimate_rad_ = 0.0;
+  TurnWindow turns_{kHeadingWindowM}, long_turns_{kLongHeadingWindowM};
   double heading_contradicted_rad_ = 0.0;
   std::deque<Step> window_;
   double wheels_m_ = 0.0, estimate_m_ = 0.0;

@@ -247,12 +247,12 @@ TEST(HealthTest, WheelAgreementFlagsAnEstimateThatStopsOrRaces) {
 TEST(HealthTest, WheelAgreementComparesTurnsBeyondTheWheelsDriftAndSkid) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  // An estimate that follows the robot while the wheels drift up to 4 degrees per metre on the
-  // straight (40 over the window) and skid by up to 45 % of every turn (fast turns, 1 rad per
+  // An estimate that follows the robot while the wheels drift up to 1.4 degrees per metre on the
+  // straight (42 over the long window) and skid by up to 45 % of every turn (fast turns, 1 rad per
   // metre): never flagged.
   for (int trial = 0; trial < 200; ++trial) {
     WheelAgreement agreement;
-    const double drift_rad_per_m = (2.0 * unit(rng) - 1.0) * 0.07;
+    const double drift_rad_per_m = (2.0 * unit(rng) - 1.0) * 1.4 * M_PI / 180.0;
     const double skid = 1.0 + (2.0 * unit(rng) - 1.0) * 0.45;
     const double curvature = (trial % 4) * 0.33;  // rad per metre
     for (int i = 0; i < 300; ++i) {
@@ -263,9 +263,9 @@ TEST(HealthTest, WheelAgreementComparesTurnsBeyondTheWheelsDriftAndSkid) {
     }
     EXPECT_EQ(agreement.heading_contradicted_rad(), 0.0);
   }
-  // An estimate that turns 13 degrees per metre while the robot drives straight (steps of 0.25 m,
-  // exact in binary): flagged once the heading window is full, holding 130 degrees of it, until
-  // the window has left the stretch.
+  // An estimate that turns 13 degrees per metre while the robot drives straight for 12 m (steps
+  // of 0.25 m, exact in binary): flagged once the short window is full, holding 130 degrees of
+  // it, and the long window all 156, until the long window has left the stretch.
   WheelAgreement agreement;
   const double rate = 13.0 * M_PI / 180.0;
   int first = -1;
@@ -278,16 +278,27 @@ TEST(HealthTest, WheelAgreementComparesTurnsBeyondTheWheelsDriftAndSkid) {
   EXPECT_NEAR(agreement.turn_difference_rad(), rate * 10.0, 1e-9);
   bool flagged = true;
   int cleared = -1;
-  for (int i = 0; i < 60 && cleared < 0; ++i) {
+  for (int i = 0; i < 150 && cleared < 0; ++i) {
     flagged = agreement.Add(Pose2(0.25, 0.0, 0.0), Pose2(0.25, 0.0, 0.0));
     if (!flagged) cleared = i;
   }
-  // 45 degrees is 3.46 m of the stretch: 3.5 m of it are left in the window after 26 straight
-  // steps (45.5 degrees, flagged), 3.25 m after 27 (cleared).
-  EXPECT_EQ(cleared, 26);
-  EXPECT_NEAR(agreement.heading_contradicted_rad(), rate * 10.0, 1e-9);
+  // 45 degrees is 3.46 m of the stretch: the long window (the last 120 steps) holds 3.5 m of it
+  // after 106 straight steps (45.5 degrees, flagged), 3.25 m after 107 (cleared).
+  EXPECT_EQ(cleared, 106);
+  EXPECT_NEAR(agreement.heading_contradicted_rad(), rate * 12.0, 1e-9);
   // The distance was right throughout: no distance contradiction.
   EXPECT_EQ(agreement.contradicted_m(), 0.0);
+  // A slow runaway, 2.8 degrees per metre on the straight: 28 degrees over the short window, 45
+  // after 16.07 m, flagged by the long window from the first scan past that (16.25 m).
+  WheelAgreement slow;
+  const double slow_rate = 2.8 * M_PI / 180.0;
+  first = -1;
+  for (int i = 0; i < 120 && first < 0; ++i) {
+    if (slow.Add(Pose2(0.25, 0.0, slow_rate * 0.25), Pose2(0.25, 0.0, 0.0))) first = i;
+  }
+  EXPECT_EQ(first, 64);
+  EXPECT_NEAR(slow.turn_difference_rad(), slow_rate * 10.0, 1e-9);
+  EXPECT_NEAR(slow.heading_contradicted_rad(), slow_rate * 16.25, 1e-9);
 }
 
 // Points every 5 cm along the segment from a to b.
