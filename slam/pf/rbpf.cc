@@ -48,11 +48,11 @@ Rbpf::Rbpf(const RbpfOptions& options)
   }
 }
 
-void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
-                          const std::vector<MatchPoint>& points, const LaserScan& scan,
-                          std::optional<double> map_range_m, double weight_exponent,
-                          std::uint64_t seed, bool* failed) const {
+void Rbpf::UpdateParticle(RbpfParticle& particle, const ScanUpdate& update, std::uint64_t seed,
+                          bool* failed) const {
   RandomEngine rng(seed);
+  const Pose2& motion = update.motion;
+  const std::vector<MatchPoint>& points = *update.points;
   const Pose2 predicted = particle.pose * motion;
   // Not a structured binding: clang 14 (the fuzz build) refuses one captured by a lambda.
   const std::pair<double, double> sigmas = MotionSigmas(motion);
@@ -139,9 +139,9 @@ void Rbpf::UpdateParticle(RbpfParticle& particle, const Pose2& motion,
     drawn = Pose2(match.pose.x() + d.x(), match.pose.y() + d.y(), match.pose.theta() + d.z());
   }
   particle.pose = drawn;
-  particle.log_weight += weight_exponent * log_eta_weight;
+  particle.log_weight += update.weight_exponent * log_eta_weight;
   particle.path_log_likelihood += log_eta;
-  particle.map.InsertScan(scan, drawn, map_range_m);
+  particle.map.InsertScan(*update.scan, drawn, update.map_range_m);
   particle.history = std::make_shared<RbpfPoseNode>(drawn, std::move(particle.history));
 }
 
@@ -166,17 +166,19 @@ std::pair<double, double> Rbpf::MotionSigmas(const Pose2& motion) const {
 
 Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& points,
                           bool* rejected) const {
-  // Two hypotheses for the increment, compared on the best particle's map (the increment is in
-  // the robot frame, so it carries over to every particle):
+  // Hypotheses for the increment, compared on the best particle's map (the increment is in the
+  // robot frame, so it carries over to every particle):
   //  - the odometry holds: the match near the prediction, climbed with the motion prior, whose
   //    density is (1 - eps) times the Gaussian motion model;
-  //  - the odometry failed: the best match anywhere in the window, whose translation density is
-  //    eps / window area (yaw still from the Gaussian: the failures this guards against, slip
-  //    and a reversal counted as forward motion, are of the translation).
+  //  - the odometry's translation failed: the best match anywhere in the window, whose
+  //    translation density is eps / window area (yaw still from the Gaussian: slip and a
+  //    reversal counted as forward motion are failures of the translation);
+  //  - with odometry_turn_check, its turn failed: below.
   // Each is scored by its observation likelihood (observation_scale, untempered: tempered like
   // the weights, the check misses reversals counted as forward motion) times that density.
   // Without a failure the window's best match is the prediction's or one the density ratio
   // outweighs (a corridor's axis gives equal likelihoods: the odometry wins there).
+  *rejected = false;
   const RbpfParticle& best = particles_[best_];
   const Pose2 predicted = best.pose * motion;
   // Not a structured binding: clang 14 (the fuzz build) refuses one captured by a lambda.
@@ -199,6 +201,8 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
                           std::log1p(-eps) - 0.5 * (ex * ex + ey * ey) / (sigma_xy * sigma_xy) -
                           kLog2Pi - 2.0 * std::log(sigma_xy) + log_yaw_density(near.pose);
 
+  Pose2 chosen = near.pose;
+  double log_chosen = log_near;
   const double half =
       options_.odometry_window_per_m * motion.translation().norm() + options_.odometry_window_min_m;
   const double step = options_.odometry_window_step_m;
@@ -206,61 +210,113 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
   const double log_far_density = std::log(eps) - 2.0 * std::log(2.0 * n * step);
   // A point's log-likelihood is at most 0: where even a perfect match in the window could not
   // beat the match near the prediction, the window need not be searched.
-  if (!(log_far_density + log_yaw_density(predicted) > log_near)) return motion;
-  // The grid only picks where to climb from: a spread subset of the points ranks its poses at a
-  // fraction of the cost (the window holds thousands of poses on a log with 1 m increments).
-  const std::vector<MatchPoint> sparse = SpreadSubset(points);
-  Pose2 start = predicted;
-  double start_ll = -std::numeric_limits<double>::infinity();
-  for (int iy = -n; iy <= n; ++iy) {
-    for (int ix = -n; ix <= n; ++ix) {
-      const Pose2 pose(predicted.x() + ix * step, predicted.y() + iy * step, predicted.theta());
-      const double ll = matcher_.Evaluate(best.map, sparse, pose).log_likelihood;
-      if (ll > start_ll) {
-        start_ll = ll;
-        start = pose;
+  if (log_far_density + log_yaw_density(predicted) > log_chosen) {
+    // The grid only picks where to climb from: a spread subset of the points ranks its poses at
+    // a fraction of the cost (the window holds thousands of poses on a log with 1 m increments).
+    const std::vector<MatchPoint> sparse = SpreadSubset(points);
+    Pose2 start = predicted;
+    double start_ll = -std::numeric_limits<double>::infinity();
+    for (int iy = -n; iy <= n; ++iy) {
+      for (int ix = -n; ix <= n; ++ix) {
+        const Pose2 pose(predicted.x() + ix * step, predicted.y() + iy * step, predicted.theta());
+        const double ll = matcher_.Evaluate(best.map, sparse, pose).log_likelihood;
+        if (ll > start_ll) {
+          start_ll = ll;
+          start = pose;
+        }
       }
     }
+    // No prior in the climb: under this hypothesis the odometry says nothing about the position.
+    constexpr double kNoPrior = 1e6;
+    const ClimbResult far =
+        matcher_.Climb(best.map, points, start, PosePrior{predicted, kNoPrior, sigma_yaw});
+    const Pose2 remapped = RemapDegenerate(best.map, points, near.pose, far.pose);
+    const double log_far = scale * matcher_.Evaluate(best.map, points, remapped).log_likelihood +
+                           log_far_density + log_yaw_density(remapped);
+    if (log_far > log_chosen) {
+      chosen = remapped;
+      log_chosen = log_far;
+      *rejected = true;
+    }
   }
-  // No prior in the climb: under this hypothesis the odometry says nothing about the position.
-  constexpr double kNoPrior = 1e6;
-  const ClimbResult far =
-      matcher_.Climb(best.map, points, start, PosePrior{predicted, kNoPrior, sigma_yaw});
-  const Pose2 remapped = RemapDegenerate(best.map, points, near.pose, far.pose);
-  const double log_far = scale * matcher_.Evaluate(best.map, points, remapped).log_likelihood +
-                         log_far_density + log_yaw_density(remapped);
-  if (!(log_far > log_near)) return motion;
-  *rejected = true;
-  return best.pose.Between(remapped);
+  // The wheels' turn failed (odometry_turn_check: a turn on the spot they missed, a burst of
+  // heading noise): the heading is anywhere within a quarter turn of the prediction (eps / pi),
+  // the position still the Gaussian's. Searched only where a perfect match at the Gaussian's peak
+  // could beat the best so far.
+  constexpr double kTurnFailureRad = std::numbers::pi / 2.0;
+  const double log_turn_density =
+      std::log(eps) - std::log(2.0 * kTurnFailureRad) - kLog2Pi - 2.0 * std::log(sigma_xy);
+  if (options_.odometry_turn_check && log_turn_density > log_chosen) {
+    constexpr double kNoPrior = 1e6;
+    double ll = 0.0;
+    double other = 0.0;
+    const Pose2 turned =
+        BestAtAnyHeading(best.map, points, predicted, std::max(2.0 * sigma_xy, step),
+                         kTurnFailureRad, PosePrior{predicted, sigma_xy, kNoPrior}, &ll, &other);
+    const double tx = turned.x() - predicted.x();
+    const double ty = turned.y() - predicted.y();
+    const double log_turn =
+        scale * ll + log_turn_density - 0.5 * (tx * tx + ty * ty) / (sigma_xy * sigma_xy);
+    // The same pose as the odometry's own (Gaussian) hypothesis would have it: a heading within
+    // the Gaussian's reach is a better match the climb from the prediction missed, not a failed
+    // turn, and the particles' own climbs are left to find it.
+    const double log_as_near = log_turn - log_turn_density + std::log1p(-eps) - kLog2Pi -
+                               2.0 * std::log(sigma_xy) + log_yaw_density(turned);
+    // Only a heading the scan picks out: where another heading matches nearly as well (a
+    // corridor seen from either end, a symmetric room), the scan cannot overrule the wheels.
+    const bool unique = scale * (ll - other) > std::log((1.0 - eps) / eps);
+    if (unique && log_turn > log_as_near && log_turn > log_chosen) {
+      chosen = turned;
+      *rejected = true;
+    }
+  }
+  return *rejected ? best.pose.Between(chosen) : motion;
 }
 
 Pose2 Rbpf::SearchAfterGap(const Pose2& motion, const std::vector<MatchPoint>& points,
                            bool* moved) const {
   // The increment is unknown over the gap: no motion prior on either hypothesis, only the scan's
-  // likelihood on the best particle's map. The grid of headings and positions (a spread subset of
-  // the points, as in CheckOdometry) picks where to climb from.
+  // likelihood on the best particle's map.
   const RbpfParticle& best = particles_[best_];
   const Pose2 predicted = best.pose * motion;
   constexpr double kNoPrior = 1e6;
   const PosePrior no_prior{predicted, kNoPrior, kNoPrior};
   const ClimbResult near = matcher_.Climb(best.map, points, predicted, no_prior);
   const double log_near = matcher_.Evaluate(best.map, points, near.pose).log_likelihood;
+  double log_far = -std::numeric_limits<double>::infinity();
+  const Pose2 far_pose =
+      BestAtAnyHeading(best.map, points, predicted, options_.odometry_gap_window_m,
+                       std::numbers::pi, no_prior, &log_far, nullptr);
+  *moved = log_far > log_near;
+  return best.pose.Between(*moved ? far_pose : near.pose);
+}
+
+Pose2 Rbpf::BestAtAnyHeading(const TiledGrid& map, const std::vector<MatchPoint>& points,
+                             const Pose2& center, double half_m, double yaw_half_rad,
+                             const PosePrior& prior, double* log_likelihood,
+                             double* runner_up) const {
+  // The grid of headings and positions (a spread subset of the points, as in CheckOdometry)
+  // picks where to climb from: the best position at each heading, and the best few headings,
+  // apart from each other, are climbed (the subset of points ranks them only roughly: a room's
+  // other wall may rank first).
   constexpr double kYawStepRad = 0.02;
   const std::vector<MatchPoint> sparse = SpreadSubset(points);
   const double step = options_.odometry_window_step_m;
-  const int n = static_cast<int>(std::ceil(options_.odometry_gap_window_m / step));
-  const int headings = static_cast<int>(std::ceil(2.0 * std::numbers::pi / kYawStepRad));
-  // The best position at each heading; the best few headings, apart from each other, are climbed
-  // (the subset of points ranks them only roughly: a room's other wall may rank first).
+  const int n = static_cast<int>(std::ceil(half_m / step));
+  // The whole circle from the centre's heading, or [-yaw_half_rad, yaw_half_rad) around it.
+  const bool circle = yaw_half_rad >= std::numbers::pi;
+  const double span = circle ? 2.0 * std::numbers::pi : 2.0 * yaw_half_rad;
+  const double first = circle ? 0.0 : -yaw_half_rad;
+  const int headings = std::max(1, static_cast<int>(std::ceil(span / kYawStepRad)));
   std::vector<std::pair<double, Pose2>> per_heading;
   per_heading.reserve(static_cast<std::size_t>(headings));
   for (int k = 0; k < headings; ++k) {
-    const double yaw = predicted.theta() + k * (2.0 * std::numbers::pi / headings);
-    std::pair<double, Pose2> best_here{-std::numeric_limits<double>::infinity(), predicted};
+    const double yaw = center.theta() + first + k * (span / headings);
+    std::pair<double, Pose2> best_here{-std::numeric_limits<double>::infinity(), center};
     for (int iy = -n; iy <= n; ++iy) {
       for (int ix = -n; ix <= n; ++ix) {
-        const Pose2 pose(predicted.x() + ix * step, predicted.y() + iy * step, yaw);
-        const double ll = matcher_.Evaluate(best.map, sparse, pose).log_likelihood;
+        const Pose2 pose(center.x() + ix * step, center.y() + iy * step, yaw);
+        const double ll = matcher_.Evaluate(map, sparse, pose).log_likelihood;
         if (ll > best_here.first) best_here = {ll, pose};
       }
     }
@@ -280,18 +336,27 @@ Pose2 Rbpf::SearchAfterGap(const Pose2& motion, const std::vector<MatchPoint>& p
     });
     if (distinct) starts.push_back(pose);
   }
-  Pose2 far_pose = near.pose;
-  double log_far = -std::numeric_limits<double>::infinity();
+  std::vector<std::pair<double, Pose2>> climbed;
   for (const Pose2& start : starts) {
-    const ClimbResult far = matcher_.Climb(best.map, points, start, no_prior);
-    const double ll = matcher_.Evaluate(best.map, points, far.pose).log_likelihood;
-    if (ll > log_far) {
-      log_far = ll;
-      far_pose = far.pose;
+    const ClimbResult climb = matcher_.Climb(map, points, start, prior);
+    climbed.emplace_back(matcher_.Evaluate(map, points, climb.pose).log_likelihood, climb.pose);
+  }
+  std::stable_sort(climbed.begin(), climbed.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  *log_likelihood = climbed.empty() ? -std::numeric_limits<double>::infinity() : climbed[0].first;
+  if (runner_up != nullptr) {
+    // The best climb at a heading apart from the best's: another peak, not its shoulder.
+    constexpr double kOtherPeakRad = 0.3;
+    *runner_up = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = 1; k < climbed.size(); ++k) {
+      if (std::abs(NormalizeAngle(climbed[k].second.theta() - climbed[0].second.theta())) >
+          kOtherPeakRad) {
+        *runner_up = climbed[k].first;
+        break;
+      }
     }
   }
-  *moved = log_far > log_near;
-  return best.pose.Between(*moved ? far_pose : near.pose);
+  return climbed.empty() ? center : climbed[0].second;
 }
 
 Pose2 Rbpf::RemapDegenerate(const TiledGrid& map, const std::vector<MatchPoint>& points,
@@ -404,13 +469,13 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
     step.weight_exponent *= total / static_cast<double>(points.size());
   }
   std::vector<char> failed(static_cast<std::size_t>(n), 0);
-  const std::optional<double> map_range_m = SparseScanRange(scan, options_.points);
+  const ScanUpdate update{motion, &points, &scan, SparseScanRange(scan, options_.points),
+                          weight_exponent};
   auto update_block = [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
       const auto k = static_cast<std::size_t>(i);
       bool f = false;
-      UpdateParticle(particles_[k], motion, points, scan, map_range_m, weight_exponent, seeds[k],
-                     &f);
+      UpdateParticle(particles_[k], update, seeds[k], &f);
       failed[k] = f;
     }
   };

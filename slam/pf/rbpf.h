@@ -92,12 +92,18 @@ class Rbpf {
   const RbpfOptions& options() const { return options_; }
 
  private:
-  /// Moves particle `i` by `motion`, draws its pose from the proposal, updates its map (with the
-  /// scan's returns out to `map_range_m` when given: SparseScanRange).
-  void UpdateParticle(RbpfParticle& particle, const Pose2& motion,
-                      const std::vector<MatchPoint>& points, const LaserScan& scan,
-                      std::optional<double> map_range_m, double weight_exponent, std::uint64_t seed,
+  /// What every particle's update of one scan shares.
+  struct ScanUpdate {
+    Pose2 motion;  ///< the increment since the last update
+    const std::vector<MatchPoint>* points;
+    const LaserScan* scan;
+    std::optional<double> map_range_m;  ///< the map takes returns out to this (SparseScanRange)
+    double weight_exponent;
+  };
+  /// Moves a particle by the update's motion, draws its pose from the proposal, updates its map.
+  void UpdateParticle(RbpfParticle& particle, const ScanUpdate& update, std::uint64_t seed,
                       bool* failed) const;
+
   void Resample(const std::vector<double>& weights);
   /// The odometry check: `motion`, or the increment the best particle's wide match gives where
   /// the mixture model finds that more likely (then `*rejected` is set).
@@ -108,6 +114,12 @@ class Rbpf {
   /// latter).
   Pose2 SearchAfterGap(const Pose2& motion, const std::vector<MatchPoint>& points,
                        bool* moved) const;
+  /// The best match on `map` at any heading within +-`half_m` of `center` (a grid, then climbs
+  /// with `prior` from its best distinct headings), its log-likelihood, and (when `runner_up` is
+  /// given) the best log-likelihood of a climb that ended at another heading.
+  Pose2 BestAtAnyHeading(const TiledGrid& map, const std::vector<MatchPoint>& points,
+                         const Pose2& center, double half_m, double yaw_half_rad,
+                         const PosePrior& prior, double* log_likelihood, double* runner_up) const;
   /// `far` with its translation from `near` dropped along the directions in which the scan
   /// cannot place the robot (odometry_degenerate_ratio).
   Pose2 RemapDegenerate(const TiledGrid& map, const std::vector<MatchPoint>& points,

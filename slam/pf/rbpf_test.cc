@@ -222,6 +222,50 @@ TEST(RbpfTest, AfterAGapInTheOdometryTheFilterFindsTheTurnItMissed) {
   EXPECT_EQ(not_searched.corrections, 0);
 }
 
+// `scans` with the turn over `stretch` missed by the wheels, its scans dropped: scan `stretch.to`
+// comes with the stretch's translation and no rotation. Not a gap: the odometry was heard
+// throughout (a turn on the spot the encoders missed, on a log with a few seconds between scans).
+std::vector<SyncedScan> WithMissedTurn(const std::vector<SyncedScan>& scans,
+                                       slam::testing::Stretch stretch) {
+  std::vector<SyncedScan> out(scans.begin(), scans.begin() + stretch.from + 1);
+  Pose2 total;
+  for (std::size_t i = stretch.from + 1; i <= stretch.to; ++i) total = total * scans[i].increment;
+  SyncedScan last = scans[stretch.to];
+  last.increment = Pose2(total.x(), total.y(), 0.0);
+  out.push_back(last);
+  out.insert(out.end(), scans.begin() + stretch.to + 1, scans.end());
+  return out;
+}
+
+TEST(RbpfTest, TheTurnCheckFindsATurnTheWheelsMissed) {
+  const ShortRun& run = GetShortRun();
+  const std::vector<GroundTruthPose>& truth = run.run.truth;
+  const slam::testing::Stretch turn = slam::testing::FirstTurn(truth, 1.0, 30, 30);
+  ASSERT_GT(turn.to, turn.from) << "no turn in the run";
+  const std::vector<SyncedScan> scans = WithMissedTurn(run.scans, turn);
+  auto run_with = [&](bool turn_check, int* rejections) {
+    RbpfOptions options = FastOptions();
+    options.num_particles = 5;  // the check is the best particle's: a few keep the test fast
+    options.odometry_turn_check = turn_check;
+    Rbpf filter(options);
+    RbpfStep step;
+    for (const SyncedScan& s : scans) step = filter.AddScan(s.scan, s.increment, s.odometry_gap_s);
+    *rejections = filter.odometry_rejections();
+    return slam::testing::EndPoseError(step.best_pose, truth);
+  };
+  int checked_rejections = 0;
+  const slam::testing::EndError checked = run_with(true, &checked_rejections);
+  EXPECT_LT(checked.position_m, 0.15);
+  EXPECT_LT(checked.heading_rad, 0.1);
+  EXPECT_GE(checked_rejections, 1);
+  // Without it the particles' own climbs, from draws of the Gaussian, never reach the turn.
+  int unchecked_rejections = 0;
+  const slam::testing::EndError unchecked = run_with(false, &unchecked_rejections);
+  EXPECT_GT(unchecked.heading_rad, 0.5);
+  RecordProperty("turn_rad", std::to_string(truth[turn.to].map_from_base.theta() -
+                                            truth[turn.from].map_from_base.theta()));
+}
+
 TEST(RbpfTest, ValidateNamesFieldValueAndRule) {
   RbpfOptions options;
   options.num_particles = 0;
