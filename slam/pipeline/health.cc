@@ -103,14 +103,39 @@ bool WheelAgreement::Add(const Pose2& estimate_increment, const Pose2& wheel_inc
 bool WheelAgreement::AddTurn(double wheels_m, double wheels_rad, double estimate_rad) {
   turns_.Add({wheels_m, wheels_rad, estimate_rad});
   long_turns_.Add({wheels_m, wheels_rad, estimate_rad});
+  drift_.Travel(wheels_m);
+  const double drift = drift_.rad_per_m();
   bool flagged = false;
   for (const TurnWindow* window : {&turns_, &long_turns_}) {
-    if (!window->Contradicted()) continue;
+    if (!window->Contradicted(drift)) continue;
     flagged = true;
-    heading_contradicted_rad_ =
-        std::max(heading_contradicted_rad_, std::abs(window->difference_rad()));
+    heading_contradicted_rad_ = std::max(
+        heading_contradicted_rad_, std::abs(window->difference_rad() - drift * window->travel_m()));
+  }
+  if (!flagged && turns_.travel_m() >= kHeadingWindowM) {
+    drift_.Add(turns_.difference_rad() / turns_.travel_m());
   }
   return flagged;
+}
+
+void WheelAgreement::DriftEstimate::Add(double rad_per_m) {
+  const double unit = (rad_per_m + kDriftRangeRadPerM) / (2.0 * kDriftRangeRadPerM);
+  const int bin =
+      std::clamp(static_cast<int>(std::lround(unit * (kDriftBins - 1))), 0, kDriftBins - 1);
+  ++counts_[static_cast<std::size_t>(bin)];
+  ++total_;
+}
+
+double WheelAgreement::DriftEstimate::rad_per_m() const {
+  if (travel_m_ < kDriftHistoryM || total_ == 0) return 0.0;
+  int below = 0;
+  for (int bin = 0; bin < kDriftBins; ++bin) {
+    below += counts_[static_cast<std::size_t>(bin)];
+    if (2 * below >= total_) {
+      return -kDriftRangeRadPerM + 2.0 * kDriftRangeRadPerM * bin / (kDriftBins - 1);
+    }
+  }
+  return 0.0;
 }
 
 double WheelAgreement::turn_difference_rad() const { return turns_.difference_rad(); }
@@ -140,8 +165,10 @@ double WheelAgreement::TurnWindow::difference_rad() const {
   return travel_m_ >= kHeadingWindowM ? estimate_rad_ - wheels_rad_ : 0.0;
 }
 
-bool WheelAgreement::TurnWindow::Contradicted() const {
-  return std::abs(difference_rad()) > kHeadingToleranceRad + kHeadingSkidShare * wheels_abs_rad_;
+bool WheelAgreement::TurnWindow::Contradicted(double drift_rad_per_m) const {
+  if (travel_m_ < kHeadingWindowM) return false;
+  return std::abs(difference_rad() - drift_rad_per_m * travel_m_) >
+         kHeadingToleranceRad + kHeadingSkidShare * wheels_abs_rad_;
 }
 
 void WheelAgreement::CloseStretch() {

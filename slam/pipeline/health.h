@@ -10,6 +10,7 @@
 // into LostIntervals. docs/estimators.md ("How each estimator judges itself") lists the rules.
 
 #include <Eigen/Core>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <map>
@@ -109,10 +110,12 @@ inline constexpr double kDivergedErrorM = 1.0;
 /// that turns more than kHeadingToleranceRad plus kHeadingSkidShare of the wheels' own turning
 /// away from them there (a scan matcher rotating on a few far landmarks while the robot drives
 /// straight) contradicts them by more than the wheels' heading drift on the straight (the ten
-/// real logs and their copies with twice the odometry noise: at most 26 degrees over 10 m and 10
+/// real logs and their copies with twice the odometry noise: at most 32 degrees over 10 m and 10
 /// beyond half the turn over 30 m) and their skid in turns (up to half the turn) explain, whatever
 /// the scans observe. The longer stretch catches a slow runaway (80 degrees over 15 m of straight
-/// driving, never 45 within 10 m) that the shorter one lets through.
+/// driving, never 45 within 10 m) that the shorter one lets through. Both compare the turns net of
+/// the wheels' own steady drift (DriftEstimate): a robot whose wheels drift 1.2 degrees per metre
+/// on the straight has 36 of them in the long stretch before its estimate errs at all.
 class WheelAgreement {
  public:
   static constexpr double kWindowM = 2.0;      ///< metres of wheel travel judged together
@@ -168,19 +171,40 @@ class WheelAgreement {
     void Clear();
     // The estimate's turn less the wheels' (0 while it holds less than kHeadingWindowM), rad.
     double difference_rad() const;
-    // Whether that difference is more than the wheels' drift and skid explain.
-    bool Contradicted() const;
+    // Whether that difference, less `drift_rad_per_m` times the window's travel, is more than
+    // the wheels' drift and skid explain.
+    bool Contradicted(double drift_rad_per_m) const;
+    double travel_m() const { return travel_m_; }
 
    private:
     double length_m_;
     std::deque<Turn> turns_;
     double travel_m_ = 0.0, wheels_rad_ = 0.0, wheels_abs_rad_ = 0.0, estimate_rad_ = 0.0;
   };
+  // The wheels' own steady heading drift per metre on this run: the median of the short
+  // window's turn difference per metre over its full windows that were not flagged, counted in
+  // kDriftBins bins over +-kDriftRangeRadPerM; 0 until kDriftHistoryM of wheel travel is held (a
+  // runaway at the start is not learnt as the wheels' bias).
+  class DriftEstimate {
+   public:
+    static constexpr int kDriftBins = 201;
+    static constexpr double kDriftRangeRadPerM = 0.05;
+    static constexpr double kDriftHistoryM = 50.0;
+    void Travel(double wheels_m) { travel_m_ += wheels_m; }
+    void Add(double rad_per_m);
+    double rad_per_m() const;
+
+   private:
+    std::array<int, kDriftBins> counts_{};
+    int total_ = 0;
+    double travel_m_ = 0.0;
+  };
   bool Persistent() const { return stretch_travel_m_ > kWindowM; }
   void CloseStretch();
   // Adds one scan's turns to the heading window; true when it is flagged.
   bool AddTurn(double wheels_m, double wheels_rad, double estimate_rad);
   TurnWindow turns_{kHeadingWindowM}, long_turns_{kLongHeadingWindowM};
+  DriftEstimate drift_;
   double heading_contradicted_rad_ = 0.0;
   std::deque<Step> window_;
   double wheels_m_ = 0.0, estimate_m_ = 0.0;

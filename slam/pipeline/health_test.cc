@@ -301,6 +301,32 @@ TEST(HealthTest, WheelAgreementComparesTurnsBeyondTheWheelsDriftAndSkid) {
   EXPECT_NEAR(slow.heading_contradicted_rad(), slow_rate * 16.25, 1e-9);
 }
 
+TEST(HealthTest, WheelAgreementLearnsTheWheelsSteadyDriftBeforeJudgingTheLongWindow) {
+  // Wheels that drift 1.2 degrees per metre on the straight (36 over the long window, as the
+  // generated campus's Pioneer profile) and an estimate that follows the robot, with a 25 degree
+  // heading glitch at 150 m taken back 2 m later: 61 degrees over the long window, of which 36
+  // are the wheels' own bias, learnt by then. Never flagged.
+  const double drift = 1.2 * M_PI / 180.0 * 0.25;  // per 0.25 m step
+  const double glitch = 25.0 * M_PI / 180.0;
+  WheelAgreement agreement;
+  for (int i = 0; i < 800; ++i) {  // 200 m
+    const double estimate_turn = i == 600 ? glitch : (i == 608 ? -glitch : 0.0);
+    ASSERT_FALSE(agreement.Add(Pose2(0.25, 0.0, estimate_turn), Pose2(0.25, 0.0, drift))) << i;
+  }
+  EXPECT_EQ(agreement.heading_contradicted_rad(), 0.0);
+  // The same wheels with a slow runaway of the estimate (3 degrees per metre) from 150 m on: the
+  // learnt bias does not hide it. Flagged once the long window holds 45 degrees beyond the bias
+  // plus half the wheels' own turning there (their 36 degrees of drift count as turning): 63
+  // degrees, 21 m of the runaway.
+  WheelAgreement runaway;
+  int first = -1;
+  for (int i = 0; i < 800 && first < 0; ++i) {
+    const double estimate_turn = i >= 600 ? 3.0 * M_PI / 180.0 * 0.25 : 0.0;
+    if (runaway.Add(Pose2(0.25, 0.0, estimate_turn), Pose2(0.25, 0.0, drift))) first = i;
+  }
+  EXPECT_EQ(first, 600 + 83);
+}
+
 // Points every 5 cm along the segment from a to b.
 void Wall(const Eigen::Vector2d& a, const Eigen::Vector2d& b, std::vector<Eigen::Vector2d>* out) {
   const int n = static_cast<int>((b - a).norm() / 0.05);
