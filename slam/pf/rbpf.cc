@@ -23,6 +23,9 @@
 namespace slamrig::slam {
 namespace {
 
+// A prior's standard deviation that leaves the climb free along it.
+constexpr double kNoPrior = 1e6;
+
 // About 48 of `points`, spread along the scan: ranks a grid of poses, for a climb from the best,
 // at a fraction of every point's cost.
 std::vector<MatchPoint> SpreadSubset(const std::vector<MatchPoint>& points) {
@@ -211,26 +214,11 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
   // A point's log-likelihood is at most 0: where even a perfect match in the window could not
   // beat the match near the prediction, the window need not be searched.
   if (log_far_density + log_yaw_density(predicted) > log_chosen) {
-    // The grid only picks where to climb from: a spread subset of the points ranks its poses at
-    // a fraction of the cost (the window holds thousands of poses on a log with 1 m increments).
-    const std::vector<MatchPoint> sparse = SpreadSubset(points);
-    Pose2 start = predicted;
-    double start_ll = -std::numeric_limits<double>::infinity();
-    for (int iy = -n; iy <= n; ++iy) {
-      for (int ix = -n; ix <= n; ++ix) {
-        const Pose2 pose(predicted.x() + ix * step, predicted.y() + iy * step, predicted.theta());
-        const double ll = matcher_.Evaluate(best.map, sparse, pose).log_likelihood;
-        if (ll > start_ll) {
-          start_ll = ll;
-          start = pose;
-        }
-      }
-    }
-    // No prior in the climb: under this hypothesis the odometry says nothing about the position.
-    constexpr double kNoPrior = 1e6;
-    const ClimbResult far =
-        matcher_.Climb(best.map, points, start, PosePrior{predicted, kNoPrior, sigma_yaw});
-    const Pose2 remapped = RemapDegenerate(best.map, points, near.pose, far.pose);
+    // No prior on the position: under this hypothesis the odometry says nothing about it.
+    double far_ll = 0.0;
+    const Pose2 far = BestAtAnyHeading(best.map, points, predicted, half, 0.0,
+                                       PosePrior{predicted, kNoPrior, sigma_yaw}, &far_ll, nullptr);
+    const Pose2 remapped = RemapDegenerate(best.map, points, near.pose, far);
     const double log_far = scale * matcher_.Evaluate(best.map, points, remapped).log_likelihood +
                            log_far_density + log_yaw_density(remapped);
     if (log_far > log_chosen) {
@@ -247,7 +235,6 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
   const double log_turn_density =
       std::log(eps) - std::log(2.0 * kTurnFailureRad) - kLog2Pi - 2.0 * std::log(sigma_xy);
   if (options_.odometry_turn_check && log_turn_density > log_chosen) {
-    constexpr double kNoPrior = 1e6;
     double ll = 0.0;
     double other = 0.0;
     const Pose2 turned =
@@ -279,7 +266,6 @@ Pose2 Rbpf::SearchAfterGap(const Pose2& motion, const std::vector<MatchPoint>& p
   // likelihood on the best particle's map.
   const RbpfParticle& best = particles_[best_];
   const Pose2 predicted = best.pose * motion;
-  constexpr double kNoPrior = 1e6;
   const PosePrior no_prior{predicted, kNoPrior, kNoPrior};
   const ClimbResult near = matcher_.Climb(best.map, points, predicted, no_prior);
   const double log_near = matcher_.Evaluate(best.map, points, near.pose).log_likelihood;

@@ -142,8 +142,9 @@ class WheelAgreement {
   double ratio() const;
   /// The heading window's turn, the estimate's less the wheels' (0 while it is not full), rad.
   double turn_difference_rad() const;
-  /// The largest turn difference of a flagged heading window so far, in magnitude (0: none). A
-  /// heading lost by that much is not a wheel's error, and no later scan takes it back.
+  /// The largest turn difference of a flagged heading window so far, net of the wheels' learnt
+  /// drift, in magnitude (0: none). A heading lost by that much is not a wheel's error, and no
+  /// later scan takes it back.
   double heading_contradicted_rad() const { return heading_contradicted_rad_; }
   /// The estimate's displacement against the wheels over the persistent flagged stretches: per
   /// stretch of consecutive flagged scans, the estimate's distance less the wheels' (from the
