@@ -23,7 +23,7 @@ int RunBenchmarkCommand(const std::vector<std::string>& args) {
       "command again after an interruption and it runs only what is missing); at the end\n"
       "DIR/summary.html shows the leaderboard, each dataset's ATE distribution and the worst\n"
       "cases. A run fails when it crashes, times out or errors, or when its ATE is above\n"
-      "max(1 m, dead reckoning's ATE on the same data). Exit 3 when any run failed.");
+      "the suite's fail_above_m (1 m unless it says). Exit 3 when any run failed.");
   parser.AddPositional("SUITE.yaml", "the suite file (see suites/)", &suite_path);
   parser.AddOption("out", "DIR", "output folder (created; reused to resume)", &options.out_dir);
   parser.AddOption("jobs", "N", "runs at a time (0: one per core)", &options.jobs);

@@ -74,7 +74,7 @@ std::vector<std::string> BenchmarkRow(const BenchmarkSuite& suite, const Benchma
     try {
       figures = ReadFigures(metrics_path, suite.estimators[run.estimator].name);
       if (figures.failure.empty()) {
-        status = JudgeBenchmarkRun(figures, &reason);
+        status = JudgeBenchmarkRun(figures, suite.fail_above_m, &reason);
       } else {
         reason = figures.failure;  // an external program that failed: status stays "error"
       }
@@ -164,17 +164,21 @@ const std::vector<std::string>& BenchmarkTimingColumns() {
   return columns;
 }
 
-std::string JudgeBenchmarkRun(const BenchmarkFigures& figures, std::string* reason) {
+std::string JudgeBenchmarkRun(const BenchmarkFigures& figures, double fail_above_m,
+                              std::string* reason) {
   const auto ate = figures.estimator.find("ate_rmse_m");
   if (ate == figures.estimator.end() || !std::isfinite(ate->second)) {
     *reason = "no ATE (no trajectory to score)";
     return "fail";
   }
-  const double bound = std::max(1.0, figures.baseline_ate_rmse_m);
-  if (ate->second > bound) {
+  if (ate->second > fail_above_m) {
     char text[160];
-    std::snprintf(text, sizeof(text), "ATE %.3g m above max(1 m, dead reckoning's %.3g m)",
-                  ate->second, figures.baseline_ate_rmse_m);
+    if (figures.baseline_ate_rmse_m >= 0.0) {
+      std::snprintf(text, sizeof(text), "ATE %.3g m above %.3g m (dead reckoning's %.3g m)",
+                    ate->second, fail_above_m, figures.baseline_ate_rmse_m);
+    } else {
+      std::snprintf(text, sizeof(text), "ATE %.3g m above %.3g m", ate->second, fail_above_m);
+    }
     *reason = text;
     return "fail";
   }

@@ -3,6 +3,7 @@
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -177,6 +178,12 @@ BenchmarkSuite LoadBenchmarkSuite(const std::string& path) {
   if (const auto timeout = root.Optional("timeout_s")) {
     suite.timeout_s = timeout->As<double>();
     if (!(suite.timeout_s > 0.0)) timeout->Fail("must be > 0 seconds");
+  }
+  if (const auto bound = root.Optional("fail_above_m")) {
+    suite.fail_above_m = bound->As<double>();
+    if (!(suite.fail_above_m > 0.0) || !std::isfinite(suite.fail_above_m)) {
+      bound->Fail("must be a finite number of metres > 0");
+    }
   }
   const YamlNode estimators = root.Required("estimators");
   for (const std::string& name : estimators.Keys()) {

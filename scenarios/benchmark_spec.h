@@ -38,6 +38,7 @@ struct BenchmarkDataset {
 ///
 /// ```yaml
 /// timeout_s: 900                          # a run still going then is a failure (default 1800)
+/// fail_above_m: 1.0                       # a run whose ATE RMSE is above it failed (default 1)
 /// estimators:                             # scenario `slam:` entries
 ///   pf: {algorithm: pf, particles: 100}
 ///   graph: {algorithm: graph}
@@ -57,6 +58,7 @@ struct BenchmarkDataset {
 struct BenchmarkSuite {
   std::string path;
   double timeout_s = 1800.0;
+  double fail_above_m = 1.0;  ///< a run whose ATE RMSE is above this failed
   std::vector<BenchmarkEstimator> estimators;
   std::vector<BenchmarkDataset> datasets;
 };

@@ -203,9 +203,8 @@ void WriteBenchmarkSummary(const BenchmarkSuite& suite, const std::string& out_d
       (board.missing > 0 ? ", " + std::to_string(board.missing) + " not run yet" : "") +
       ".</p><h2>Leaderboard</h2><p>ATE RMSE in metres over each dataset's runs: median / 90th "
       "percentile / maximum. A run fails when it crashes, times out (" +
-      Metres(suite.timeout_s) +
-      " s), ends in an error, or its ATE is above max(1 m, dead reckoning's ATE on the same "
-      "data).</p>" +
+      Metres(suite.timeout_s) + " s), ends in an error, or its ATE is above " +
+      Metres(suite.fail_above_m) + " m (the suite's <code>fail_above_m</code>).</p>" +
       LeaderboardTable(board) + "<h2>Distributions</h2>";
   QuantilePlots(board, out_dir, &html);
   html +=

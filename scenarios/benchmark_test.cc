@@ -150,22 +150,27 @@ TEST(BenchmarkSpecTest, BadInputNamesTheFileLineAndKey) {
             std::string::npos);
 }
 
-TEST(BenchmarkRunnerTest, FailsAboveOneMetreOrDeadReckoningWhicheverIsLarger) {
+TEST(BenchmarkRunnerTest, FailsAboveTheSuitesBoundHoweverFarDeadReckoningIs) {
   std::string reason;
   BenchmarkFigures f;
   f.baseline_ate_rmse_m = 0.3;
   f.estimator["ate_rmse_m"] = 0.9;
-  EXPECT_EQ(JudgeBenchmarkRun(f, &reason), "pass");
+  EXPECT_EQ(JudgeBenchmarkRun(f, 1.0, &reason), "pass");
   EXPECT_EQ(reason, "");
   f.estimator["ate_rmse_m"] = 1.1;
-  EXPECT_EQ(JudgeBenchmarkRun(f, &reason), "fail");
-  EXPECT_EQ(reason, "ATE 1.1 m above max(1 m, dead reckoning's 0.3 m)");
-  f.baseline_ate_rmse_m = 2.0;
-  EXPECT_EQ(JudgeBenchmarkRun(f, &reason), "pass");
-  f.estimator["ate_rmse_m"] = 2.5;
-  EXPECT_EQ(JudgeBenchmarkRun(f, &reason), "fail");
+  EXPECT_EQ(JudgeBenchmarkRun(f, 1.0, &reason), "fail");
+  EXPECT_EQ(reason, "ATE 1.1 m above 1 m (dead reckoning's 0.3 m)");
+  // Far better than dead reckoning is still a failure above the bound.
+  f.baseline_ate_rmse_m = 13.0;
+  f.estimator["ate_rmse_m"] = 8.5;
+  EXPECT_EQ(JudgeBenchmarkRun(f, 1.0, &reason), "fail");
+  EXPECT_EQ(reason, "ATE 8.5 m above 1 m (dead reckoning's 13 m)");
+  EXPECT_EQ(JudgeBenchmarkRun(f, 10.0, &reason), "pass");
+  f.baseline_ate_rmse_m = -1.0;  // no baseline
+  EXPECT_EQ(JudgeBenchmarkRun(f, 5.0, &reason), "fail");
+  EXPECT_EQ(reason, "ATE 8.5 m above 5 m");
   f.estimator.clear();
-  EXPECT_EQ(JudgeBenchmarkRun(f, &reason), "fail");
+  EXPECT_EQ(JudgeBenchmarkRun(f, 1.0, &reason), "fail");
   EXPECT_EQ(reason, "no ATE (no trajectory to score)");
 }
 
