@@ -138,7 +138,10 @@ double WheelAgreement::DriftEstimate::rad_per_m() const {
   return 0.0;
 }
 
-double WheelAgreement::turn_difference_rad() const { return turns_.difference_rad(); }
+double WheelAgreement::turn_difference_rad() const {
+  if (turns_.travel_m() < kHeadingWindowM) return 0.0;
+  return turns_.difference_rad() - drift_.rad_per_m() * turns_.travel_m();
+}
 
 void WheelAgreement::TurnWindow::Add(const Turn& turn) {
   turns_.push_back(turn);

@@ -140,7 +140,8 @@ class WheelAgreement {
   void Reset();
   /// The window's distance ratio (1 while the window is not full).
   double ratio() const;
-  /// The heading window's turn, the estimate's less the wheels' (0 while it is not full), rad.
+  /// The heading window's turn, the estimate's less the wheels', net of the wheels' learnt drift
+  /// over it (what is judged; 0 while it is not full), rad.
   double turn_difference_rad() const;
   /// The largest turn difference of a flagged heading window so far, net of the wheels' learnt
   /// drift, in magnitude (0: none). A heading lost by that much is not a wheel's error, and no

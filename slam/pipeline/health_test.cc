@@ -314,6 +314,9 @@ TEST(HealthTest, WheelAgreementLearnsTheWheelsSteadyDriftBeforeJudgingTheLongWin
     ASSERT_FALSE(agreement.Add(Pose2(0.25, 0.0, estimate_turn), Pose2(0.25, 0.0, drift))) << i;
   }
   EXPECT_EQ(agreement.heading_contradicted_rad(), 0.0);
+  // The reported difference is the judged one, net of the learnt drift (the raw one is -12
+  // degrees: -0.209 rad), to the drift histogram's bin (0.0005 rad/m, over 10 m).
+  EXPECT_NEAR(agreement.turn_difference_rad(), 0.0, 0.0025);
   // The same wheels with a slow runaway of the estimate (3 degrees per metre) from 150 m on: the
   // learnt bias does not hide it. Flagged once the long window holds 45 degrees beyond the bias
   // plus half the wheels' own turning there (their 36 degrees of drift count as turning): 63
