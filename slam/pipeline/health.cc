@@ -109,8 +109,8 @@ bool WheelAgreement::AddTurn(double wheels_m, double wheels_rad, double estimate
   for (const TurnWindow* window : {&turns_, &long_turns_}) {
     if (!window->Contradicted(drift)) continue;
     flagged = true;
-    heading_contradicted_rad_ = std::max(
-        heading_contradicted_rad_, std::abs(window->difference_rad() - drift * window->travel_m()));
+    heading_contradicted_rad_ =
+        std::max(heading_contradicted_rad_, std::abs(window->net_difference_rad(drift)));
   }
   if (!flagged && turns_.travel_m() >= kHeadingWindowM) {
     drift_.Add(turns_.difference_rad() / turns_.travel_m());
@@ -139,8 +139,7 @@ double WheelAgreement::DriftEstimate::rad_per_m() const {
 }
 
 double WheelAgreement::turn_difference_rad() const {
-  if (turns_.travel_m() < kHeadingWindowM) return 0.0;
-  return turns_.difference_rad() - drift_.rad_per_m() * turns_.travel_m();
+  return turns_.net_difference_rad(drift_.rad_per_m());
 }
 
 void WheelAgreement::TurnWindow::Add(const Turn& turn) {
@@ -168,9 +167,13 @@ double WheelAgreement::TurnWindow::difference_rad() const {
   return travel_m_ >= kHeadingWindowM ? estimate_rad_ - wheels_rad_ : 0.0;
 }
 
+double WheelAgreement::TurnWindow::net_difference_rad(double drift_rad_per_m) const {
+  return travel_m_ >= kHeadingWindowM ? difference_rad() - drift_rad_per_m * travel_m_ : 0.0;
+}
+
 bool WheelAgreement::TurnWindow::Contradicted(double drift_rad_per_m) const {
   if (travel_m_ < kHeadingWindowM) return false;
-  return std::abs(difference_rad() - drift_rad_per_m * travel_m_) >
+  return std::abs(net_difference_rad(drift_rad_per_m)) >
          kHeadingToleranceRad + kHeadingSkidShare * wheels_abs_rad_;
 }
 

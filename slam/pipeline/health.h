@@ -173,8 +173,9 @@ class WheelAgreement {
     void Clear();
     // The estimate's turn less the wheels' (0 while it holds less than kHeadingWindowM), rad.
     double difference_rad() const;
-    // Whether that difference, less `drift_rad_per_m` times the window's travel, is more than
-    // the wheels' drift and skid explain.
+    // That difference less `drift_rad_per_m` times the window's travel (0 while not full), rad.
+    double net_difference_rad(double drift_rad_per_m) const;
+    // Whether the net difference is more than the wheels' drift and skid explain.
     bool Contradicted(double drift_rad_per_m) const;
     double travel_m() const { return travel_m_; }
 
