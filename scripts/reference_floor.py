@@ -25,6 +25,7 @@ else in file order, as scripts/score_real_logs.py does. Needs NumPy (exit 77 wit
 """
 import gzip
 import math
+import os
 import sys
 
 try:
@@ -32,6 +33,9 @@ try:
 except ImportError:
     print("reference_floor.py: needs NumPy (python3-numpy)", file=sys.stderr)
     sys.exit(77)
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from score_real_logs import aligned_rmse as pairs_rmse, pair_indices  # noqa: E402
 
 RANGE_M = 15.0
 CELL_M = 0.05
@@ -86,24 +90,15 @@ def read_tum(path):
 
 
 def pair(estimate, scans):
-    """{scan index: (x, y, yaw)} of the estimate."""
-    bucket = lambda t: round(t * 2000)  # 0.5 ms
-    first = {}
-    for index, scan in enumerate(scans):
-        first.setdefault(bucket(scan[0]), index)
-    by_time = {first[bucket(t)]: (x, y, yaw) for t, x, y, yaw in estimate if bucket(t) in first}
-    if len(by_time) >= 0.8 * min(len(estimate), len(scans)):
-        return by_time
-    return {i: estimate[i][1:] for i in range(min(len(estimate), len(scans)))}
+    """{scan index: (x, y, yaw)} of the estimate, paired as scripts/score_real_logs.py pairs."""
+    indices, _ = pair_indices([p[0] for p in estimate], [s[0] for s in scans])
+    return {j: estimate[i][1:] for i, j in indices}
 
 
 def aligned_rmse(a, b):
-    """RMSE of a's positions after the rigid 2D motion that best maps them onto b's."""
-    a, b = a - a.mean(axis=0), b - b.mean(axis=0)
-    angle = math.atan2(np.sum(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]), np.sum(a * b))
-    c, s = math.cos(angle), math.sin(angle)
-    rotated = np.stack([c * a[:, 0] - s * a[:, 1], s * a[:, 0] + c * a[:, 1]], axis=1)
-    return math.sqrt(np.mean(np.sum((rotated - b) ** 2, axis=1)))
+    """RMSE of a's positions (N x 2) after the rigid 2D motion that best maps them onto b's:
+    scripts/score_real_logs.py's metric."""
+    return pairs_rmse([(tuple(p), tuple(q)) for p, q in zip(a.tolist(), b.tolist())])
 
 
 def occupied_cells(scans, poses, indices):

@@ -68,17 +68,25 @@ def read_tum(path):
     return poses
 
 
-def pair_poses(estimate, reference):
-    """[((x, y) estimated, (x, y) reference)] and how they were paired ('time' or 'index')."""
+def pair_indices(estimate_stamps, reference_stamps):
+    """[(estimate index, reference index)] and how they were paired ('time' or 'index'): by stamp
+    (0.5 ms buckets, the first reference of a bucket) when that pairs 80 % of the shorter, else
+    in order."""
     bucket = lambda t: round(t * 2000)  # 0.5 ms
     first_at = {}
-    for t, x, y in reference:
-        first_at.setdefault(bucket(t), (x, y))
-    by_time = [((x, y), first_at[bucket(t)]) for t, x, y in estimate if bucket(t) in first_at]
-    if len(by_time) >= 0.8 * min(len(estimate), len(reference)):
+    for j, t in enumerate(reference_stamps):
+        first_at.setdefault(bucket(t), j)
+    by_time = [(i, first_at[bucket(t)]) for i, t in enumerate(estimate_stamps)
+               if bucket(t) in first_at]
+    if len(by_time) >= 0.8 * min(len(estimate_stamps), len(reference_stamps)):
         return by_time, "time"
-    count = min(len(estimate), len(reference))
-    return [(estimate[i][1:], reference[i][1:]) for i in range(count)], "index"
+    return [(i, i) for i in range(min(len(estimate_stamps), len(reference_stamps)))], "index"
+
+
+def pair_poses(estimate, reference):
+    """[((x, y) estimated, (x, y) reference)] and how they were paired ('time' or 'index')."""
+    indices, how = pair_indices([p[0] for p in estimate], [p[0] for p in reference])
+    return [(estimate[i][1:], reference[j][1:]) for i, j in indices], how
 
 
 def aligned_rmse(pairs):
