@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "slam/grid/see_through.h"
 #include "slam/matching/scan_points.h"
 #include "slam/types/check.h"
 
@@ -44,6 +45,13 @@ ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
   if (step.odometry_rejected || scan.odometry_gap_s > filter_.options().odometry_gap_s) {
     wheels_.Reset();
   }
+  // The best map against its own scan: the share of rays crossing a wall it holds (a health
+  // value only; docs/studies/see-through.md measures why it is no lost rule).
+  if (step.updated && !filter_.particles().empty()) {
+    see_through_ = CountSeeThrough(filter_.best().map, scan.scan, step.best_pose,
+                                   SparseScanRange(scan.scan, filter_.options().points), {})
+                       .fraction();
+  }
   const bool contradicts =
       wheels_.Judge(scan.scan, scan.increment, estimate_increment, step.updated);
   health_.Add(lost_ || contradicts);
@@ -55,7 +63,8 @@ ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
                          {"neff_ratio", step.neff / particles},
                          {"matched_fraction", step.matched_fraction},
                          {"matched_fraction_ratio", matched_ratio_.ratio()},
-                         {"failed_match_share", step.failed_matches / particles}},
+                         {"failed_match_share", step.failed_matches / particles},
+                         {"see_through_fraction", see_through_}},
                         std::nullopt,
                         lost_ || contradicts};
   wheels_.AppendTrace(&estimate.trace);

@@ -50,7 +50,8 @@ class RbpfEstimator final : public Estimator {
   int failed_matches_ = 0;
   // The lost rule: the best particle's matched fraction against its own long-term level.
   QualityRatio matched_ratio_{0.3, 0.02, 20, 0.5};
-  bool lost_ = false;  // at the last update; held between updates
+  bool lost_ = false;         // at the last update; held between updates
+  double see_through_ = 0.0;  // at the last update
   HealthRecord health_;
   WheelCheck wheels_;
   mutable OccupancyGrid map_;
