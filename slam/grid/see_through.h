@@ -40,10 +40,12 @@ struct SeeThroughOptions {
 
 /// Traces `scan`'s returns (BeamEnds' hits, `max_range_m` as for Grid::InsertScan) seen from
 /// `world_from_base` through `map` (an OccupancyGrid or a TiledGrid: LogOdds, WorldToCell,
-/// options) and counts those that cross a wall cell before their end.
+/// options) and counts those that cross a wall cell before their end; `crossed`, when given, gets
+/// the first wall cell each crossing ray met.
 template <typename Grid>
 SeeThrough CountSeeThrough(const Grid& map, const LaserScan& scan, const Pose2& world_from_base,
-                           std::optional<double> max_range_m, const SeeThroughOptions& options) {
+                           std::optional<double> max_range_m, const SeeThroughOptions& options,
+                           std::vector<Eigen::Array2i>* crossed = nullptr) {
   std::vector<std::pair<Eigen::Vector2d, bool>> ends;
   BeamEnds(scan, world_from_base, map.options(), max_range_m, &ends);
   const Eigen::Vector2d origin = (world_from_base * scan.base_from_laser).translation();
@@ -58,7 +60,10 @@ SeeThrough CountSeeThrough(const Grid& map, const LaserScan& scan, const Pose2& 
     const Eigen::Vector2d stop = origin + ray * ((length - options.end_margin_m) / length);
     bool crosses = false;
     TraceRay(start, map.WorldToCell(stop), [&](int x, int y) {
-      crosses = crosses || map.LogOdds(Eigen::Array2i(x, y)) >= options.wall_log_odds;
+      if (!crosses && map.LogOdds(Eigen::Array2i(x, y)) >= options.wall_log_odds) {
+        crosses = true;
+        if (crossed != nullptr) crossed->emplace_back(x, y);
+      }
     });
     ++result.rays;
     result.crossing += crosses;

@@ -50,13 +50,22 @@ OccupancyGridOptions GridOptions() {
   return options;
 }
 
+// A pose drawn x, then y, then yaw (one draw per statement: a fixed order).
+Pose2 DrawPose(std::mt19937& rng, std::uniform_real_distribution<double>& x,
+               std::uniform_real_distribution<double>& y,
+               std::uniform_real_distribution<double>& yaw) {
+  const double px = x(rng);
+  const double py = y(rng);
+  return Pose2(px, py, yaw(rng));
+}
+
 // The room mapped from 20 poses inside it.
 template <typename Grid>
 void MapTheRoom(Grid* map) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> x(1.5, kWidth - 1.5), y(1.5, kHeight - 1.5), yaw(-3, 3);
   for (int i = 0; i < 20; ++i) {
-    const Pose2 pose(x(rng), y(rng), yaw(rng));
+    const Pose2 pose = DrawPose(rng, x, y, yaw);
     map->InsertScan(RoomScan(pose), pose);
   }
 }
@@ -76,7 +85,7 @@ TEST(SeeThroughTest, AScanAgreesWithTheMapOfItsOwnRoom) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> x(1.0, kWidth - 1.0), y(1.0, kHeight - 1.0), yaw(-3, 3);
   for (int i = 0; i < 50; ++i) {
-    const Pose2 pose(x(rng), y(rng), yaw(rng));
+    const Pose2 pose = DrawPose(rng, x, y, yaw);
     const LaserScan scan = RoomScan(pose);
     const SeeThrough result = CountSeeThrough(map, scan, pose, std::nullopt, {});
     EXPECT_EQ(result.rays, LongRays(scan, SeeThroughOptions{})) << i;
@@ -97,7 +106,7 @@ void CheckAMisplacedScanCrossesTheWallsItShouldHaveEnded(Grid* map) {
   std::uniform_real_distribution<double> x(1.0, kWidth - 2.0), y(1.0, kHeight - 1.0), yaw(-3, 3);
   int compared = 0;
   for (int i = 0; i < 50; ++i) {
-    const Pose2 truth(x(rng), y(rng), yaw(rng));
+    const Pose2 truth = DrawPose(rng, x, y, yaw);
     const Pose2 placed(truth.x() + 1.5, truth.y(), truth.theta());
     const LaserScan scan = RoomScan(truth);
     int expected = 0, ambiguous = 0, rays = 0;

@@ -258,6 +258,27 @@ double BlindStretchBound::bound_m() const {
   return std::sqrt(ChiSquareQuantile(0.99, 2) * std::max(eig.eigenvalues()[1], 0.0));
 }
 
+void WallCrossings::Add(const std::vector<Eigen::Vector2d>& crossed) {
+  std::vector<std::pair<int, int>> squares;
+  squares.reserve(crossed.size());
+  for (const Eigen::Vector2d& p : crossed) {
+    squares.emplace_back(static_cast<int>(std::floor(p.x() / kBinM)),
+                         static_cast<int>(std::floor(p.y() / kBinM)));
+  }
+  std::sort(squares.begin(), squares.end());
+  squares.erase(std::unique(squares.begin(), squares.end()), squares.end());
+  for (const auto& square : squares) ++counts_[square];
+  window_.push_back(std::move(squares));
+  if (static_cast<int>(window_.size()) > kUpdates) {
+    for (const auto& square : window_.front()) {
+      const auto it = counts_.find(square);
+      if (--it->second == 0) counts_.erase(it);
+    }
+    window_.pop_front();
+  }
+  worst_m_ = std::max(worst_m_, extent_m());
+}
+
 void HealthRecord::Add(bool lost) {
   if (lost) {
     ++lost_scans_;

@@ -416,5 +416,69 @@ TEST(HealthTest, BlindStretchBoundAgreesWithSampledPathsOnACurve) {
   EXPECT_NEAR(bound.bound_m(), sampled_bound, 0.06 * sampled_bound);
 }
 
+// A door mapped closed and seen open, crossed from one place for many updates: the same metre of
+// wall.
+TEST(HealthTest, WallCrossingsCountADoorOnce) {
+  WallCrossings crossings;
+  std::vector<Eigen::Vector2d> door;
+  for (double x = 0.01; x < 1.0; x += 0.02) door.emplace_back(5.0 + x, 2.05);
+  for (int update = 0; update < 100; ++update) {
+    crossings.Add(door);
+    EXPECT_NEAR(crossings.extent_m(), 1.0, 1e-9) << update;  // five 0.2 m squares
+  }
+}
+
+// A revisit beside the first visit crosses a new metre of the first copy's walls at every
+// update: the extent grows by a metre an update up to the window's length; the window forgets
+// it kUpdates updates later, the worst extent does not.
+TEST(HealthTest, WallCrossingsGrowAlongAWholeCopyCrossed) {
+  WallCrossings crossings;
+  for (int update = 0; update < 2 * WallCrossings::kUpdates; ++update) {
+    std::vector<Eigen::Vector2d> wall;
+    for (double x = 0.01; x < 1.0; x += 0.02) wall.emplace_back(update + x, 3.1);
+    crossings.Add(wall);
+    EXPECT_NEAR(crossings.extent_m(), std::min(update + 1, WallCrossings::kUpdates), 1e-9);
+  }
+  for (int update = 0; update < WallCrossings::kUpdates; ++update) crossings.Add({});
+  EXPECT_EQ(crossings.extent_m(), 0.0);
+  EXPECT_NEAR(crossings.worst_m(), WallCrossings::kUpdates, 1e-9);
+}
+
+// The extent is the distinct squares crossed over the last kUpdates updates, counted afresh.
+TEST(HealthTest, WallCrossingsAreTheWindowsDistinctSquaresOnRandomRuns) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> coordinate(-3.0, 3.0);
+  std::uniform_int_distribution<int> count(0, 30);
+  for (int run = 0; run < 8; ++run) {
+    WallCrossings crossings;
+    std::vector<std::vector<Eigen::Vector2d>> updates;
+    double worst = 0.0;
+    for (int update = 0; update < 120; ++update) {
+      std::vector<Eigen::Vector2d> points(static_cast<std::size_t>(count(rng)));
+      for (auto& p : points) {
+        p.x() = coordinate(rng);
+        p.y() = coordinate(rng);
+      }
+      crossings.Add(points);
+      updates.push_back(points);
+      std::vector<std::pair<long, long>> squares;
+      const std::size_t from =
+          updates.size() > WallCrossings::kUpdates ? updates.size() - WallCrossings::kUpdates : 0;
+      for (std::size_t u = from; u < updates.size(); ++u) {
+        for (const auto& p : updates[u]) {
+          squares.emplace_back(std::lround(std::floor(p.x() / WallCrossings::kBinM)),
+                               std::lround(std::floor(p.y() / WallCrossings::kBinM)));
+        }
+      }
+      std::sort(squares.begin(), squares.end());
+      const auto distinct = std::unique(squares.begin(), squares.end()) - squares.begin();
+      const double expected = static_cast<double>(distinct) * WallCrossings::kBinM;
+      worst = std::max(worst, expected);
+      ASSERT_NEAR(crossings.extent_m(), expected, 1e-9) << run << " " << update;
+      ASSERT_NEAR(crossings.worst_m(), worst, 1e-9);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace slamrig::slam

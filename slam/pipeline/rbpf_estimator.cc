@@ -45,12 +45,19 @@ ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
   if (step.odometry_rejected || scan.odometry_gap_s > filter_.options().odometry_gap_s) {
     wheels_.Reset();
   }
-  // The best map against its own scan: the share of rays crossing a wall it holds (a health
-  // value only; docs/studies/see-through.md measures why it is no lost rule).
+  // The best map against its own scan: the share of its rays crossing a wall the map holds, and
+  // the extent of wall crossed over the last updates (WallCrossings: what a map written twice
+  // shows). Health values, not judged (docs/studies/see-through.md).
   if (step.updated && !filter_.particles().empty()) {
-    see_through_ = CountSeeThrough(filter_.best().map, scan.scan, step.best_pose,
-                                   SparseScanRange(scan.scan, filter_.options().points), {})
+    const TiledGrid& best_map = filter_.best().map;
+    std::vector<Eigen::Array2i> cells;
+    see_through_ = CountSeeThrough(best_map, scan.scan, step.best_pose,
+                                   SparseScanRange(scan.scan, filter_.options().points), {}, &cells)
                        .fraction();
+    std::vector<Eigen::Vector2d> crossed;
+    crossed.reserve(cells.size());
+    for (const Eigen::Array2i& cell : cells) crossed.push_back(best_map.CellCenter(cell));
+    wall_crossings_.Add(crossed);
   }
   const bool contradicts =
       wheels_.Judge(scan.scan, scan.increment, estimate_increment, step.updated);
@@ -64,7 +71,8 @@ ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
                          {"matched_fraction", step.matched_fraction},
                          {"matched_fraction_ratio", matched_ratio_.ratio()},
                          {"failed_match_share", step.failed_matches / particles},
-                         {"see_through_fraction", see_through_}},
+                         {"see_through_fraction", see_through_},
+                         {"wall_crossed_m", wall_crossings_.extent_m()}},
                         std::nullopt,
                         lost_ || contradicts};
   wheels_.AppendTrace(&estimate.trace);
@@ -94,8 +102,8 @@ const OccupancyGrid& RbpfEstimator::map() const {
 const std::vector<std::string>& RbpfEstimator::StatisticNames() {
   static const std::vector<std::string> names = WheelCheck::WithStatisticNames(
       {"mean_neff", "resamples", "updates", "failed_matches", "odometry_rejections",
-       "gap_corrections", "mean_weight_exponent", "map_tiles", "map_tiles_per_particle", "lost",
-       "diverged"});
+       "gap_corrections", "mean_weight_exponent", "map_tiles", "map_tiles_per_particle",
+       "wall_crossed_m", "lost", "diverged"});
   return names;
 }
 
@@ -115,6 +123,7 @@ std::map<std::string, double> RbpfEstimator::Statistics() const {
        filter_.particles().empty()
            ? 0.0
            : static_cast<double>(tiles) / static_cast<double>(filter_.particles().size())},
+      {"wall_crossed_m", wall_crossings_.worst_m()},
       {"lost", health_.losses()},
       {"diverged", Diverged() ? 1.0 : 0.0}};
   wheels_.AppendStatistics(&statistics);

@@ -52,6 +52,7 @@ class RbpfEstimator final : public Estimator {
   QualityRatio matched_ratio_{0.3, 0.02, 20, 0.5};
   bool lost_ = false;         // at the last update; held between updates
   double see_through_ = 0.0;  // at the last update
+  WallCrossings wall_crossings_;
   HealthRecord health_;
   WheelCheck wheels_;
   mutable OccupancyGrid map_;
