@@ -171,8 +171,8 @@ double WheelAgreement::TurnWindow::net_difference_rad(double drift_rad_per_m) co
   return travel_m_ >= kHeadingWindowM ? difference_rad() - drift_rad_per_m * travel_m_ : 0.0;
 }
 
+// A window that is not full has no net difference, so it is never contradicted.
 bool WheelAgreement::TurnWindow::Contradicted(double drift_rad_per_m) const {
-  if (travel_m_ < kHeadingWindowM) return false;
   return std::abs(net_difference_rad(drift_rad_per_m)) >
          kHeadingToleranceRad + kHeadingSkidShare * wheels_abs_rad_;
 }
