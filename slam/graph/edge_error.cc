@@ -41,12 +41,14 @@ Eigen::Vector3d EdgeError(const PoseGraph& graph, const PoseGraphEdge& edge) {
       .error;
 }
 
+double EdgeChi2(const PoseGraph& graph, const PoseGraphEdge& edge) {
+  const Eigen::Vector3d e = EdgeError(graph, edge);
+  return e.dot(edge.information * e);
+}
+
 double Chi2(const PoseGraph& graph) {
   double chi2 = 0.0;
-  for (const PoseGraphEdge& edge : graph.edges()) {
-    const Eigen::Vector3d e = EdgeError(graph, edge);
-    chi2 += e.dot(edge.information * e);
-  }
+  for (const PoseGraphEdge& edge : graph.edges()) chi2 += EdgeChi2(graph, edge);
   return chi2;
 }
 

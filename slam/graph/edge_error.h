@@ -27,6 +27,12 @@ EdgeErrorResult EvaluateEdgeError(const Eigen::Vector3d& xi, const Eigen::Vector
 /// The error of `edge` at the graph's current poses.
 Eigen::Vector3d EdgeError(const PoseGraph& graph, const PoseGraphEdge& edge);
 
+/// e^T Omega e of `edge` at the graph's current poses.
+double EdgeChi2(const PoseGraph& graph, const PoseGraphEdge& edge);
+
+/// The 99 % quantile of chi2 with 3 degrees of freedom: an edge above it is strained.
+inline constexpr double kEdgeChi2P99 = 11.3449;
+
 /// g2o's chi2 of the whole graph at its current poses: sum of e^T Omega e over all edges.
 double Chi2(const PoseGraph& graph);
 

@@ -14,6 +14,7 @@
 
 #include "slam/eval/chi_square.h"
 #include "slam/graph/edge_error.h"
+#include "slam/graph/odometry_release.h"
 #include "slam/graph/optimality_certificate.h"
 #include "slam/matching/correlative_matcher.h"
 #include "slam/matching/grid_view.h"
@@ -25,19 +26,6 @@
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
-namespace {
-
-// chi2 with 3 degrees of freedom: its 99 % quantile.
-constexpr double kChi2Dof3P99 = 11.3449;
-
-// An edge's chi2 at the graph's current poses.
-double EdgeChi2(const PoseGraph& graph, const PoseGraphEdge& edge) {
-  const Eigen::Vector3d error = EdgeError(graph, edge);
-  return error.dot(edge.information * error);
-}
-
-}  // namespace
-
 std::vector<std::string> GraphSlamOptions::Validate() const {
   Rules rules;
   const std::string prefix = "icp_odometry.";
@@ -82,6 +70,8 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
       .Positive("loop_sigma_xy_floor_m", loop_sigma_xy_floor_m)
       .Positive("loop_sigma_yaw_floor_rad", loop_sigma_yaw_floor_rad)
       .AtLeast("optimize_every_keyframes", optimize_every_keyframes, 1)
+      .InRange("released_edge_information_scale", released_edge_information_scale, 0.0, 1.0,
+               Ends::kOpenLow)
       .Fraction("diverged_strained_share", diverged_strained_share)
       .Nested("optimizer", optimizer.Validate())
       .InRange("threads", num_threads, 0, 1024);
@@ -174,9 +164,27 @@ void GraphSlam::Finish() {
   JudgeConsistency();
 }
 
+bool GraphSlam::ReleaseWrongOdometryEdge() {
+  OdometryReleaseOptions release_options;
+  release_options.optimizer = options_.optimizer;
+  release_options.information_scale = options_.released_edge_information_scale;
+  const std::optional<OdometryRelease> release = slam::ReleaseWrongOdometryEdge(
+      &graph_, release_options,
+      [this](std::size_t e) { return !released_.contains(graph_.edges()[e].to); });
+  if (!release) return false;
+  released_.insert(graph_.edges()[release->edge].to);
+  edge_variances_[release->edge] /= options_.released_edge_information_scale;
+  ++counts_.released_odometry;
+  counts_.final_chi2 = release->summary.final_chi2;
+  switches_ = release->summary.switches;
+  ++counts_.optimizations;
+  return true;
+}
+
 void GraphSlam::DropStrainedClosures() {
   while (true) {
-    double worst = kChi2Dof3P99;
+    if (options_.release_wrong_odometry && ReleaseWrongOdometryEdge()) continue;
+    double worst = kEdgeChi2P99;
     std::optional<std::size_t> worst_closure;
     for (std::size_t i = 0; i < closures_.size(); ++i) {
       const std::size_t e = closure_edges_[i];
@@ -231,7 +239,7 @@ void GraphSlam::JudgeConsistency() {
     ++kept;
     const double edge_chi2 = EdgeChi2(graph_, edges[e]);
     chi2 += edge_chi2;
-    strained_[e] = edge_chi2 > kChi2Dof3P99;
+    strained_[e] = edge_chi2 > kEdgeChi2P99;
     strained += strained_[e];
   }
   counts_.strained_edges = strained;

@@ -15,6 +15,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -55,6 +56,11 @@ struct GraphSlamCounts {
   /// chi2 above chi2_3's 99 % quantile): the rest of the graph, every other closure included,
   /// contradicts them; they no longer count as loop closures.
   int dropped_strained = 0;
+  /// At Finish(), before any closure is dropped: odometry edges (the front end's) released
+  /// because, wrong, each explained two or more strained closures at once; their information is
+  /// scaled down by released_edge_information_scale, so the closures place the nodes on each
+  /// side. Each is a front-end failure the back end repaired.
+  int released_odometry = 0;
   /// After Finish(): whether the final graph's solution is certified globally optimal
   /// (optimality_certificate.h) for the graph with every robust edge weighted by its final
   /// robust-loss weight, and the certificate matrix's smallest eigenvalue (NaN before Finish()
@@ -168,6 +174,9 @@ class GraphSlam {
   // Takes out, one at a time and re-optimising after each, the closure the optimum leaves most
   // strained, while one is.
   void DropStrainedClosures();
+  // Releases an odometry edge that, wrong, strains two or more closures (odometry_release.h),
+  // each edge at most once; true when it did.
+  bool ReleaseWrongOdometryEdge();
   // Takes closure `i` (of closures_) out of the graph.
   void RemoveClosure(std::size_t i);
   // Rebuilds the graph with its vertices (at their current estimates) and the edges `keep`
@@ -189,6 +198,7 @@ class GraphSlam {
   std::vector<std::size_t> closure_edges_;  // graph edge of each closure
   std::vector<double> switches_;            // of each graph edge, from the last optimisation
   std::vector<bool> strained_;              // of each graph edge, after Finish()
+  std::set<int> released_;                  // the `to` node of each released odometry edge
   GraphSlamCounts counts_;
   IcpOdometryStep last_step_;
   OdometryChain chain_;  // the odometry edges alone, for pairwise consistency

@@ -134,6 +134,17 @@ struct GraphSlamOptions {
   /// (pairwise consistency needs two): a corridor's start corner, seen half from the start,
   /// matched from the other side.
   bool loop_drop_strained = true;
+  /// Before each closure is dropped (with loop_drop_strained): a front-end edge that is grossly
+  /// wrong (an alias one door along a corridor, a turn taken the wrong way) strains every closure
+  /// that spans it, and the robust loss on the closures alone makes the wrong edge the cheaper
+  /// explanation: the closures are given up one by one and the error stays. While two or more
+  /// closures are strained, an odometry edge that a solve with the robust loss on every edge
+  /// leaves more than ten standard deviations off is released (its information times
+  /// released_edge_information_scale, its measurement kept) when that reconciles at least two of
+  /// the strained closures and at least half of them (slam/graph/odometry_release.h). A single
+  /// strained closure is never traded for an edge: it is dropped. Counted as released_odometry.
+  bool release_wrong_odometry = true;
+  double released_edge_information_scale = 1e-4;
   /// The loop edge's covariance: ICP's, raised to at least these standard deviations.
   double loop_sigma_xy_floor_m = 0.02;
   double loop_sigma_yaw_floor_rad = 0.005;
@@ -199,6 +210,8 @@ void VisitFields(V& v, GraphSlamOptions& o) {
          {{LoopConsistency::kNone, "none"}, {LoopConsistency::kPairwise, "pairwise"}});
   v("loop_pairwise_chi2", o.loop_pairwise_chi2);
   v("loop_drop_strained", o.loop_drop_strained);
+  v("release_wrong_odometry", o.release_wrong_odometry);
+  v("released_edge_information_scale", o.released_edge_information_scale);
   v("loop_sigma_xy_floor_m", o.loop_sigma_xy_floor_m);
   v("loop_sigma_yaw_floor_rad", o.loop_sigma_yaw_floor_rad);
   v("optimize_every_keyframes", o.optimize_every_keyframes);

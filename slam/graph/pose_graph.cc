@@ -12,15 +12,29 @@ void PoseGraph::AddVertex(int id, const Pose2& pose, bool fixed) {
   vertices_.push_back({.id = id, .pose = pose, .fixed = fixed});
 }
 
+namespace {
+
+bool SymmetricPositiveDefinite(const Eigen::Matrix3d& m) {
+  return m.allFinite() && m.isApprox(m.transpose()) &&
+         Eigen::LLT<Eigen::Matrix3d>(m).info() == Eigen::Success;
+}
+
+}  // namespace
+
 void PoseGraph::AddEdge(const PoseGraphEdge& edge) {
   SLAMRIG_CHECK(HasVertex(edge.from) && HasVertex(edge.to),
                 "PoseGraph::AddEdge: edge to a vertex that was never added");
   SLAMRIG_CHECK(edge.from != edge.to, "PoseGraph::AddEdge: edge from a vertex to itself");
-  SLAMRIG_CHECK(edge.information.allFinite() &&
-                    edge.information.isApprox(edge.information.transpose()) &&
-                    Eigen::LLT<Eigen::Matrix3d>(edge.information).info() == Eigen::Success,
+  SLAMRIG_CHECK(SymmetricPositiveDefinite(edge.information),
                 "PoseGraph::AddEdge: information is not symmetric positive definite");
   edges_.push_back(edge);
+}
+
+void PoseGraph::SetEdgeInformation(std::size_t k, const Eigen::Matrix3d& information) {
+  SLAMRIG_CHECK(k < edges_.size(), "PoseGraph::SetEdgeInformation: no such edge");
+  SLAMRIG_CHECK(SymmetricPositiveDefinite(information),
+                "PoseGraph::SetEdgeInformation: information is not symmetric positive definite");
+  edges_[k].information = information;
 }
 
 std::size_t PoseGraph::IndexOf(int id) const {

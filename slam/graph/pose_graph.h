@@ -43,6 +43,8 @@ class PoseGraph {
   /// symmetric positive definite (SLAMRIG_CHECK; the readers reject such input with a
   /// ParseError before it gets here).
   void AddEdge(const PoseGraphEdge& edge);
+  /// Replaces the information matrix of edges()[k] (same SLAMRIG_CHECKs as AddEdge).
+  void SetEdgeInformation(std::size_t k, const Eigen::Matrix3d& information);
 
   bool HasVertex(int id) const { return index_.count(id) != 0; }
   /// Index of vertex `id` in vertices() (SLAMRIG_CHECK that it exists).
