@@ -168,9 +168,20 @@ bool GraphSlam::ReleaseWrongOdometryEdge() {
   OdometryReleaseOptions release_options;
   release_options.optimizer = options_.optimizer;
   release_options.information_scale = options_.released_edge_information_scale;
-  const std::optional<OdometryRelease> release = slam::ReleaseWrongOdometryEdge(
-      &graph_, release_options,
-      [this](std::size_t e) { return !released_.contains(graph_.edges()[e].to); });
+  auto eligible = [this](std::size_t e) { return !released_.contains(graph_.edges()[e].to); };
+  // As for the odometry check's re-match: the released edge's distance stays within the wheels'
+  // confidence, or within the front end's own distance from them.
+  auto plausible = [this](std::size_t e, const Pose2& relative) {
+    if (options_.odometry_check_wheel_confidence >= 1.0) return true;
+    const PoseGraphEdge& edge = graph_.edges()[e];
+    const WheelMotion& wheels = nodes_[static_cast<std::size_t>(edge.to)].wheels;
+    const double allowed =
+        std::max(WheelChi2(wheels, edge.measurement),
+                 ChiSquareQuantile(options_.odometry_check_wheel_confidence, 1.0));
+    return WheelChi2(wheels, relative) <= allowed;
+  };
+  const std::optional<OdometryRelease> release =
+      slam::ReleaseWrongOdometryEdge(&graph_, release_options, eligible, plausible);
   if (!release) return false;
   released_.insert(graph_.edges()[release->edge].to);
   edge_variances_[release->edge] /= options_.released_edge_information_scale;
@@ -297,7 +308,7 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
                         const std::optional<Eigen::Vector2d>& blind_noise,
                         const WheelMotion& wheels, std::vector<Eigen::Vector2d> points) {
   const int id = static_cast<int>(nodes_.size());
-  Node node{scan, odom_pose, std::move(points), Eigen::Vector2d::Zero(), Pose2()};
+  Node node{scan, odom_pose, std::move(points), Eigen::Vector2d::Zero(), Pose2(), wheels};
   if (nodes_.empty()) {
     graph_.AddVertex(id, Pose2(), /*fixed=*/true);
   } else {
@@ -330,6 +341,15 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
   }
   nodes_.push_back(std::move(node));
   ++counts_.keyframes;
+}
+
+double GraphSlam::WheelChi2(const WheelMotion& wheels, const Pose2& relative) {
+  auto signed_distance = [](const Pose2& p) {
+    return std::copysign(p.translation().norm(), p.translation().x());
+  };
+  const double sxy = std::max(wheels.sigmas.x(), 1e-6);
+  const double e = signed_distance(relative) - signed_distance(wheels.relative);
+  return e * e / (sxy * sxy);
 }
 
 Pose2 GraphSlam::CheckedRelative(const Pose2& icp_relative, const Pose2& alternative, bool doubtful,
@@ -373,14 +393,7 @@ Pose2 GraphSlam::CheckedRelative(const Pose2& icp_relative, const Pose2& alterna
   // puts it off by tenths of a radian where the re-match is right. Distances are signed, forwards
   // or backwards in the previous node's frame: a re-match two node spacings back is as far as the
   // wheels say, the wrong way.
-  auto signed_distance = [](const Pose2& p) {
-    return std::copysign(p.translation().norm(), p.translation().x());
-  };
-  auto wheel_chi2 = [&](const Pose2& p) {
-    const double sxy = std::max(wheels.sigmas.x(), 1e-6);
-    const double e = signed_distance(p) - signed_distance(wheels.relative);
-    return e * e / (sxy * sxy);
-  };
+  auto wheel_chi2 = [&](const Pose2& p) { return WheelChi2(wheels, p); };
   const double allowed_chi2 =
       options_.odometry_check_wheel_confidence >= 1.0
           ? std::numeric_limits<double>::infinity()

@@ -131,6 +131,12 @@ class GraphSlam {
   bool last_scan_is_node() const { return last_scan_is_node_; }
 
  private:
+  // The wheels' motion between two nodes and its noise (sigma xy, sigma yaw), for the odometry
+  // check: a re-match may not stray from it further than ICP odometry's own pose did.
+  struct WheelMotion {
+    Pose2 relative;
+    Eigen::Vector2d sigmas{0, 0};
+  };
   struct Node {
     int scan = 0;                         // index of its scan
     Pose2 odom_pose;                      // IcpOdometry's pose
@@ -139,13 +145,11 @@ class GraphSlam {
     // checked^-1 * ICP relative of the edge from the previous node: the identity unless the
     // odometry check re-placed it, when it carries the next edge over from the previous node.
     Pose2 rematch_offset;
+    WheelMotion wheels;  // since the previous node
   };
-  // The wheels' motion between two nodes and its noise (sigma xy, sigma yaw), for the odometry
-  // check: a re-match may not stray from it further than ICP odometry's own pose did.
-  struct WheelMotion {
-    Pose2 relative;
-    Eigen::Vector2d sigmas{0, 0};
-  };
+  // The squared difference, in the wheels' sigma, between the signed distance (forwards or
+  // backwards in the previous node's frame) of `relative` and of the wheels' motion.
+  static double WheelChi2(const WheelMotion& wheels, const Pose2& relative);
   // Waits until the back end has placed every node decided so far; rethrows what it threw.
   void JoinBackEnd() const;
   // Variances (xy, yaw) along the least uncertain graph path from the newest node to every node.

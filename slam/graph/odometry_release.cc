@@ -7,17 +7,28 @@
 #include "slam/graph/edge_error.h"
 
 namespace slamrig::slam {
-int CountStrainedClosures(const PoseGraph& graph) {
+namespace {
+
+// The edges of `kind` other than `except` whose chi2 is above chi2_3's 99 % quantile.
+int CountStrained(const PoseGraph& graph, EdgeKind kind, std::size_t except) {
   int strained = 0;
-  for (const PoseGraphEdge& edge : graph.edges()) {
-    strained += edge.kind == EdgeKind::kLoopClosure && EdgeChi2(graph, edge) > kEdgeChi2P99;
+  for (std::size_t k = 0; k < graph.edges().size(); ++k) {
+    const PoseGraphEdge& edge = graph.edges()[k];
+    strained += k != except && edge.kind == kind && EdgeChi2(graph, edge) > kEdgeChi2P99;
   }
   return strained;
 }
 
+}  // namespace
+
+int CountStrainedClosures(const PoseGraph& graph) {
+  return CountStrained(graph, EdgeKind::kLoopClosure, graph.edges().size());
+}
+
 std::optional<OdometryRelease> ReleaseWrongOdometryEdge(
     PoseGraph* graph, const OdometryReleaseOptions& options,
-    const std::function<bool(std::size_t)>& eligible) {
+    const std::function<bool(std::size_t)>& eligible,
+    const std::function<bool(std::size_t, const Pose2&)>& plausible) {
   const int strained_before = CountStrainedClosures(*graph);
   if (strained_before < std::max(options.min_reconciled, 1)) return std::nullopt;
   // From the graph's poses a robust loss keeps what it has (the closures given up), so the trial
@@ -54,8 +65,14 @@ std::optional<OdometryRelease> ReleaseWrongOdometryEdge(
     release.strained_before = strained_before;
     release.strained_after = CountStrainedClosures(released);
     const int reconciled = release.strained_before - release.strained_after;
-    if (reconciled >= options.min_reconciled &&
-        reconciled >= options.min_reconciled_share * release.strained_before) {
+    const PoseGraphEdge& edge = released.edges()[k];
+    // The strain must be gone, not moved onto another front-end edge (a solve that pulls two
+    // identical rooms onto each other strains the edge between them).
+    const bool moved = CountStrained(released, EdgeKind::kOdometry, k) >
+                       CountStrained(*graph, EdgeKind::kOdometry, k);
+    if (!moved && reconciled >= options.min_reconciled &&
+        reconciled >= options.min_reconciled_share * release.strained_before &&
+        plausible(k, released.pose(edge.from).Between(released.pose(edge.to)))) {
       *graph = std::move(released);
       return release;
     }

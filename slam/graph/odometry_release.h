@@ -40,17 +40,24 @@ struct OdometryReleaseOptions {
 /// room) is an odometry edge that is wrong by metres; every loop closure that spans it is then
 /// strained, and a robust loss on the closures alone makes the wrong edge the cheaper explanation
 /// (the closures are given up one by one, the error stays). With at least two loop closures
-/// strained (chi2 above chi2_3's 99 % quantile) at the graph's current poses, this solves once with
-/// the robust loss on every edge (a single gross error then concentrates on its own edge), takes
+/// strained (chi2 above chi2_3's 99 % quantile) at the graph's current poses, this solves without a
+/// robust loss and then with one on every edge (a gross error then concentrates on its own edge),
+/// takes
 /// the odometry edges left above min_candidate_chi2 there as candidates, and for each releases it
 /// and re-solves from that solve's poses with `options.optimizer`; the first release that
-/// reconciles `min_reconciled` strained closures and `min_reconciled_share` of them is kept, and
+/// reconciles `min_reconciled` strained closures and `min_reconciled_share` of them, strains no
+/// more of the other odometry edges than before, and is `plausible`, is kept, and
 /// `graph` holds its solution. Several gross errors are released one call at a time. Otherwise
 /// `graph` is left as it was and the answer is empty: one strained closure is never traded for an
-/// edge. `eligible(k)` says whether edges()[k], an odometry edge, may be released.
+/// edge. `eligible(k)` says whether edges()[k], an odometry edge, may be released, and
+/// `plausible(k, relative)` whether the relative pose a release gives it (its `to` in its `from`'s
+/// frame) is one the robot's own motion allows: closures that agree with each other (two identical
+/// rooms taken for one) are explained as well by releasing the edge between them, which the
+/// wheels rule out.
 std::optional<OdometryRelease> ReleaseWrongOdometryEdge(
     PoseGraph* graph, const OdometryReleaseOptions& options,
-    const std::function<bool(std::size_t)>& eligible);
+    const std::function<bool(std::size_t)>& eligible,
+    const std::function<bool(std::size_t, const Pose2&)>& plausible);
 
 /// The loop-closure edges (kind kLoopClosure) whose chi2 at the graph's poses is above chi2_3's
 /// 99 % quantile (11.34).

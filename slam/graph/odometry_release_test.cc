@@ -81,6 +81,7 @@ double MaxPositionError(const PoseGraph& graph) {
 }
 
 auto Any = [](std::size_t) { return true; };
+auto Anywhere = [](std::size_t, const Pose2&) { return true; };
 
 TEST(OdometryReleaseTest, FindsTheOneWrongOdometryEdgeWhereverItIs) {
   OdometryReleaseOptions options;
@@ -93,7 +94,7 @@ TEST(OdometryReleaseTest, FindsTheOneWrongOdometryEdgeWhereverItIs) {
     ASSERT_GE(CountStrainedClosures(laps.graph), 2) << "edge from " << wrong;
     ASSERT_GT(MaxPositionError(laps.graph), 0.5) << "edge from " << wrong;
     const std::optional<OdometryRelease> release =
-        ReleaseWrongOdometryEdge(&laps.graph, options, Any);
+        ReleaseWrongOdometryEdge(&laps.graph, options, Any, Anywhere);
     ASSERT_TRUE(release.has_value()) << "edge from " << wrong;
     EXPECT_EQ(release->edge, laps.wrong_edge) << "edge from " << wrong;
     EXPECT_EQ(release->strained_after, 0);
@@ -107,7 +108,7 @@ TEST(OdometryReleaseTest, ReleasesTwoWrongEdgesOneCallAtATime) {
   options.optimizer = BackEnd();
   TwoLaps laps = MakeTwoLaps(kLap + 6, -1, 21, /*second_wrong_odometry=*/kLap + 15);
   int released = 0;
-  while (ReleaseWrongOdometryEdge(&laps.graph, options, Any)) ++released;
+  while (ReleaseWrongOdometryEdge(&laps.graph, options, Any, Anywhere)) ++released;
   EXPECT_EQ(released, 2);
   EXPECT_EQ(CountStrainedClosures(laps.graph), 0);
   EXPECT_LT(MaxPositionError(laps.graph), 0.02);
@@ -119,14 +120,36 @@ TEST(OdometryReleaseTest, AnEdgeNotEligibleIsNotReleased) {
   TwoLaps laps = MakeTwoLaps(kLap + 10, -1, 3);
   const PoseGraph before = laps.graph;
   const std::size_t wrong = laps.wrong_edge;
-  const std::optional<OdometryRelease> release =
-      ReleaseWrongOdometryEdge(&laps.graph, options, [wrong](std::size_t k) { return k != wrong; });
+  const std::optional<OdometryRelease> release = ReleaseWrongOdometryEdge(
+      &laps.graph, options, [wrong](std::size_t k) { return k != wrong; }, Anywhere);
   // Any other edge released reconciles fewer closures than needed, or none is tried.
   if (release) {
     EXPECT_NE(release->edge, wrong);
   } else {
     EXPECT_EQ(Chi2(laps.graph), Chi2(before));
   }
+}
+
+TEST(OdometryReleaseTest, NoReleaseTheRobotsOwnMotionRulesOut) {
+  OdometryReleaseOptions options;
+  options.optimizer = BackEnd();
+  TwoLaps laps = MakeTwoLaps(kLap + 10, -1, 3);
+  const PoseGraph before = laps.graph;
+  const std::size_t wrong = laps.wrong_edge;
+  const Pose2 truth = Truth(kLap + 10).Between(Truth(kLap + 11));
+  std::vector<std::size_t> asked;
+  auto never = [&](std::size_t k, const Pose2& relative) {
+    asked.push_back(k);
+    // The release gives the wrong edge its true relative pose back.
+    if (k == wrong) {
+      EXPECT_LT((relative.translation() - truth.translation()).norm(), 0.02);
+    }
+    return false;
+  };
+  EXPECT_FALSE(ReleaseWrongOdometryEdge(&laps.graph, options, Any, never).has_value());
+  ASSERT_FALSE(asked.empty());
+  EXPECT_EQ(asked.front(), wrong);
+  EXPECT_EQ(Chi2(laps.graph), Chi2(before));
 }
 
 TEST(OdometryReleaseTest, NeverTradesASingleStrainedClosureForAnEdge) {
@@ -136,7 +159,7 @@ TEST(OdometryReleaseTest, NeverTradesASingleStrainedClosureForAnEdge) {
     TwoLaps laps = MakeTwoLaps(-1, node, 11);
     ASSERT_EQ(CountStrainedClosures(laps.graph), 1) << "closure at " << node;
     const PoseGraph before = laps.graph;
-    EXPECT_FALSE(ReleaseWrongOdometryEdge(&laps.graph, options, Any).has_value());
+    EXPECT_FALSE(ReleaseWrongOdometryEdge(&laps.graph, options, Any, Anywhere).has_value());
     for (std::size_t i = 0; i < before.vertices().size(); ++i) {
       EXPECT_EQ(laps.graph.vertices()[i].pose.x(), before.vertices()[i].pose.x());
     }
@@ -148,7 +171,7 @@ TEST(OdometryReleaseTest, LeavesAConsistentGraphAlone) {
   options.optimizer = BackEnd();
   TwoLaps laps = MakeTwoLaps(-1, -1, 5);
   EXPECT_EQ(CountStrainedClosures(laps.graph), 0);
-  EXPECT_FALSE(ReleaseWrongOdometryEdge(&laps.graph, options, Any).has_value());
+  EXPECT_FALSE(ReleaseWrongOdometryEdge(&laps.graph, options, Any, Anywhere).has_value());
   EXPECT_LT(MaxPositionError(laps.graph), 0.02);
 }
 
