@@ -169,16 +169,11 @@ bool GraphSlam::ReleaseWrongOdometryEdge() {
   release_options.optimizer = options_.optimizer;
   release_options.information_scale = options_.released_edge_information_scale;
   auto eligible = [this](std::size_t e) { return !released_.contains(graph_.edges()[e].to); };
-  // As for the odometry check's re-match: the released edge's distance stays within the wheels'
-  // confidence, or within the front end's own distance from them.
+  // As for the odometry check's re-match: the wheels must allow the released edge's distance.
   auto plausible = [this](std::size_t e, const Pose2& relative) {
-    if (options_.odometry_check_wheel_confidence >= 1.0) return true;
     const PoseGraphEdge& edge = graph_.edges()[e];
-    const WheelMotion& wheels = nodes_[static_cast<std::size_t>(edge.to)].wheels;
-    const double allowed =
-        std::max(WheelChi2(wheels, edge.measurement),
-                 ChiSquareQuantile(options_.odometry_check_wheel_confidence, 1.0));
-    return WheelChi2(wheels, relative) <= allowed;
+    return WheelsAllow(nodes_[static_cast<std::size_t>(edge.to)].wheels, edge.measurement,
+                       relative);
   };
   const std::optional<OdometryRelease> release =
       slam::ReleaseWrongOdometryEdge(&graph_, release_options, eligible, plausible);
@@ -343,13 +338,20 @@ void GraphSlam::AddNode(int scan, const Pose2& odom_pose, bool doubtful,
   ++counts_.keyframes;
 }
 
-double GraphSlam::WheelChi2(const WheelMotion& wheels, const Pose2& relative) {
+bool GraphSlam::WheelsAllow(const WheelMotion& wheels, const Pose2& front_end,
+                            const Pose2& relative) const {
+  if (options_.odometry_check_wheel_confidence >= 1.0) return true;
   auto signed_distance = [](const Pose2& p) {
     return std::copysign(p.translation().norm(), p.translation().x());
   };
-  const double sxy = std::max(wheels.sigmas.x(), 1e-6);
-  const double e = signed_distance(relative) - signed_distance(wheels.relative);
-  return e * e / (sxy * sxy);
+  auto wheel_chi2 = [&](const Pose2& p) {
+    const double sxy = std::max(wheels.sigmas.x(), 1e-6);
+    const double e = signed_distance(p) - signed_distance(wheels.relative);
+    return e * e / (sxy * sxy);
+  };
+  const double allowed = std::max(wheel_chi2(front_end),
+                                  ChiSquareQuantile(options_.odometry_check_wheel_confidence, 1.0));
+  return wheel_chi2(relative) <= allowed;
 }
 
 Pose2 GraphSlam::CheckedRelative(const Pose2& icp_relative, const Pose2& alternative, bool doubtful,
@@ -393,13 +395,7 @@ Pose2 GraphSlam::CheckedRelative(const Pose2& icp_relative, const Pose2& alterna
   // puts it off by tenths of a radian where the re-match is right. Distances are signed, forwards
   // or backwards in the previous node's frame: a re-match two node spacings back is as far as the
   // wheels say, the wrong way.
-  auto wheel_chi2 = [&](const Pose2& p) { return WheelChi2(wheels, p); };
-  const double allowed_chi2 =
-      options_.odometry_check_wheel_confidence >= 1.0
-          ? std::numeric_limits<double>::infinity()
-          : std::max(wheel_chi2(icp_relative),
-                     ChiSquareQuantile(options_.odometry_check_wheel_confidence, 1.0));
-  auto plausible = [&](const Pose2& p) { return wheel_chi2(p) <= allowed_chi2; };
+  auto plausible = [&](const Pose2& p) { return WheelsAllow(wheels, icp_relative, p); };
   Pose2 relative = icp_relative;
   double best_score = RasterScore(raster, query, relative);
   if (!(alternative == icp_relative) && plausible(alternative)) {

@@ -147,9 +147,12 @@ class GraphSlam {
     Pose2 rematch_offset;
     WheelMotion wheels;  // since the previous node
   };
-  // The squared difference, in the wheels' sigma, between the signed distance (forwards or
-  // backwards in the previous node's frame) of `relative` and of the wheels' motion.
-  static double WheelChi2(const WheelMotion& wheels, const Pose2& relative);
+  // Whether `relative`'s distance from the previous node, signed (forwards or backwards in its
+  // frame), stays within odometry_check_wheel_confidence (1 dof, the wheels' sigma) of the
+  // wheels', or no farther from it than the front end's own `front_end` relative pose: a re-match
+  // or a release may not contradict the wheels more than the front end did. Always true at
+  // confidence 1 (no wheels of the robot's own).
+  bool WheelsAllow(const WheelMotion& wheels, const Pose2& front_end, const Pose2& relative) const;
   // Waits until the back end has placed every node decided so far; rethrows what it threw.
   void JoinBackEnd() const;
   // Variances (xy, yaw) along the least uncertain graph path from the newest node to every node.

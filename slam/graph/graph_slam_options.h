@@ -143,8 +143,8 @@ struct GraphSlamOptions {
   /// released_edge_information_scale, its measurement kept) when that reconciles at least two of
   /// the strained closures and at least half of them, strains no other odometry edge, and keeps
   /// the edge's distance within odometry_check_wheel_confidence of the wheels' (as the odometry
-  /// check's re-match does; slam/graph/odometry_release.h). A single
-  /// strained closure is never traded for an edge: it is dropped. Counted as released_odometry.
+  /// check's re-match does; slam/graph/odometry_release.h). A single strained closure is never
+  /// traded for an edge: it is dropped. Counted as released_odometry.
   bool release_wrong_odometry = true;
   double released_edge_information_scale = 1e-4;
   /// The loop edge's covariance: ICP's, raised to at least these standard deviations.

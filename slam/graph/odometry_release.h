@@ -42,12 +42,11 @@ struct OdometryReleaseOptions {
 /// (the closures are given up one by one, the error stays). With at least two loop closures
 /// strained (chi2 above chi2_3's 99 % quantile) at the graph's current poses, this solves without a
 /// robust loss and then with one on every edge (a gross error then concentrates on its own edge),
-/// takes
-/// the odometry edges left above min_candidate_chi2 there as candidates, and for each releases it
-/// and re-solves from that solve's poses with `options.optimizer`; the first release that
-/// reconciles `min_reconciled` strained closures and `min_reconciled_share` of them, strains no
-/// more of the other odometry edges than before, and is `plausible`, is kept, and
-/// `graph` holds its solution. Several gross errors are released one call at a time. Otherwise
+/// takes the odometry edges left above min_candidate_chi2 there as candidates, and for each
+/// releases it and re-solves from that solve's poses with `options.optimizer`; the first release
+/// that reconciles `min_reconciled` strained closures and `min_reconciled_share` of them, strains
+/// no more of the other odometry edges than before, and is `plausible`, is kept, and `graph` holds
+/// its solution. Several gross errors are released one call at a time. Otherwise
 /// `graph` is left as it was and the answer is empty: one strained closure is never traded for an
 /// edge. `eligible(k)` says whether edges()[k], an odometry edge, may be released, and
 /// `plausible(k, relative)` whether the relative pose a release gives it (its `to` in its `from`'s

@@ -41,6 +41,13 @@ PoseGraphOptimizerOptions BackEnd() {
   return {.max_iterations = 50, .robust_loss = RobustLoss::kCauchy, .robust_loss_scale = 1.0};
 }
 
+// The release's defaults around the back end's solve.
+OdometryReleaseOptions ReleaseOptions() {
+  OdometryReleaseOptions options;
+  options.optimizer = BackEnd();
+  return options;
+}
+
 TwoLaps MakeTwoLaps(int wrong_odometry, int wrong_closure, std::uint64_t seed,
                     int second_wrong_odometry = -1) {
   std::mt19937_64 rng(seed);
@@ -84,8 +91,7 @@ auto Any = [](std::size_t) { return true; };
 auto Anywhere = [](std::size_t, const Pose2&) { return true; };
 
 TEST(OdometryReleaseTest, FindsTheOneWrongOdometryEdgeWhereverItIs) {
-  OdometryReleaseOptions options;
-  options.optimizer = BackEnd();
+  const OdometryReleaseOptions options = ReleaseOptions();
   std::mt19937_64 rng(7);
   for (int trial = 0; trial < 12; ++trial) {
     const int wrong = std::uniform_int_distribution<int>(kLap + 2, 2 * kLap - 5)(rng);
@@ -104,8 +110,7 @@ TEST(OdometryReleaseTest, FindsTheOneWrongOdometryEdgeWhereverItIs) {
 }
 
 TEST(OdometryReleaseTest, ReleasesTwoWrongEdgesOneCallAtATime) {
-  OdometryReleaseOptions options;
-  options.optimizer = BackEnd();
+  const OdometryReleaseOptions options = ReleaseOptions();
   TwoLaps laps = MakeTwoLaps(kLap + 6, -1, 21, /*second_wrong_odometry=*/kLap + 15);
   int released = 0;
   while (ReleaseWrongOdometryEdge(&laps.graph, options, Any, Anywhere)) ++released;
@@ -115,8 +120,7 @@ TEST(OdometryReleaseTest, ReleasesTwoWrongEdgesOneCallAtATime) {
 }
 
 TEST(OdometryReleaseTest, AnEdgeNotEligibleIsNotReleased) {
-  OdometryReleaseOptions options;
-  options.optimizer = BackEnd();
+  const OdometryReleaseOptions options = ReleaseOptions();
   TwoLaps laps = MakeTwoLaps(kLap + 10, -1, 3);
   const PoseGraph before = laps.graph;
   const std::size_t wrong = laps.wrong_edge;
@@ -131,8 +135,7 @@ TEST(OdometryReleaseTest, AnEdgeNotEligibleIsNotReleased) {
 }
 
 TEST(OdometryReleaseTest, NoReleaseTheRobotsOwnMotionRulesOut) {
-  OdometryReleaseOptions options;
-  options.optimizer = BackEnd();
+  const OdometryReleaseOptions options = ReleaseOptions();
   TwoLaps laps = MakeTwoLaps(kLap + 10, -1, 3);
   const PoseGraph before = laps.graph;
   const std::size_t wrong = laps.wrong_edge;
@@ -153,8 +156,7 @@ TEST(OdometryReleaseTest, NoReleaseTheRobotsOwnMotionRulesOut) {
 }
 
 TEST(OdometryReleaseTest, NeverTradesASingleStrainedClosureForAnEdge) {
-  OdometryReleaseOptions options;
-  options.optimizer = BackEnd();
+  const OdometryReleaseOptions options = ReleaseOptions();
   for (int node = kLap + 1; node < 2 * kLap; node += 5) {
     TwoLaps laps = MakeTwoLaps(-1, node, 11);
     ASSERT_EQ(CountStrainedClosures(laps.graph), 1) << "closure at " << node;
@@ -167,8 +169,7 @@ TEST(OdometryReleaseTest, NeverTradesASingleStrainedClosureForAnEdge) {
 }
 
 TEST(OdometryReleaseTest, LeavesAConsistentGraphAlone) {
-  OdometryReleaseOptions options;
-  options.optimizer = BackEnd();
+  const OdometryReleaseOptions options = ReleaseOptions();
   TwoLaps laps = MakeTwoLaps(-1, -1, 5);
   EXPECT_EQ(CountStrainedClosures(laps.graph), 0);
   EXPECT_FALSE(ReleaseWrongOdometryEdge(&laps.graph, options, Any, Anywhere).has_value());
