@@ -99,6 +99,31 @@ TEST(SelfDiagnosisTest, GraphCallsAnUnrepairedFrontEndLossDiverged) {
   EXPECT_EQ(noisy["diverged"].as<double>(), 1.0);
 }
 
+// Infinite-corridor with twice its odometry noise: at seed 2 the front end takes a turn 92 degrees
+// wrong where the scans see little, no loop closure takes it back, and the final trajectory runs
+// its two outdoor loops rotated (ATE 70 m) with every edge consistent. Its turns against the
+// wheels' say so; at seed 1 (0.52 m) they agree within the wheels' noise.
+TEST(SelfDiagnosisTest, GraphCallsATurnTheWheelsDidNotMakeDiverged) {
+  SLAMRIG_REQUIRE_DATASET(log, "carmen_corrected/infinite-corridor-corrected.log.gz");
+  testing::TempDir dir;
+  auto graph = [&](const std::string& seed) {
+    const auto run = testing::RunCommand(
+        std::string(SLAMRIG_BINARY) + " slam " + log + " --algorithm graph --quiet --seed " + seed +
+        " --perturb odometry.noise_per_m=0.0660 --perturb odometry.noise_per_rad=0.1212" +
+        " --perturb scans.drop_fraction=0.1 --out " + dir.File(seed));
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    return YAML::LoadFile(dir.File(seed + "/metrics.json"))["configs"]["graph"];
+  };
+  const YAML::Node good = graph("1");
+  EXPECT_LT(good["ate_rmse_m"].as<double>(), 1.0);
+  EXPECT_EQ(good["wheel_heading_contradiction_rad"].as<double>(), 0.0);
+  EXPECT_EQ(good["diverged"].as<double>(), 0.0);
+  const YAML::Node failed = graph("2");
+  EXPECT_GT(failed["ate_rmse_m"].as<double>(), 1.0);  // the failure the verdict must see
+  EXPECT_GT(failed["wheel_heading_contradiction_rad"].as<double>(), 1.0);
+  EXPECT_EQ(failed["diverged"].as<double>(), 1.0);
+}
+
 // Seattle's log has no ODOM line for 3 s while the robot turns 1.4 rad on the spot: the reader
 // says so, the synchroniser hands the next scan the odometry's silence, and the pf and the rbpf
 // search every heading near by after it (metrics.json's gap_corrections), as ICP odometry does

@@ -27,7 +27,10 @@ GraphSlamOptions GraphOptions(const GraphSlamEstimatorOptions& options,
 
 GraphSlamEstimator::GraphSlamEstimator(const GraphSlamEstimatorOptions& options,
                                        const EstimatorContext& context)
-    : options_(options), slam_(GraphOptions(options, context)), map_(options.map) {}
+    : options_(options),
+      slam_(GraphOptions(options, context)),
+      map_(options.map),
+      own_odometry_(context.own_odometry) {}
 
 ScanEstimate GraphSlamEstimator::AddScan(const SyncedScan& scan) {
   const Pose2 pose = slam_.Add(scan.scan, scan.increment, scan.odometry_gap_s);
@@ -37,6 +40,8 @@ ScanEstimate GraphSlamEstimator::AddScan(const SyncedScan& scan) {
     map_.InsertScan(scan.scan, pose);
     node_scans_.push_back(scan.scan);
   }
+  wheel_increments_.push_back(scan.increment);
+  odometry_gaps_.push_back(scan.odometry_gap_s > options_.graph.odometry.search.gap_s);
   ScanEstimate estimate;
   estimate.pose = pose;
   estimate.lost = front_end_health_.Judge(slam_.last_step(), &estimate.trace);
@@ -65,6 +70,51 @@ void GraphSlamEstimator::Finish() {
   for (std::size_t k = 0; k < node_scans_.size(); ++k) {
     map_.InsertScan(node_scans_[k], graph.pose(static_cast<int>(k)));
   }
+  JudgeTurnsAgainstWheels();
+}
+
+void GraphSlamEstimator::JudgeTurnsAgainstWheels() {
+  if (!own_odometry_) return;
+  const std::vector<Pose2> poses = slam_.Poses();
+  const std::size_t n = std::min(poses.size(), wheel_increments_.size());
+  // The wheels' heading noise on this run: the front end's model (a share of the turn, a little
+  // per metre) scaled by the median of the final poses' turn residuals against the wheels over
+  // the scans that turn (where the share of the turn is the model's larger term), each in units
+  // of the model's sigma (a median of |N(0, 1)| is 0.6745). A median: a wrong turn or two of
+  // the estimate's do not raise it; wheels that scatter by a third of every turn do.
+  const IcpOdometryOptions& model = options_.graph.odometry;
+  std::vector<double> residuals;
+  for (std::size_t i = 1; i < n; ++i) {
+    const Pose2& wheels = wheel_increments_[i];
+    const double turn_sigma = model.sigma_yaw_per_rad * std::abs(wheels.theta());
+    if (odometry_gaps_[i] || !(turn_sigma > model.IncrementSigmas(wheels).y() / 2.0)) continue;
+    const double residual = NormalizeAngle(poses[i - 1].Between(poses[i]).theta() - wheels.theta());
+    residuals.push_back(std::abs(residual) / model.IncrementSigmas(wheels).y());
+  }
+  double scale = 1.0;
+  if (!residuals.empty()) {
+    const auto middle = residuals.begin() + static_cast<std::ptrdiff_t>(residuals.size() / 2);
+    std::nth_element(residuals.begin(), middle, residuals.end());
+    scale = std::max(1.0, *middle / 0.6745);
+  }
+  WheelAgreement agreement;
+  for (std::size_t i = 1; i < n; ++i) {
+    if (odometry_gaps_[i]) {
+      agreement.Reset();
+      continue;
+    }
+    const Pose2& wheels = wheel_increments_[i];
+    const Pose2 estimate = poses[i - 1].Between(poses[i]);
+    // The noise grows with the turn the robot made, which the wheels may under-report (a turn
+    // logged with the wrong sign): the larger of the two turns sets it.
+    const Pose2 turned(wheels.x(), wheels.y(),
+                       std::max(std::abs(wheels.theta()), std::abs(estimate.theta())));
+    // Observability 1: the turns alone are judged; the front end holds the distance to the
+    // wheels itself (the odometry check).
+    agreement.Add(estimate, wheels, 1.0, scale * model.IncrementSigmas(turned).y());
+  }
+  wheel_heading_contradiction_rad_ = agreement.heading_contradicted_rad();
+  wheel_heading_noise_scale_ = scale;
 }
 
 EstimatorView GraphSlamEstimator::View() const {
@@ -117,7 +167,9 @@ const std::vector<std::string>& GraphSlamEstimator::StatisticNames() {
                                                  "lost",
                                                  "chi2_ratio",
                                                  "unrepaired_losses",
-                                                 "unrepaired_error_bound_m"};
+                                                 "unrepaired_error_bound_m",
+                                                 "wheel_heading_contradiction_rad",
+                                                 "wheel_heading_noise_scale"};
   return names;
 }
 
@@ -142,11 +194,15 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"certified", c.certified ? 1.0 : 0.0},
           {"certificate_lambda_min", c.certificate_lambda_min},
           {"strained_edges", c.strained_edges},
-          {"diverged", c.diverged || bound_m > kDivergedErrorM ? 1.0 : 0.0},
+          {"diverged",
+           c.diverged || bound_m > kDivergedErrorM || wheel_heading_contradiction_rad_ > 0.0 ? 1.0
+                                                                                             : 0.0},
           {"lost", health_.losses()},
           {"chi2_ratio", c.chi2_ratio},
           {"unrepaired_losses", static_cast<double>(unrepaired.size())},
-          {"unrepaired_error_bound_m", bound_m}};
+          {"unrepaired_error_bound_m", bound_m},
+          {"wheel_heading_contradiction_rad", wheel_heading_contradiction_rad_},
+          {"wheel_heading_noise_scale", wheel_heading_noise_scale_}};
 }
 
 }  // namespace slamrig::slam

@@ -43,7 +43,8 @@ class GraphSlamEstimator final : public Estimator {
   const OccupancyGrid& map() const override { return map_; }
   /// keyframes, loop_closures, loop_candidates, rejected, optimizations, final_chi2,
   /// switched_off, odometry_rematched, window_edge_rejected, gate_rejected, inconsistent, the
-  /// certificate's, and its own judgement: strained_edges, chi2_ratio, unrepaired_losses, lost,
+  /// certificate's, and its own judgement: strained_edges, chi2_ratio, unrepaired_losses,
+  /// unrepaired_error_bound_m, wheel_heading_contradiction_rad, wheel_heading_noise_scale, lost,
   /// diverged.
   std::map<std::string, double> Statistics() const override;
   /// The names Statistics() reports, without an instance: the algorithm table's list (and so
@@ -65,16 +66,31 @@ class GraphSlamEstimator final : public Estimator {
   /// not the verdict: a loss a closure repaired left no error, and one that none did is judged
   /// by what it may have left.
   std::vector<double> UnrepairedLossBounds() const;
+  /// After Finish(): how far the final trajectory turned away from the wheels, beyond what their
+  /// drift, skid and noise explain (WheelAgreement's turn test on the final poses; the wheels'
+  /// heading noise is the front end's model scaled by the median of the final turns' residuals
+  /// against them), rad; 0: never, or no own odometry. Above 0 the run is diverged: a wrong turn
+  /// that no loop closure took back (a corridor matched at the wrong heading where the scans saw
+  /// nothing else) leaves the map rotated from there on, each part consistent in itself.
+  double WheelHeadingContradiction() const { return wheel_heading_contradiction_rad_; }
 
  private:
+  // The final poses' turns against the wheels' (WheelHeadingContradiction), at Finish().
+  void JudgeTurnsAgainstWheels();
+
   GraphSlamEstimatorOptions options_;
   GraphSlam slam_;
   OccupancyGrid map_;
   std::vector<LaserScan> node_scans_;  // the scan of each graph node (vertex id), for the map
   FrontEndHealth front_end_health_;
-  HealthRecord health_;                // its loss_scans() are the repair test's
-  BlindStretchBound blind_;            // over the current loss
-  std::vector<double> loss_bounds_m_;  // per loss (health_.loss_scans()), its bound at its end
+  HealthRecord health_;                  // its loss_scans() are the repair test's
+  BlindStretchBound blind_;              // over the current loss
+  std::vector<double> loss_bounds_m_;    // per loss (health_.loss_scans()), its bound at its end
+  bool own_odometry_;                    // the wheels are a witness of the turns
+  std::vector<Pose2> wheel_increments_;  // per scan, the wheels' increment since the previous one
+  std::vector<bool> odometry_gaps_;      // per scan, the odometry was silent before it
+  double wheel_heading_contradiction_rad_ = 0.0;
+  double wheel_heading_noise_scale_ = 1.0;  // that median scale
 };
 
 }  // namespace slamrig::slam

@@ -66,10 +66,11 @@ double Observability(const MatchConstraints& geometry, const Eigen::Vector2d& di
 }
 
 bool WheelAgreement::Add(const Pose2& estimate_increment, const Pose2& wheel_increment,
-                         double observability) {
+                         double observability, double wheel_yaw_sigma_rad) {
   const Eigen::Vector2d wheels = wheel_increment.translation();
   const double wheels_m = wheels.norm();
-  const bool turned = AddTurn(wheels_m, wheel_increment.theta(), estimate_increment.theta());
+  const bool turned = AddTurn({wheels_m, wheel_increment.theta(), estimate_increment.theta(),
+                               wheel_yaw_sigma_rad * wheel_yaw_sigma_rad});
   if (observability >= kObservable) return turned;
   // The estimate's own motion along the wheels' direction.
   const double estimate_m =
@@ -100,10 +101,10 @@ bool WheelAgreement::Add(const Pose2& estimate_increment, const Pose2& wheel_inc
   return true;
 }
 
-bool WheelAgreement::AddTurn(double wheels_m, double wheels_rad, double estimate_rad) {
-  turns_.Add({wheels_m, wheels_rad, estimate_rad});
-  long_turns_.Add({wheels_m, wheels_rad, estimate_rad});
-  drift_.Travel(wheels_m);
+bool WheelAgreement::AddTurn(const Turn& turn) {
+  turns_.Add(turn);
+  long_turns_.Add(turn);
+  drift_.Travel(turn.wheels_m);
   const double drift = drift_.rad_per_m();
   bool flagged = false;
   for (const TurnWindow* window : {&turns_, &long_turns_}) {
@@ -148,19 +149,21 @@ void WheelAgreement::TurnWindow::Add(const Turn& turn) {
   wheels_rad_ += turn.wheels_rad;
   wheels_abs_rad_ += std::abs(turn.wheels_rad);
   estimate_rad_ += turn.estimate_rad;
+  wheels_variance_rad2_ += turn.wheels_variance_rad2;
   while (turns_.size() > 1 && travel_m_ - turns_.front().wheels_m >= length_m_) {
     const Turn& old = turns_.front();
     travel_m_ -= old.wheels_m;
     wheels_rad_ -= old.wheels_rad;
     wheels_abs_rad_ -= std::abs(old.wheels_rad);
     estimate_rad_ -= old.estimate_rad;
+    wheels_variance_rad2_ -= old.wheels_variance_rad2;
     turns_.pop_front();
   }
 }
 
 void WheelAgreement::TurnWindow::Clear() {
   turns_.clear();
-  travel_m_ = wheels_rad_ = wheels_abs_rad_ = estimate_rad_ = 0.0;
+  travel_m_ = wheels_rad_ = wheels_abs_rad_ = estimate_rad_ = wheels_variance_rad2_ = 0.0;
 }
 
 double WheelAgreement::TurnWindow::difference_rad() const {
@@ -173,8 +176,9 @@ double WheelAgreement::TurnWindow::net_difference_rad(double drift_rad_per_m) co
 
 // A window that is not full has no net difference, so it is never contradicted.
 bool WheelAgreement::TurnWindow::Contradicted(double drift_rad_per_m) const {
+  const double noise_rad = kHeadingNoiseSigmas * std::sqrt(std::max(wheels_variance_rad2_, 0.0));
   return std::abs(net_difference_rad(drift_rad_per_m)) >
-         kHeadingToleranceRad + kHeadingSkidShare * wheels_abs_rad_;
+         std::max(kHeadingToleranceRad + kHeadingSkidShare * wheels_abs_rad_, noise_rad);
 }
 
 void WheelAgreement::CloseStretch() {

@@ -126,6 +126,9 @@ class WheelAgreement {
   static constexpr double kLongHeadingWindowM = 30.0;
   static constexpr double kHeadingToleranceRad = 0.7853981633974483;  ///< 45 degrees ...
   static constexpr double kHeadingSkidShare = 0.5;  ///< ... plus this share of the wheels' turning
+  /// ... or, where larger, this many standard deviations of the wheels' measured heading noise
+  /// summed over the window (Add's wheel_yaw_sigma_rad).
+  static constexpr double kHeadingNoiseSigmas = 5.0;
 
   /// Adds one scan's increments since the previous scan, both in the robot's frame there: the
   /// estimate's own (an estimator that revises its choice of hypothesis, like an RBPF switching
@@ -133,8 +136,13 @@ class WheelAgreement {
   /// is full and its ratio lies outside the tolerance, or the heading window is full and its
   /// turns disagree. `observability`: the scan's along the wheels' direction (Observability); at
   /// kObservable or above its distance is not judged.
+  ///
+  /// `wheel_yaw_sigma_rad`: the standard deviation of the wheels' heading increment where the
+  /// estimator measured it (0: not known). A turn difference within kHeadingNoiseSigmas times
+  /// the window's summed deviation is the wheels' own noise and never contradicts them: wheels
+  /// whose heading scatters by more than the fixed tolerance per turn are no witness of it.
   bool Add(const Pose2& estimate_increment, const Pose2& wheel_increment,
-           double observability = 0.0);
+           double observability = 0.0, double wheel_yaw_sigma_rad = 0.0);
   /// Forgets the window: after a gap in the odometry or a jump the estimator made on purpose (a
   /// relocalisation), the motion before it says nothing about the motion after.
   void Reset();
@@ -164,6 +172,7 @@ class WheelAgreement {
   };
   struct Turn {
     double wheels_m, wheels_rad, estimate_rad;
+    double wheels_variance_rad2 = 0.0;  // of wheels_rad, where the estimator measured it
   };
   // The turns over the fewest latest scans that cover a length of wheel travel.
   class TurnWindow {
@@ -183,6 +192,7 @@ class WheelAgreement {
     double length_m_;
     std::deque<Turn> turns_;
     double travel_m_ = 0.0, wheels_rad_ = 0.0, wheels_abs_rad_ = 0.0, estimate_rad_ = 0.0;
+    double wheels_variance_rad2_ = 0.0;
   };
   // The wheels' own steady heading drift per metre on this run: the median of the short
   // window's turn difference per metre over its full windows that were not flagged, counted in
@@ -205,7 +215,7 @@ class WheelAgreement {
   bool Persistent() const { return stretch_travel_m_ > kWindowM; }
   void CloseStretch();
   // Adds one scan's turns to the heading window; true when it is flagged.
-  bool AddTurn(double wheels_m, double wheels_rad, double estimate_rad);
+  bool AddTurn(const Turn& turn);
   TurnWindow turns_{kHeadingWindowM}, long_turns_{kLongHeadingWindowM};
   DriftEstimate drift_;
   double heading_contradicted_rad_ = 0.0;

@@ -330,6 +330,38 @@ TEST(HealthTest, WheelAgreementLearnsTheWheelsSteadyDriftBeforeJudgingTheLongWin
   EXPECT_EQ(first, 600 + 83);
 }
 
+TEST(HealthTest, WheelAgreementAllowsTheWheelsMeasuredHeadingNoise) {
+  // Wheels whose heading scatters by 60 % of every turn (Gaussian, per turn of the robot: twice
+  // a noisy log's odometry), on a route that turns half a radian every 2 m, and an estimate that
+  // follows the robot. Judged by the fixed tolerance the wheels themselves contradict it on some
+  // runs; told their noise (5 sigma of the window's sum), never.
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  int fixed_flagged = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    WheelAgreement fixed, told;
+    for (int i = 0; i < 400; ++i) {  // 100 m in 0.25 m steps
+      const double turn = i % 8 == 0 ? (i % 16 == 0 ? 0.5 : -0.5) : 0.0;
+      const double sigma = 0.6 * std::abs(turn);
+      const Pose2 wheels(0.25, 0.0, turn + sigma * normal(rng));
+      fixed.Add(Pose2(0.25, 0.0, turn), wheels, 1.0);
+      ASSERT_FALSE(told.Add(Pose2(0.25, 0.0, turn), wheels, 1.0, sigma)) << trial << " " << i;
+    }
+    fixed_flagged += fixed.heading_contradicted_rad() > 0.0;
+    EXPECT_EQ(told.heading_contradicted_rad(), 0.0);
+  }
+  EXPECT_GE(fixed_flagged, 10);  // 20 of 200: the fixed tolerance is not what holds them
+  // Told the same noise, a turn the robot did not make is still seen: the estimate turns half a
+  // turn more than the wheels where the robot turned half a radian (sigma 0.3 rad), pi against 5
+  // sigma, 1.5 rad.
+  WheelAgreement wrong;
+  for (int i = 0; i < 40; ++i) {  // 10 m, straight and exact
+    ASSERT_FALSE(wrong.Add(Pose2(0.25, 0.0, 0.0), Pose2(0.25, 0.0, 0.0), 1.0, 0.002));
+  }
+  EXPECT_TRUE(wrong.Add(Pose2(0.25, 0.0, 0.5 + M_PI), Pose2(0.25, 0.0, 0.5), 1.0, 0.3));
+  EXPECT_NEAR(wrong.heading_contradicted_rad(), M_PI, 1e-9);
+}
+
 // Points every 5 cm along the segment from a to b.
 void Wall(const Eigen::Vector2d& a, const Eigen::Vector2d& b, std::vector<Eigen::Vector2d>* out) {
   const int n = static_cast<int>((b - a).norm() / 0.05);
