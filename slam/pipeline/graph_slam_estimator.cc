@@ -81,7 +81,7 @@ void GraphSlamEstimator::JudgeTurnsAgainstWheels() {
   // per metre) scaled by the median of the final poses' turn residuals against the wheels over
   // the scans that turn (where the share of the turn is the model's larger term), each in units
   // of the model's sigma (a median of |N(0, 1)| is 0.6745). A median: a wrong turn or two of
-  // the estimate's do not raise it; wheels that scatter by a third of every turn do.
+  // the estimate's do not raise it; wheels that scatter in every turn do.
   const IcpOdometryOptions& model = options_.graph.odometry;
   std::vector<double> residuals;
   for (std::size_t i = 1; i < n; ++i) {
@@ -178,6 +178,10 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
   const std::vector<double> unrepaired = UnrepairedLossBounds();
   const double bound_m =
       unrepaired.empty() ? 0.0 : *std::max_element(unrepaired.begin(), unrepaired.end());
+  // Strained edges, a loss that may have left more than kDivergedErrorM, or a turn the wheels
+  // contradict.
+  const bool diverged =
+      c.diverged || bound_m > kDivergedErrorM || wheel_heading_contradiction_rad_ > 0.0;
   return {{"keyframes", c.keyframes},
           {"loop_closures", c.loop_closures},
           {"loop_candidates", c.loop_candidates},
@@ -194,9 +198,7 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"certified", c.certified ? 1.0 : 0.0},
           {"certificate_lambda_min", c.certificate_lambda_min},
           {"strained_edges", c.strained_edges},
-          {"diverged",
-           c.diverged || bound_m > kDivergedErrorM || wheel_heading_contradiction_rad_ > 0.0 ? 1.0
-                                                                                             : 0.0},
+          {"diverged", diverged ? 1.0 : 0.0},
           {"lost", health_.losses()},
           {"chi2_ratio", c.chi2_ratio},
           {"unrepaired_losses", static_cast<double>(unrepaired.size())},
