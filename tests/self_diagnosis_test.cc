@@ -100,8 +100,8 @@ TEST(SelfDiagnosisTest, GraphCallsAnUnrepairedFrontEndLossDiverged) {
 }
 
 // Infinite-corridor with twice its odometry noise: at seed 2 the front end takes a turn 92 degrees
-// wrong where the scans see little, no loop closure takes it back, and the final trajectory runs
-// its two outdoor loops rotated (ATE 70 m) with every edge consistent. Its turns against the
+// wrong, no loop closure takes it back, and the final trajectory runs its two large loops rotated
+// (ATE 70 m) with every edge consistent. Its turns against the
 // wheels' say so; at seed 1 (0.52 m) they agree within the wheels' noise.
 TEST(SelfDiagnosisTest, GraphCallsATurnTheWheelsDidNotMakeDiverged) {
   SLAMRIG_REQUIRE_DATASET(log, "carmen_corrected/infinite-corridor-corrected.log.gz");

@@ -86,10 +86,11 @@ void GraphSlamEstimator::JudgeTurnsAgainstWheels() {
   std::vector<double> residuals;
   for (std::size_t i = 1; i < n; ++i) {
     const Pose2& wheels = wheel_increments_[i];
+    const double sigma = model.IncrementSigmas(wheels).y();
     const double turn_sigma = model.sigma_yaw_per_rad * std::abs(wheels.theta());
-    if (odometry_gaps_[i] || !(turn_sigma > model.IncrementSigmas(wheels).y() / 2.0)) continue;
+    if (odometry_gaps_[i] || !(turn_sigma > sigma / 2.0)) continue;
     const double residual = NormalizeAngle(poses[i - 1].Between(poses[i]).theta() - wheels.theta());
-    residuals.push_back(std::abs(residual) / model.IncrementSigmas(wheels).y());
+    residuals.push_back(std::abs(residual) / sigma);
   }
   double scale = 1.0;
   if (!residuals.empty()) {
