@@ -43,11 +43,14 @@ SyncedScan ScanMatchedOdometry::Apply(const SyncedScan& scan) {
   // Constant velocity: the last matched increment, scaled down to a shorter interval but never
   // stretched beyond itself (a log whose scans are triggered by motion, as the corrected CARMEN
   // logs are, has intervals that vary while the motion per scan does not); the stretched one, at
-  // most twice, is a further candidate (a time-triggered log that lost a scan). After a failed
-  // match the velocity is not known, and the robot is predicted still.
+  // most twice, is a further candidate (a time-triggered log that lost a scan). A failed match
+  // leaves the velocity as the last match measured it: the robot coasts. Predicted still, it is
+  // lost for good once it has driven beyond the local map, every later match failing in turn
+  // (acapulco without odometry: 54 scans in a row from scan 274, 11.5 m;
+  // docs/studies/no-odometry.md).
   Pose2 prediction;
   std::optional<Pose2> stretched;
-  if (started_ && last_matched_ && last_dt_s_ > 0.0 && scan.dt_s > 0.0) {
+  if (has_velocity_ && last_dt_s_ > 0.0 && scan.dt_s > 0.0) {
     const double ratio = scan.dt_s / last_dt_s_;
     prediction = Scaled(last_increment_, std::min(ratio, 1.0));
     if (ratio > 1.0) stretched = Scaled(last_increment_, std::min(ratio, 2.0));
@@ -65,12 +68,15 @@ SyncedScan ScanMatchedOdometry::Apply(const SyncedScan& scan) {
   if (stretched) candidates.push_back(*stretched);
   const IcpOdometryStep step = odometry_.Add(scan.scan, candidates);
   const Pose2 increment = started_ ? pose_.Between(step.pose) : Pose2();
-  last_matched_ = step.outcome == IcpOdometryOutcome::kMatched ||
-                  step.outcome == IcpOdometryOutcome::kDegenerate;
+  const bool matched = step.outcome == IcpOdometryOutcome::kMatched ||
+                       step.outcome == IcpOdometryOutcome::kDegenerate;
+  if (started_ && matched) {
+    last_increment_ = increment;
+    last_dt_s_ = scan.dt_s;
+    has_velocity_ = true;
+  }
   started_ = true;
   pose_ = step.pose;
-  last_increment_ = increment;
-  last_dt_s_ = scan.dt_s;
   out.odom_from_base = step.pose;
   out.increment = increment;
   const double distance = increment.translation().norm();

@@ -16,7 +16,8 @@ namespace slamrig::slam {
 /// +-1.2 m and +-0.75 rad at least around the prediction; the best match is kept, the prediction
 /// winning ties (along a corridor the scan cannot tell how far the robot went: the prediction
 /// says it, not the seed that overlaps the map best, standing still). Where every match fails the
-/// prediction stands; where the match is degenerate, along the degenerate direction only. Every
+/// prediction stands and the velocity is kept; where the match is degenerate, along the
+/// degenerate direction only. Every
 /// estimator then takes the result as its odometry, with its own motion noise around it.
 /// Deterministic.
 class ScanMatchedOdometry {
@@ -32,9 +33,9 @@ class ScanMatchedOdometry {
  private:
   IcpOdometry odometry_;
   Pose2 pose_;
-  Pose2 last_increment_;
-  double last_dt_s_ = 0.0;
-  bool last_matched_ = false;
+  Pose2 last_increment_;       // the last matched increment ...
+  double last_dt_s_ = 0.0;     // ... its interval ...
+  bool has_velocity_ = false;  // ... and whether a scan has matched yet
   bool started_ = false;
 };
 

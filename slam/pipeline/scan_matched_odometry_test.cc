@@ -102,6 +102,33 @@ TEST(ScanMatchedOdometryTest, KeepsItsSpeedWhereTheCorridorCannotTell) {
   EXPECT_NEAR(end.y(), truth.y(), 0.05);
 }
 
+// Five scans with no return at all (the scanner blinded, a glass front) along a corridor with
+// pillars: the robot coasts at its last matched speed through them and the next scan matches
+// again. Predicted still, it would be 2.5 m past its prediction when the scans came back, beyond
+// the window, and every later match would fail (it ended 6.8 m short).
+TEST(ScanMatchedOdometryTest, CoastsThroughScansThatCannotMatch) {
+  SegmentWorld corridor({{{-100.0, 1.0}, {100.0, 1.0}}, {{-100.0, -1.0}, {100.0, -1.0}}});
+  for (double x = -98.0; x < -40.0; x += 1.7) corridor.AddBox(x, 0.7, x + 0.3, 1.0);
+  RandomEngine rng(13);
+  ScanMatchedOdometry odometry;
+  Pose2 truth(-99.0, 0.1, 0.0);
+  const Pose2 start = truth;
+  Pose2 estimate;
+  for (int k = 0; k < 60; ++k) {
+    if (k > 0) truth = truth * Pose2(0.5, 0.0, 0.0);
+    SyncedScan scan = ScanAt(corridor, truth, k == 0 ? 0.0 : 1.0, rng);
+    if (k >= 20 && k < 25) {
+      for (float& r : scan.scan.ranges_m) r = static_cast<float>(scan.scan.range_max_m);
+    }
+    estimate = odometry.Apply(scan).odom_from_base;
+  }
+  const Pose2 end = start * estimate;
+  EXPECT_NEAR(end.x(), truth.x(), 0.2);
+  EXPECT_NEAR(end.y(), truth.y(), 0.05);
+  EXPECT_EQ(odometry.counts().no_points, 5);
+  EXPECT_GE(odometry.counts().matched + odometry.counts().degenerate, 54);
+}
+
 // Same scans, same bits.
 TEST(ScanMatchedOdometryTest, SameScansSameBits) {
   const SegmentWorld world = SegmentWorld::Office();
