@@ -557,8 +557,8 @@ void ParticleFilter::MoveCloud(const Pose2& to, ParticleFilterStep* step) {
   step->mean_pose = correction * step->mean_pose;
 }
 
-bool ParticleFilter::SearchAfterGap(const std::vector<Eigen::Vector2d>& points,
-                                    ParticleFilterStep* step) {
+bool ParticleFilter::SearchNear(const std::vector<Eigen::Vector2d>& points, double radius_m,
+                                ParticleFilterStep* step) {
   const RelocalisationOptions& o = options_.relocalisation;
   // The places' bar is the long-term quality: none before it is trusted.
   if (!o.enabled || options_.observation != ObservationModel::kLikelihoodField ||
@@ -567,10 +567,10 @@ bool ParticleFilter::SearchAfterGap(const std::vector<Eigen::Vector2d>& points,
   }
   // A one-off search (the map changes with every update): the map within reach of the window.
   const Pose2& here = step->best_pose;
-  const double half = o.slip_radius_m + Reach(points) + 2.0 * map_.resolution();
+  const double half = radius_m + Reach(points) + 2.0 * map_.resolution();
   const Eigen::Vector2d h = Eigen::Vector2d::Constant(half);
   CorrelativeMatcherOptions m;
-  m.linear_window_m = o.slip_radius_m;
+  m.linear_window_m = radius_m;
   m.angular_window_rad = kEveryHeadingRad;
   m.min_score = 0.0;
   const CorrelativeMatcher matcher(
@@ -623,7 +623,14 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
   ChooseEstimate(constraints, degenerate, predicted_mean, &step);
   step.quality = Quality(step.best_score, points.size());
   step.neff = EffectiveSampleSize(weights);
-  if (after_gap && !lost_) step.gap_corrected = SearchAfterGap(points, &step);
+  if (!lost_) {
+    if (after_gap) {
+      step.gap_corrected = SearchNear(points, reloc.slip_radius_m, &step);
+    } else if (scan_matched_increments_ && reloc.scan_matched_search_m > 0.0 &&
+               tracked_updates_ > reloc.warmup_updates && !FitsAsPlace(step.quality)) {
+      step.gap_corrected = SearchNear(points, reloc.scan_matched_search_m, &step);
+    }
+  }
   if (!UpdateMapAndLostState(scan, points, &step)) {
     last_step_ = step;
     return step;

@@ -60,6 +60,10 @@ class ParticleFilter {
   ParticleFilterStep AddScan(const LaserScan& scan, const Pose2& odometry_increment,
                              double odometry_gap_s = 0.0);
 
+  /// Tells the filter that its increments are scan matches, not the robot's own odometry
+  /// (RelocalisationOptions::scan_matched_search_m).
+  void SetScanMatchedIncrements(bool scan_matched) { scan_matched_increments_ = scan_matched; }
+
   const std::vector<Particle>& particles() const { return particles_; }
   const OccupancyGrid& map() const { return map_; }
   const ParticleFilterOptions& options() const { return options_; }
@@ -153,10 +157,12 @@ class ParticleFilter {
   // candidates for the next lost update.
   LostVerdict Decide(const std::vector<Eigen::Vector2d>& points, const ScoredPose& tracked,
                      std::vector<Candidate> places);
-  // After an odometry gap (RelocalisationOptions::odometry_gap_s): the best place within
-  // slip_radius_m of the estimate at every heading; when it fits as a place and beats the
-  // filter's own match by win_margin, the cloud moves there. True when it moved.
-  bool SearchAfterGap(const std::vector<Eigen::Vector2d>& points, ParticleFilterStep* step);
+  // After an odometry gap (RelocalisationOptions::odometry_gap_s), or at every update where the
+  // increments are scan matches: the best place within `radius_m` of the estimate at every
+  // heading; when it fits as a place and beats the filter's own match by win_margin, the cloud
+  // moves there. True when it moved.
+  bool SearchNear(const std::vector<Eigen::Vector2d>& points, double radius_m,
+                  ParticleFilterStep* step);
   // Moves the whole cloud, and the step's estimate and mean, by the rigid correction that puts
   // the estimate at `to` (a slip corrected, a turn found after a gap).
   void MoveCloud(const Pose2& to, ParticleFilterStep* step);
@@ -212,8 +218,9 @@ class ParticleFilter {
   std::vector<Particle> particles_;
   std::vector<double> log_weights_;
   bool started_ = false;
-  Pose2 pending_motion_;        // odometry since the last update
-  double pending_gap_s_ = 0.0;  // the longest odometry gap since the last update
+  bool scan_matched_increments_ = false;  // SetScanMatchedIncrements
+  Pose2 pending_motion_;                  // odometry since the last update
+  double pending_gap_s_ = 0.0;            // the longest odometry gap since the last update
   OdometryCalibration calibration_;
   ParticleFilterStep last_step_;
   int resample_count_ = 0;

@@ -18,6 +18,7 @@ std::vector<std::string> RelocalisationOptions::Validate() const {
       .Positive("slip_radius_m", slip_radius_m)
       .Positive("slip_angle_rad", slip_angle_rad)
       .NonNegative("odometry_gap_s", odometry_gap_s)
+      .NonNegative("scan_matched_search_m", scan_matched_search_m)
       .AtLeast("confirm_updates", confirm_updates, 1)
       .AtLeast("global_candidates", global_candidates, 1)
       .Positive("distinct_radius_m", distinct_radius_m)

@@ -91,6 +91,11 @@ struct RelocalisationOptions {
   /// to the place found when it fits as a place (accept_ratio) and beats the filter's own match
   /// by win_margin. 0: never.
   double odometry_gap_s = 1.0;
+  /// Where the increments are scan matches (a source without odometry: ScanMatchedOdometry,
+  /// whose failures are a corridor's or a room's aliases anywhere within its search window, up to
+  /// 2 m, not a wheel's slip), every update searches within this of the estimate at every heading
+  /// as after a gap, and the cloud moves to the place found on the same terms. 0: never.
+  double scan_matched_search_m = 2.0;
   double search_max_range_m = 10.0;  ///< points used by the global search (a finer yaw step)
   /// The global search's raster: the map max-pooled to this (rounded to a whole number of map
   /// cells, at least one), each place it finds then matched at the map's resolution (the shift
@@ -131,6 +136,7 @@ void VisitFields(V& v, RelocalisationOptions& o) {
   v("slip_radius_m", o.slip_radius_m);
   v("slip_angle_rad", o.slip_angle_rad);
   v("odometry_gap_s", o.odometry_gap_s);
+  v("scan_matched_search_m", o.scan_matched_search_m);
   v("search_max_range_m", o.search_max_range_m);
   v("search_resolution_m", o.search_resolution_m);
   v("search_window_m", o.search_window_m);

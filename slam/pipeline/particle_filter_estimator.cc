@@ -15,7 +15,9 @@ ParticleFilterOptions ParticleFilterEstimator::Seeded(ParticleFilterOptions opti
 ParticleFilterEstimator::ParticleFilterEstimator(const ParticleFilterOptions& options,
                                                  const EstimatorContext& context)
     : filter_(Seeded(options, context.seed)),
-      wheels_(context.own_odometry, filter_.options().points) {}
+      wheels_(context.own_odometry, filter_.options().points) {
+  filter_.SetScanMatchedIncrements(!context.own_odometry);
+}
 
 ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
   const ParticleFilterStep step = filter_.AddScan(scan.scan, scan.increment, scan.odometry_gap_s);
