@@ -38,6 +38,19 @@ def strip_raw_odometry(source, target):
     return kept, dropped
 
 
+def run_without_odometry(binary, log, work, algorithm):
+    """Runs `algorithm` on the stripped `log`; its metrics.json config, which must say the run
+    had no odometry of its own."""
+    out = os.path.join(work, algorithm)
+    run = subprocess.run([binary, "slam", log, "--algorithm", algorithm, "--out", out, "--quiet"],
+                         capture_output=True, text=True, check=False)
+    assert run.returncode == 0, run.stderr
+    with open(os.path.join(out, "metrics.json")) as f:
+        config = json.load(f)["configs"][algorithm]
+    assert config["run"]["odometry_source"] == "none", config["run"]
+    return config
+
+
 def main():
     binary, data_dir, work = sys.argv[1:4]
     data_dir = os.environ.get("SLAMRIG_DATA_DIR", data_dir)
@@ -64,22 +77,10 @@ def main():
     assert config["ate_rmse_m"] < 3.0, config["ate_rmse_m"]
     dead_reckoning = config["ate_rmse_m"]
     # The pf re-searches its own map where its match says the prior aliased (issue 32: <= 0.5 m).
-    out = os.path.join(work, "pf")
-    run = subprocess.run([binary, "slam", log, "--algorithm", "pf", "--out", out, "--quiet"],
-                         capture_output=True, text=True, check=False)
-    assert run.returncode == 0, run.stderr
-    with open(os.path.join(out, "metrics.json")) as f:
-        pf = json.load(f)["configs"]["pf"]
-    assert pf["run"]["odometry_source"] == "none", pf["run"]
+    pf = run_without_odometry(binary, log, work, "pf")
     assert pf["ate_rmse_m"] < 0.5, pf["ate_rmse_m"]
     assert pf["gap_corrections"] >= 1, pf["gap_corrections"]
-    out = os.path.join(work, "graph")
-    run = subprocess.run([binary, "slam", log, "--algorithm", "graph", "--out", out, "--quiet"],
-                         capture_output=True, text=True, check=False)
-    assert run.returncode == 0, run.stderr
-    with open(os.path.join(out, "metrics.json")) as f:
-        graph = json.load(f)["configs"]["graph"]
-    assert graph["run"]["odometry_source"] == "none", graph["run"]
+    graph = run_without_odometry(binary, log, work, "graph")
     assert graph["ate_rmse_m"] < 0.3, graph["ate_rmse_m"]
     print(f"no_odometry_check: note said; {placed['matched']} of 910 scans matched; "
           f"dead reckoning on the scan-matched prior {dead_reckoning:.3f} m, "

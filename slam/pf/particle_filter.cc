@@ -627,7 +627,7 @@ ParticleFilterStep ParticleFilter::AddScan(const LaserScan& scan, const Pose2& o
     if (after_gap) {
       step.gap_corrected = SearchNear(points, reloc.slip_radius_m, &step);
     } else if (scan_matched_increments_ && reloc.scan_matched_search_m > 0.0 &&
-               tracked_updates_ > reloc.warmup_updates && !FitsAsPlace(step.quality)) {
+               !FitsAsPlace(step.quality)) {
       step.gap_corrected = SearchNear(points, reloc.scan_matched_search_m, &step);
     }
   }

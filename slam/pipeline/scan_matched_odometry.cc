@@ -50,7 +50,7 @@ SyncedScan ScanMatchedOdometry::Apply(const SyncedScan& scan) {
   // docs/studies/no-odometry.md).
   Pose2 prediction;
   std::optional<Pose2> stretched;
-  if (has_velocity_ && last_dt_s_ > 0.0 && scan.dt_s > 0.0) {
+  if (last_dt_s_ > 0.0 && scan.dt_s > 0.0) {
     const double ratio = scan.dt_s / last_dt_s_;
     prediction = Scaled(last_increment_, std::min(ratio, 1.0));
     if (ratio > 1.0) stretched = Scaled(last_increment_, std::min(ratio, 2.0));
@@ -73,7 +73,6 @@ SyncedScan ScanMatchedOdometry::Apply(const SyncedScan& scan) {
   if (started_ && matched) {
     last_increment_ = increment;
     last_dt_s_ = scan.dt_s;
-    has_velocity_ = true;
   }
   started_ = true;
   pose_ = step.pose;

@@ -17,9 +17,8 @@ namespace slamrig::slam {
 /// winning ties (along a corridor the scan cannot tell how far the robot went: the prediction
 /// says it, not the seed that overlaps the map best, standing still). Where every match fails the
 /// prediction stands and the velocity is kept; where the match is degenerate, along the
-/// degenerate direction only. Every
-/// estimator then takes the result as its odometry, with its own motion noise around it.
-/// Deterministic.
+/// degenerate direction only. Every estimator then takes the result as its odometry, with its own
+/// motion noise around it. Deterministic.
 class ScanMatchedOdometry {
  public:
   ScanMatchedOdometry();
@@ -33,9 +32,8 @@ class ScanMatchedOdometry {
  private:
   IcpOdometry odometry_;
   Pose2 pose_;
-  Pose2 last_increment_;       // the last matched increment ...
-  double last_dt_s_ = 0.0;     // ... its interval ...
-  bool has_velocity_ = false;  // ... and whether a scan has matched yet
+  Pose2 last_increment_;    // the last matched increment ...
+  double last_dt_s_ = 0.0;  // ... and its interval (0: none matched yet)
   bool started_ = false;
 };
 
