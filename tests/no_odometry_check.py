@@ -80,11 +80,16 @@ def main():
     pf = run_without_odometry(binary, log, work, "pf")
     assert pf["ate_rmse_m"] < 0.5, pf["ate_rmse_m"]
     assert pf["gap_corrections"] >= 1, pf["gap_corrections"]
+    # The rbpf does the same on its best particle's map (1.6 m before, silent).
+    rbpf = run_without_odometry(binary, log, work, "rbpf")
+    assert rbpf["ate_rmse_m"] < 0.5, rbpf["ate_rmse_m"]
+    assert rbpf["gap_corrections"] >= 1, rbpf["gap_corrections"]
     graph = run_without_odometry(binary, log, work, "graph")
     assert graph["ate_rmse_m"] < 0.3, graph["ate_rmse_m"]
     print(f"no_odometry_check: note said; {placed['matched']} of 910 scans matched; "
           f"dead reckoning on the scan-matched prior {dead_reckoning:.3f} m, "
-          f"pf {pf['ate_rmse_m']:.3f} m, graph {graph['ate_rmse_m']:.3f} m")
+          f"pf {pf['ate_rmse_m']:.3f} m, rbpf {rbpf['ate_rmse_m']:.3f} m, "
+          f"graph {graph['ate_rmse_m']:.3f} m")
     return 0
 
 

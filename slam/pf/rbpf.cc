@@ -260,6 +260,47 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
   return *rejected ? best.pose.Between(chosen) : motion;
 }
 
+double Rbpf::MatchedFraction(const TiledGrid& map, const std::vector<MatchPoint>& points,
+                             const Pose2& pose) const {
+  return points.empty() ? 0.0
+                        : static_cast<double>(matcher_.Evaluate(map, points, pose).matched) /
+                              static_cast<double>(points.size());
+}
+
+Pose2 Rbpf::SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchPoint>& points,
+                                   bool* moved) const {
+  *moved = false;
+  constexpr int kWarmupUpdates = 20;
+  // The grid that picks where to climb from, twice as coarse as the gap search's in position and
+  // in heading: an eighth of its cost over four times its area.
+  constexpr int kScanMatchedCoarsening = 2;
+  if (matched_samples_ < kWarmupUpdates) return motion;
+  const RbpfParticle& best = particles_[best_];
+  const Pose2 predicted = best.pose * motion;
+  const auto [sigma_xy, sigma_yaw] = MotionSigmas(motion);
+  const ClimbResult near =
+      matcher_.Climb(best.map, points, predicted, PosePrior{predicted, sigma_xy, sigma_yaw});
+  const double near_fraction = MatchedFraction(best.map, points, near.pose);
+  const double bar = options_.scan_matched_accept_ratio * matched_level_;
+  if (near_fraction >= bar) return motion;
+  double ll = 0.0;
+  double other_ll = 0.0;
+  const Pose2 far = BestAtAnyHeading(best.map, points, predicted, options_.scan_matched_window_m,
+                                     std::numbers::pi, PosePrior{predicted, kNoPrior, kNoPrior},
+                                     &ll, &other_ll, kScanMatchedCoarsening);
+  const double far_fraction = MatchedFraction(best.map, points, far);
+  // Only a place the scan picks out: where another heading matches within the odds of a failed
+  // increment (the turn check's rule), the poor match is more likely new ground than an alias.
+  const double eps = options_.odometry_failure_probability;
+  const bool unique = options_.observation_scale * (ll - other_ll) > std::log((1.0 - eps) / eps);
+  if (!unique || far_fraction < bar ||
+      !(far_fraction > near_fraction + options_.scan_matched_win_margin * matched_level_)) {
+    return motion;
+  }
+  *moved = true;
+  return best.pose.Between(far);
+}
+
 Pose2 Rbpf::SearchAfterGap(const Pose2& motion, const std::vector<MatchPoint>& points,
                            bool* moved) const {
   // The increment is unknown over the gap: no motion prior on either hypothesis, only the scan's
@@ -279,21 +320,21 @@ Pose2 Rbpf::SearchAfterGap(const Pose2& motion, const std::vector<MatchPoint>& p
 
 Pose2 Rbpf::BestAtAnyHeading(const TiledGrid& map, const std::vector<MatchPoint>& points,
                              const Pose2& center, double half_m, double yaw_half_rad,
-                             const PosePrior& prior, double* log_likelihood,
-                             double* runner_up) const {
+                             const PosePrior& prior, double* log_likelihood, double* runner_up,
+                             int coarsening) const {
   // The grid of headings and positions (a spread subset of the points, as in CheckOdometry)
   // picks where to climb from: the best position at each heading, and the best few headings,
   // apart from each other, are climbed (the subset of points ranks them only roughly: a room's
   // other wall may rank first).
-  constexpr double kYawStepRad = 0.02;
+  const double yaw_step_rad = 0.02 * coarsening;
   const std::vector<MatchPoint> sparse = SpreadSubset(points);
-  const double step = options_.odometry_window_step_m;
+  const double step = options_.odometry_window_step_m * coarsening;
   const int n = static_cast<int>(std::ceil(half_m / step));
   // The whole circle from the centre's heading, or [-yaw_half_rad, yaw_half_rad) around it.
   const bool circle = yaw_half_rad >= std::numbers::pi;
   const double span = circle ? 2.0 * std::numbers::pi : 2.0 * yaw_half_rad;
   const double first = circle ? 0.0 : -yaw_half_rad;
-  const int headings = std::max(1, static_cast<int>(std::ceil(span / kYawStepRad)));
+  const int headings = std::max(1, static_cast<int>(std::ceil(span / yaw_step_rad)));
   std::vector<std::pair<double, Pose2>> per_heading;
   per_heading.reserve(static_cast<std::size_t>(headings));
   for (int k = 0; k < headings; ++k) {
@@ -446,6 +487,13 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
     motion = CheckOdometry(pending, points, &step.odometry_rejected);
     odometry_rejections_ += step.odometry_rejected;
   }
+  if (!after_gap && scan_matched_increments_ && options_.scan_matched_window_m > 0.0 &&
+      options_.odometry_failure_probability > 0.0 && !points.empty()) {
+    bool moved = false;
+    motion = SearchScanMatchedAlias(motion, points, &moved);
+    gap_corrections_ += moved;
+    step.odometry_rejected = step.odometry_rejected || moved;
+  }
   const double weight_exponent = WeightExponent(points);
   step.weight_exponent = weight_exponent;
   if (options_.weight_correlation_per_point && !points.empty()) {
@@ -493,12 +541,14 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
     if (particles_[i].path_log_likelihood > particles_[best_].path_log_likelihood) best_ = i;
   }
   step.best_pose = particles_[best_].pose;
-  step.matched_fraction =
-      points.empty()
-          ? 0.0
-          : static_cast<double>(
-                matcher_.Evaluate(particles_[best_].map, points, step.best_pose).matched) /
-                static_cast<double>(points.size());
+  step.matched_fraction = MatchedFraction(particles_[best_].map, points, step.best_pose);
+  if (!points.empty() && !(step.matched_fraction < 0.5 * matched_level_)) {
+    constexpr double kLevelRate = 0.02;
+    matched_level_ = matched_samples_ == 0
+                         ? step.matched_fraction
+                         : matched_level_ + kLevelRate * (step.matched_fraction - matched_level_);
+    ++matched_samples_;
+  }
   last_step_ = step;
   return step;
 }

@@ -74,6 +74,10 @@ class Rbpf {
   RbpfStep AddScan(const LaserScan& scan, const Pose2& odometry_increment,
                    double odometry_gap_s = 0.0);
 
+  /// Tells the filter that its increments are scan matches, not the robot's own odometry
+  /// (RbpfOptions::scan_matched_window_m).
+  void SetScanMatchedIncrements(bool scan_matched) { scan_matched_increments_ = scan_matched; }
+
   const std::vector<RbpfParticle>& particles() const { return particles_; }
   /// The particle with the most likely path.
   const RbpfParticle& best() const { return particles_[best_]; }
@@ -86,8 +90,9 @@ class Rbpf {
   /// Updates whose odometry increment the check replaced
   /// (RbpfOptions::odometry_failure_probability).
   int odometry_rejections() const { return odometry_rejections_; }
-  /// Updates after an odometry gap whose increment the search at every heading replaced
-  /// (RbpfOptions::odometry_gap_s).
+  /// Updates whose increment the search at every heading replaced: after an odometry gap
+  /// (RbpfOptions::odometry_gap_s), or an alias of a scan-matched increment
+  /// (RbpfOptions::scan_matched_window_m).
   int gap_corrections() const { return gap_corrections_; }
   const RbpfOptions& options() const { return options_; }
 
@@ -109,6 +114,15 @@ class Rbpf {
   /// the mixture model finds that more likely (then `*rejected` is set).
   Pose2 CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& points,
                       bool* rejected) const;
+  /// Where the increments are scan matches (RbpfOptions::scan_matched_window_m): the increment
+  /// to the best place within the window at every heading on the best particle's map, where the
+  /// match near the prediction falls short of the long-term matched fraction and the place found,
+  /// unique among the headings, does not (`*moved`); `motion` itself otherwise.
+  Pose2 SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchPoint>& points,
+                               bool* moved) const;
+  /// The share of `points` at `pose` that the matcher counts as matched on `map`.
+  double MatchedFraction(const TiledGrid& map, const std::vector<MatchPoint>& points,
+                         const Pose2& pose) const;
   /// After an odometry gap: the most likely of the match near the prediction and the best match
   /// within +-odometry_gap_window_m at every heading, as an increment (`*moved` when it is the
   /// latter).
@@ -116,10 +130,12 @@ class Rbpf {
                        bool* moved) const;
   /// The best match on `map` at any heading within +-`half_m` of `center` (a grid, then climbs
   /// with `prior` from its best distinct headings), its log-likelihood, and (when `runner_up` is
-  /// given) the best log-likelihood of a climb that ended at another heading.
+  /// given) the best log-likelihood of a climb that ended at another heading. The grid's steps are
+  /// `coarsening` times odometry_window_step_m and 0.02 rad.
   Pose2 BestAtAnyHeading(const TiledGrid& map, const std::vector<MatchPoint>& points,
                          const Pose2& center, double half_m, double yaw_half_rad,
-                         const PosePrior& prior, double* log_likelihood, double* runner_up) const;
+                         const PosePrior& prior, double* log_likelihood, double* runner_up,
+                         int coarsening = 1) const;
   /// `far` with its translation from `near` dropped along the directions in which the scan
   /// cannot place the robot (odometry_degenerate_ratio).
   Pose2 RemapDegenerate(const TiledGrid& map, const std::vector<MatchPoint>& points,
@@ -137,12 +153,17 @@ class Rbpf {
   std::vector<RbpfParticle> particles_;
   std::size_t best_ = 0;
   bool started_ = false;
+  bool scan_matched_increments_ = false;  // SetScanMatchedIncrements
   Pose2 pending_motion_;
   RbpfStep last_step_;
   int resample_count_ = 0;
   int update_count_ = 0;
   int odometry_rejections_ = 0;
   int gap_corrections_ = 0;
+  // The best particle's matched fraction, averaged slowly over the updates (its long-term level;
+  // an update below half of it leaves it alone), and the updates averaged.
+  double matched_level_ = 0.0;
+  int matched_samples_ = 0;
   double pending_gap_s_ = 0.0;  // the longest odometry gap since the last update
 };
 

@@ -35,6 +35,9 @@ std::vector<std::string> RbpfOptions::Validate() const {
       .Positive("odometry_window_step_m", odometry_window_step_m)
       .NonNegative("odometry_gap_s", odometry_gap_s)
       .NonNegative("odometry_gap_window_m", odometry_gap_window_m)
+      .NonNegative("scan_matched_window_m", scan_matched_window_m)
+      .Fraction("scan_matched_accept_ratio", scan_matched_accept_ratio)
+      .NonNegative("scan_matched_win_margin", scan_matched_win_margin)
       .Require(below_one(odometry_degenerate_ratio), "odometry_degenerate_ratio",
                odometry_degenerate_ratio, "must be in [0, 1)")
       .Fraction("resample_neff_ratio", resample_neff_ratio)

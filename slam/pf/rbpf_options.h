@@ -109,6 +109,19 @@ struct RbpfOptions {
   /// prediction, is the increment for every particle. 0: never.
   double odometry_gap_s = 1.0;
   double odometry_gap_window_m = 1.0;
+  /// Where the increments are scan matches (a source without odometry: ScanMatchedOdometry,
+  /// Rbpf::SetScanMatchedIncrements), a failed increment is an alias of the prior's local map
+  /// anywhere within its own search window (up to 2 m) at any heading. The best particle's map
+  /// holds the whole past, where the scan fits only the true place: an update whose match near
+  /// the prediction matches less than scan_matched_accept_ratio of the long-term matched
+  /// fraction searches that map within this half-width at every heading, and the place found
+  /// becomes the increment for every particle when it matches at least that share, beats the
+  /// near match by scan_matched_win_margin of the long-term level, and no other heading matches
+  /// within the odds of a failed increment (odometry_failure_probability; 0: never searched) (the
+  /// pf's relocalisation.scan_matched_search_m). 0: never.
+  double scan_matched_window_m = 2.0;
+  double scan_matched_accept_ratio = 0.8;
+  double scan_matched_win_margin = 0.1;
   /// A direction in which the scan's information at the window's match is below this fraction of
   /// its information in the best-determined direction is degenerate (a corridor's axis): the
   /// match's displacement along it is dropped and the odometry kept there (Zhang, Kaess, Singh,
@@ -170,6 +183,9 @@ void VisitFields(V& v, RbpfOptions& o) {
   v("odometry_window_step_m", o.odometry_window_step_m);
   v("odometry_gap_s", o.odometry_gap_s);
   v("odometry_gap_window_m", o.odometry_gap_window_m);
+  v("scan_matched_window_m", o.scan_matched_window_m);
+  v("scan_matched_accept_ratio", o.scan_matched_accept_ratio);
+  v("scan_matched_win_margin", o.scan_matched_win_margin);
   v("odometry_degenerate_ratio", o.odometry_degenerate_ratio);
   v("odometry_turn_check", o.odometry_turn_check);
   v.Enum("resampling", o.resampling,

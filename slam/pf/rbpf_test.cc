@@ -266,6 +266,39 @@ TEST(RbpfTest, TheTurnCheckFindsATurnTheWheelsMissed) {
                                             truth[turn.from].map_from_base.theta()));
 }
 
+// Without odometry the increments are scan matches, and the prior's failure is an alias of its
+// local map: one increment a metre off (a door spacing along a corridor, a room's other wall), the
+// next ones right again from the wrong pose. The update that takes it matches the best
+// particle's map poorly; the map holds the place the scan came from, and the search there at
+// every heading finds it. Told that its increments are wheels', the filter follows the alias.
+TEST(RbpfTest, AScanMatchedIncrementsAliasIsFoundInTheBestMap) {
+  const ShortRun& run = GetShortRun();
+  const std::vector<GroundTruthPose>& truth = run.run.truth;
+  std::vector<SyncedScan> scans = run.scans;
+  const std::size_t alias = scans.size() * 2 / 3;
+  scans[alias].increment = scans[alias].increment * Pose2(-1.0, 0.6, 0.0);
+  auto run_with = [&](bool scan_matched, int* corrections) {
+    RbpfOptions options = FastOptions();
+    options.num_particles = 5;  // the search is the best particle's: a few keep the test fast
+    Rbpf filter(options);
+    filter.SetScanMatchedIncrements(scan_matched);
+    RbpfStep step;
+    for (const SyncedScan& s : scans) step = filter.AddScan(s.scan, s.increment, s.odometry_gap_s);
+    *corrections = filter.gap_corrections();
+    return slam::testing::EndPoseError(step.best_pose, truth);
+  };
+  int corrections = 0;
+  const slam::testing::EndError searched = run_with(true, &corrections);
+  EXPECT_LT(searched.position_m, 0.15);
+  EXPECT_LT(searched.heading_rad, 0.1);
+  EXPECT_GE(corrections, 1);
+  int wheel_corrections = 0;
+  const slam::testing::EndError followed = run_with(false, &wheel_corrections);
+  EXPECT_GT(followed.position_m, 0.8);
+  EXPECT_EQ(wheel_corrections, 0);
+  RecordProperty("scans", std::to_string(scans.size()));
+}
+
 TEST(RbpfTest, ValidateNamesFieldValueAndRule) {
   RbpfOptions options;
   options.num_particles = 0;

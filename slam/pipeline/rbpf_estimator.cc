@@ -18,7 +18,9 @@ RbpfOptions RbpfEstimator::Seeded(RbpfOptions options, std::uint64_t seed) {
 RbpfEstimator::RbpfEstimator(const RbpfOptions& options, const EstimatorContext& context)
     : filter_(Seeded(options, context.seed)),
       wheels_(context.own_odometry, filter_.options().points),
-      map_(options.map) {}
+      map_(options.map) {
+  filter_.SetScanMatchedIncrements(!context.own_odometry);
+}
 
 ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
   const RbpfStep step = filter_.AddScan(scan.scan, scan.increment, scan.odometry_gap_s);
