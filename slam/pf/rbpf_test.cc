@@ -188,6 +188,14 @@ TEST(RbpfTest, FiltersOnlyAfterEnoughMotion) {
   EXPECT_EQ(filter.update_count(), 2);
 }
 
+// Feeds `scans` (with their odometry gaps) to `filter`; the last pose's error against `truth`.
+slam::testing::EndError EndErrorAfter(Rbpf& filter, const std::vector<SyncedScan>& scans,
+                                      const std::vector<GroundTruthPose>& truth) {
+  RbpfStep step;
+  for (const SyncedScan& s : scans) step = filter.AddScan(s.scan, s.increment, s.odometry_gap_s);
+  return slam::testing::EndPoseError(step.best_pose, truth);
+}
+
 // A gap in the log while the robot turns by more than 1 rad: the scans and odometry of the turn
 // are missing and the scan after it comes with no motion and the odometry's silence. The update
 // after the gap matches at every heading near by and takes the most likely match as the
@@ -205,9 +213,8 @@ TEST(RbpfTest, AfterAGapInTheOdometryTheFilterFindsTheTurnItMissed) {
   };
   auto run_with = [&](const RbpfOptions& options) {
     Rbpf filter(options);
-    RbpfStep step;
-    for (const SyncedScan& s : scans) step = filter.AddScan(s.scan, s.increment, s.odometry_gap_s);
-    return Outcome{slam::testing::EndPoseError(step.best_pose, truth), filter.gap_corrections()};
+    const slam::testing::EndError end = EndErrorAfter(filter, scans, truth);
+    return Outcome{end, filter.gap_corrections()};
   };
   RbpfOptions options = FastOptions();
   options.num_particles = 5;  // the search is the best particle's: a few keep the test fast
@@ -248,10 +255,9 @@ TEST(RbpfTest, TheTurnCheckFindsATurnTheWheelsMissed) {
     options.num_particles = 5;  // the check is the best particle's: a few keep the test fast
     options.odometry_turn_check = turn_check;
     Rbpf filter(options);
-    RbpfStep step;
-    for (const SyncedScan& s : scans) step = filter.AddScan(s.scan, s.increment, s.odometry_gap_s);
+    const slam::testing::EndError end = EndErrorAfter(filter, scans, truth);
     *rejections = filter.odometry_rejections();
-    return slam::testing::EndPoseError(step.best_pose, truth);
+    return end;
   };
   int checked_rejections = 0;
   const slam::testing::EndError checked = run_with(true, &checked_rejections);
@@ -282,10 +288,9 @@ TEST(RbpfTest, AScanMatchedIncrementsAliasIsFoundInTheBestMap) {
     options.num_particles = 5;  // the search is the best particle's: a few keep the test fast
     Rbpf filter(options);
     filter.SetScanMatchedIncrements(scan_matched);
-    RbpfStep step;
-    for (const SyncedScan& s : scans) step = filter.AddScan(s.scan, s.increment, s.odometry_gap_s);
+    const slam::testing::EndError end = EndErrorAfter(filter, scans, truth);
     *corrections = filter.gap_corrections();
-    return slam::testing::EndPoseError(step.best_pose, truth);
+    return end;
   };
   int corrections = 0;
   const slam::testing::EndError searched = run_with(true, &corrections);
