@@ -19,7 +19,7 @@
 
 #include "slam/matching/scan_points.h"
 #include "slam/odometry/gaussian.h"
-#include "slam/pf/solution_remapping.h"
+#include "slam/matching/solution_remapping.h"
 #include "slam/types/check.h"
 
 namespace slamrig::slam {

@@ -11,7 +11,7 @@
 #include "slam/matching/scan_refiner.h"
 #include "slam/odometry/odometry_calibration.h"
 #include "slam/pf/particle_filter_options.h"
-#include "slam/pf/solution_remapping.h"
+#include "slam/matching/solution_remapping.h"
 #include "slam/types/pose2.h"
 #include "slam/types/records.h"
 #include "slam/types/thread_pool.h"

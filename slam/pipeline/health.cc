@@ -49,12 +49,6 @@ double NisWindow::ratio() const {
   return nis_sum_ / ChiSquareQuantile(kProbability, dimension_sum_);
 }
 
-MatchConstraints ScanGeometry(const std::vector<Eigen::Vector2d>& points) {
-  constexpr double kNeighbourM = 0.3;
-  if (points.empty()) return MatchConstraints{};
-  return DecomposeInformation(ScanInformation(points, SurfaceNormals(points, kNeighbourM)));
-}
-
 double Observability(const MatchConstraints& geometry, const Eigen::Vector2d& direction) {
   const double norm = direction.norm();
   const double strongest = geometry.eigenvalues.y();

@@ -20,7 +20,7 @@
 
 #include "slam/matching/icp_odometry.h"
 #include "slam/matching/scan_points.h"
-#include "slam/pf/solution_remapping.h"
+#include "slam/matching/solution_remapping.h"
 #include "slam/pipeline/estimator.h"
 #include "slam/types/pose2.h"
 #include "slam/types/records.h"
@@ -227,14 +227,9 @@ class WheelAgreement {
   double contradicted_m_ = 0.0;    // the closed stretches'
 };
 
-/// The translation directions a scan's own geometry constrains (MatchConstraints: the
-/// point-to-line information, ScanInformation with normals from neighbours within 0.3 m, yaw left
-/// free).
-MatchConstraints ScanGeometry(const std::vector<Eigen::Vector2d>& points);
-
-/// How well that geometry observes translation along `direction` (robot frame): the information
-/// along it over the strongest direction's, about 1 in a room, near 0 along a corridor's axis; 0
-/// for a scan without geometry or a zero direction.
+/// How well a scan's geometry (ScanGeometry) observes translation along `direction` (robot frame):
+/// the information along it over the strongest direction's, about 1 in a room, near 0 along a
+/// corridor's axis; 0 for a scan without geometry or a zero direction.
 double Observability(const MatchConstraints& geometry, const Eigen::Vector2d& direction);
 
 /// A filter's check of its estimate against the wheels (WheelAgreement), with the scan geometry

@@ -2,7 +2,7 @@
 // State Estimation Problems", ICRA 2016. The eigenvectors of the linearised problem's information
 // J^T J whose eigenvalues fall below a threshold span the degenerate subspace; the solution's
 // component there is replaced by the prior's (Sec. V, Eq. 11, with V_u the eigenvectors kept).
-#include "slam/pf/solution_remapping.h"
+#include "slam/matching/solution_remapping.h"
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
@@ -79,6 +79,12 @@ Eigen::Matrix3d ScanInformation(std::span<const Eigen::Vector2d> points,
     information += j * j.transpose();
   }
   return information;
+}
+
+MatchConstraints ScanGeometry(std::span<const Eigen::Vector2d> points) {
+  constexpr double kNeighbourM = 0.3;
+  if (points.empty()) return MatchConstraints{};
+  return DecomposeInformation(ScanInformation(points, SurfaceNormals(points, kNeighbourM)));
 }
 
 SelectedPoints DropGrazingPoints(std::span<const Eigen::Vector2d> points,

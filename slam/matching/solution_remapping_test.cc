@@ -1,4 +1,4 @@
-#include "slam/pf/solution_remapping.h"
+#include "slam/matching/solution_remapping.h"
 
 #include <gtest/gtest.h>
 

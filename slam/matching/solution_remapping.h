@@ -36,6 +36,11 @@ std::vector<Eigen::Vector2d> SurfaceNormals(std::span<const Eigen::Vector2d> poi
 Eigen::Matrix3d ScanInformation(std::span<const Eigen::Vector2d> points,
                                 std::span<const Eigen::Vector2d> normals);
 
+/// The translation directions a scan's own geometry constrains: DecomposeInformation of its
+/// ScanInformation, with SurfaceNormals from neighbours within 0.3 m (yaw left free). Points in
+/// the robot's frame, in beam order.
+MatchConstraints ScanGeometry(std::span<const Eigen::Vector2d> points);
+
 /// The points whose beam meets its surface at an incidence angle (between the beam and the
 /// normal) of at most `max_incidence_rad`, and their normals; points without a normal are kept.
 /// A grazing beam's footprint stretches along the wall by 1 / cos(incidence): its end point
