@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "slam/matching/map_frame_drift.h"
+#include "slam/matching/solution_remapping.h"
 #include "slam/types/check.h"
 #include "slam/types/validation.h"
 
@@ -41,6 +42,8 @@ std::vector<std::string> IcpOdometryOptions::Validate() const {
       .Require(max_covariance_ratio > 1.0, "max_covariance_ratio", max_covariance_ratio,
                "must be > 1")
       .Positive("max_yaw_stddev_rad", max_yaw_stddev_rad)
+      .Fraction("weak_direction_ratio", weak_direction_ratio)
+      .Positive("weak_direction_gate_sigmas", weak_direction_gate_sigmas)
       .Fraction("min_score", min_score)
       .Positive("max_correction_m", max_correction_m)
       .Positive("max_correction_rad", max_correction_rad)
@@ -211,6 +214,41 @@ std::optional<MatchResult> IcpOdometry::GatedMatch(const std::vector<Eigen::Vect
   return match;
 }
 
+Eigen::Vector2d IcpOdometry::KeptCorrection(const MatchResult& match, const Pose2& fallback,
+                                            const Eigen::Matrix3d& prior_covariance,
+                                            const std::vector<Eigen::Vector2d>& points,
+                                            bool* degenerate) const {
+  // Keep the (calibrated) odometry along poorly constrained directions of the match ...
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(match.covariance.topLeftCorner<2, 2>());
+  Eigen::Vector2d correction = match.pose.translation() - fallback.translation();
+  const double max_var = options_.max_translation_stddev_m * options_.max_translation_stddev_m;
+  for (int i = 0; i < 2; ++i) {
+    const double variance = eig.eigenvalues()[i];
+    if (variance > max_var ||
+        variance > options_.max_covariance_ratio * std::max(eig.eigenvalues()[0], 1e-300)) {
+      const Eigen::Vector2d e = eig.eigenvectors().col(i);
+      correction -= e.dot(correction) * e;
+      *degenerate = true;
+    }
+  }
+  // ... and along a direction the scan itself hardly sees, where the match moved far from the
+  // odometry (IcpOdometryOptions::weak_direction_ratio).
+  if (options_.weak_direction_ratio > 0.0) {
+    const MatchConstraints geometry = ScanGeometry(points);
+    const Eigen::Matrix2d to_odom = Eigen::Rotation2Dd(match.pose.theta()).toRotationMatrix();
+    const double gate = options_.weak_direction_gate_sigmas * std::sqrt(prior_covariance(0, 0));
+    for (int i = 0; i < 2; ++i) {
+      if (geometry.eigenvalues[i] >= options_.weak_direction_ratio * geometry.eigenvalues.y())
+        continue;
+      const Eigen::Vector2d e = to_odom * geometry.eigenvectors.col(i);
+      if (std::abs(e.dot(correction)) <= gate) continue;
+      correction -= e.dot(correction) * e;
+      *degenerate = true;
+    }
+  }
+  return correction;
+}
+
 IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>& increments,
                                  double odometry_gap_s) {
   SLAMRIG_CHECK(!increments.empty(), "IcpOdometry::Add: no increment");
@@ -272,21 +310,9 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
   step.outcome = points.empty() ? IcpOdometryOutcome::kNoPoints : IcpOdometryOutcome::kMatchFailed;
 
   if (match) {
-    // Keep the (calibrated) odometry along poorly constrained directions of the match.
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(
-        match->covariance.topLeftCorner<2, 2>());
-    Eigen::Vector2d correction = match->pose.translation() - fallback.translation();
     bool degenerate = false;
-    const double max_var = options_.max_translation_stddev_m * options_.max_translation_stddev_m;
-    for (int i = 0; i < 2; ++i) {
-      const double variance = eig.eigenvalues()[i];
-      if (variance > max_var ||
-          variance > options_.max_covariance_ratio * std::max(eig.eigenvalues()[0], 1e-300)) {
-        const Eigen::Vector2d e = eig.eigenvectors().col(i);
-        correction -= e.dot(correction) * e;
-        degenerate = true;
-      }
-    }
+    const Eigen::Vector2d correction =
+        KeptCorrection(*match, fallback, prior_covariance, points, &degenerate);
     double yaw = match->pose.theta();
     if (match->covariance(2, 2) > options_.max_yaw_stddev_rad * options_.max_yaw_stddev_rad) {
       yaw = fallback.theta();

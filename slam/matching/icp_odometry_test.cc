@@ -3,7 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
+#include <utility>
 
+#include "slam/matching/scan_points.h"
+#include "slam/matching/solution_remapping.h"
 #include "slam/matching/testing/segment_world.h"
 
 namespace slamrig::slam {
@@ -171,6 +175,58 @@ TEST(IcpOdometryTest, FallsBackToOdometryAlongADegenerateCorridor) {
   EXPECT_LT(std::abs(NormalizeAngle(estimate.theta() - truth.theta())), 0.01);
   // With the heading corrected, the distance along the axis is the odometry's: 3 % too long.
   EXPECT_NEAR(estimate.x() - start.x(), 1.03 * (truth.x() - start.x()), 0.05);
+}
+
+// A corridor closed by a wall 15 m ahead: the wall's few returns are the only surface across the
+// axis, so the scan's own geometry sees the axis weakly (under the 15 % of weak_direction_ratio)
+// while ICP's covariance is far from degenerate and its match does correct the odometry there.
+SegmentWorld CorridorWithAFarEnd() {
+  return SegmentWorld(
+      {{{-100.0, -1.0}, {15.0, -1.0}}, {{-100.0, 1.0}, {15.0, 1.0}}, {{15.0, -1.0}, {15.0, 1.0}}});
+}
+
+// Where the scan sees a direction weakly, a match that moved the pose along it beyond the gate is
+// taken for a slide and the odometry stands there. With the rule off the same match corrects the
+// odometry (the far wall does hold it: what the rule trades for the wheels); within the gate, or
+// where the scan sees every direction well (the office), the rule leaves the match as it is.
+TEST(IcpOdometryTest, KeepsTheOdometryWhereAMatchMovesFarAlongAWeaklySeenDirection) {
+  const SegmentWorld corridor = CorridorWithAFarEnd(), office = SegmentWorld::Office();
+  const Pose2 truth(0.5, 0.0, 0.0);
+  // The second scan's step with the rule on and off: the odometry off by `error_m` along x.
+  auto steps = [&](const SegmentWorld& world, const Pose2& start, double error_m) {
+    std::pair<IcpOdometryStep, IcpOdometryStep> on_off;
+    for (const bool on : {true, false}) {
+      IcpOdometryOptions options;
+      options.weak_direction_ratio = on ? 0.15 : 0.0;
+      IcpOdometry icp(options);
+      icp.Add(world.Scan(start, Time(), RangeFinderSpec{}, nullptr), Pose2());
+      const IcpOdometryStep step =
+          icp.Add(world.Scan(start * truth, Time(), RangeFinderSpec{}, nullptr),
+                  Pose2(truth.x() + error_m, 0.0, 0.0));
+      (on ? on_off.first : on_off.second) = step;
+    }
+    return on_off;
+  };
+  const Pose2 origin;
+  ASSERT_EQ(ScanGeometry(ScanToBasePoints(corridor.Scan(truth, Time(), RangeFinderSpec{}, nullptr),
+                                          IcpOdometryOptions().points))
+                .WeakCount(0.15),
+            1);
+
+  const auto [slid, matched] = steps(corridor, origin, 0.3);
+  EXPECT_EQ(matched.outcome, IcpOdometryOutcome::kMatched);
+  EXPECT_NEAR(matched.pose.x(), truth.x(), 0.03);
+  EXPECT_EQ(slid.outcome, IcpOdometryOutcome::kDegenerate);
+  EXPECT_NEAR(slid.pose.x(), truth.x() + 0.3, 0.01);
+  EXPECT_NEAR(slid.pose.y(), 0.0, 0.02);  // across the corridor the match holds
+
+  for (const auto& [world, start, error_m] :
+       {std::tuple{&corridor, origin, 0.06}, std::tuple{&office, Pose2(5.0, 1.5, 0.0), 0.3}}) {
+    const auto [on, off] = steps(*world, start, error_m);
+    EXPECT_EQ(on.outcome, off.outcome) << error_m;
+    EXPECT_EQ(on.pose, off.pose) << error_m;
+  }
+  EXPECT_NEAR(steps(office, Pose2(5.0, 1.5, 0.0), 0.3).first.pose.x(), truth.x(), 0.02);
 }
 
 // Wheels that turn the robot 0.02 rad per metre: a lap of the office fits the drift from the clear

@@ -60,6 +60,8 @@ void VisitFields(V& v, IcpOdometryOptions& o) {
   v("max_translation_stddev_m", o.max_translation_stddev_m);
   v("max_covariance_ratio", o.max_covariance_ratio);
   v("max_yaw_stddev_rad", o.max_yaw_stddev_rad);
+  v("weak_direction_ratio", o.weak_direction_ratio);
+  v("weak_direction_gate_sigmas", o.weak_direction_gate_sigmas);
   v("min_score", o.min_score);
   v("max_correction_m", o.max_correction_m);
   v("max_correction_rad", o.max_correction_rad);
