@@ -81,12 +81,19 @@ TEST(ScanMatchedOdometryTest, RecoversMotionTriggeredStepsWithoutOdometry) {
   EXPECT_GE(odometry.counts().matched, steps * 95 / 100);
 }
 
+// A 2 m wide corridor along x with pillars (0.3 m boxes on its left wall) every `spacing_m` from
+// x = -98 up to `pillars_to_x`, and bare walls beyond.
+SegmentWorld PillaredCorridor(double spacing_m, double pillars_to_x) {
+  SegmentWorld corridor({{{-100.0, 1.0}, {100.0, 1.0}}, {{-100.0, -1.0}, {100.0, -1.0}}});
+  for (double x = -98.0; x < pillars_to_x; x += spacing_m) corridor.AddBox(x, 0.7, x + 0.3, 1.0);
+  return corridor;
+}
+
 // A corridor with pillars along its first 30 m, then 20 m of bare walls: once the scans cannot
 // tell how far the robot went, the prediction (its last speed) carries it on, rather than the
 // seed that fits the map best, standing still.
 TEST(ScanMatchedOdometryTest, KeepsItsSpeedWhereTheCorridorCannotTell) {
-  SegmentWorld corridor({{{-100.0, 1.0}, {100.0, 1.0}}, {{-100.0, -1.0}, {100.0, -1.0}}});
-  for (double x = -98.0; x < -70.0; x += 4.0) corridor.AddBox(x, 0.7, x + 0.3, 1.0);
+  const SegmentWorld corridor = PillaredCorridor(4.0, -70.0);
   RandomEngine rng(11);
   ScanMatchedOdometry odometry;
   Pose2 truth(-99.0, 0.1, 0.0);
@@ -107,8 +114,7 @@ TEST(ScanMatchedOdometryTest, KeepsItsSpeedWhereTheCorridorCannotTell) {
 // again. Predicted still, it would be 2.5 m past its prediction when the scans came back, beyond
 // the window, and every later match would fail (it ended 6.8 m short).
 TEST(ScanMatchedOdometryTest, CoastsThroughScansThatCannotMatch) {
-  SegmentWorld corridor({{{-100.0, 1.0}, {100.0, 1.0}}, {{-100.0, -1.0}, {100.0, -1.0}}});
-  for (double x = -98.0; x < -40.0; x += 1.7) corridor.AddBox(x, 0.7, x + 0.3, 1.0);
+  const SegmentWorld corridor = PillaredCorridor(1.7, -40.0);
   RandomEngine rng(13);
   ScanMatchedOdometry odometry;
   Pose2 truth(-99.0, 0.1, 0.0);
