@@ -18,8 +18,8 @@
 #include <limits>
 
 #include "slam/matching/scan_points.h"
-#include "slam/odometry/gaussian.h"
 #include "slam/matching/solution_remapping.h"
+#include "slam/odometry/gaussian.h"
 #include "slam/types/check.h"
 
 namespace slamrig::slam {
