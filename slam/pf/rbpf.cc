@@ -168,7 +168,7 @@ std::pair<double, double> Rbpf::MotionSigmas(const Pose2& motion) const {
 }
 
 Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& points,
-                          bool* rejected) const {
+                          bool* rejected, ClimbResult* near_out) const {
   // Hypotheses for the increment, compared on the best particle's map (the increment is in the
   // robot frame, so it carries over to every particle):
   //  - the odometry holds: the match near the prediction, climbed with the motion prior, whose
@@ -198,6 +198,7 @@ Pose2 Rbpf::CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& po
 
   const ClimbResult near =
       matcher_.Climb(best.map, points, predicted, PosePrior{predicted, sigma_xy, sigma_yaw});
+  if (near_out != nullptr) *near_out = near;
   const double ex = near.pose.x() - predicted.x();
   const double ey = near.pose.y() - predicted.y();
   const double log_near = scale * matcher_.Evaluate(best.map, points, near.pose).log_likelihood +
@@ -268,7 +269,7 @@ double Rbpf::MatchedFraction(const TiledGrid& map, const std::vector<MatchPoint>
 }
 
 Pose2 Rbpf::SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchPoint>& points,
-                                   bool* moved) const {
+                                   const std::optional<ClimbResult>& climbed, bool* moved) const {
   *moved = false;
   constexpr int kWarmupUpdates = 20;
   // The grid that picks where to climb from, twice as coarse as the gap search's in position and
@@ -278,8 +279,9 @@ Pose2 Rbpf::SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchP
   const RbpfParticle& best = particles_[best_];
   const Pose2 predicted = best.pose * motion;
   const auto [sigma_xy, sigma_yaw] = MotionSigmas(motion);
-  const ClimbResult near =
-      matcher_.Climb(best.map, points, predicted, PosePrior{predicted, sigma_xy, sigma_yaw});
+  const ClimbResult near = climbed ? *climbed
+                                   : matcher_.Climb(best.map, points, predicted,
+                                                    PosePrior{predicted, sigma_xy, sigma_yaw});
   const double near_fraction = MatchedFraction(best.map, points, near.pose);
   const double bar = options_.scan_matched_accept_ratio * matched_level_;
   if (near_fraction >= bar) return motion;
@@ -299,6 +301,32 @@ Pose2 Rbpf::SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchP
   }
   *moved = true;
   return best.pose.Between(far);
+}
+
+Pose2 Rbpf::ChooseMotion(const Pose2& pending, bool after_gap,
+                         const std::vector<MatchPoint>& points, bool* rejected) {
+  if (points.empty()) return pending;
+  Pose2 motion = pending;
+  std::optional<ClimbResult> near_climb;  // the best particle's climb from `motion`'s prediction
+  if (after_gap) {
+    bool moved = false;
+    motion = SearchAfterGap(pending, points, &moved);
+    gap_corrections_ += moved;
+  } else if (options_.odometry_failure_probability > 0.0) {
+    ClimbResult near;
+    motion = CheckOdometry(pending, points, rejected, &near);
+    odometry_rejections_ += *rejected;
+    // Kept, the increment's climb is the one the alias search starts from.
+    if (!*rejected) near_climb = near;
+  }
+  if (!after_gap && scan_matched_increments_ && options_.scan_matched_window_m > 0.0 &&
+      options_.odometry_failure_probability > 0.0) {
+    bool moved = false;
+    motion = SearchScanMatchedAlias(motion, points, near_climb, &moved);
+    gap_corrections_ += moved;
+    *rejected = *rejected || moved;
+  }
+  return motion;
 }
 
 Pose2 Rbpf::SearchAfterGap(const Pose2& motion, const std::vector<MatchPoint>& points,
@@ -478,22 +506,7 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
   if (options_.weight_correlation_per_point) {
     AssignIndependenceWeights(points, options_.weight_correlation_length_m);
   }
-  Pose2 motion = pending;
-  if (after_gap && !points.empty()) {
-    bool moved = false;
-    motion = SearchAfterGap(pending, points, &moved);
-    gap_corrections_ += moved;
-  } else if (options_.odometry_failure_probability > 0.0 && !points.empty()) {
-    motion = CheckOdometry(pending, points, &step.odometry_rejected);
-    odometry_rejections_ += step.odometry_rejected;
-  }
-  if (!after_gap && scan_matched_increments_ && options_.scan_matched_window_m > 0.0 &&
-      options_.odometry_failure_probability > 0.0 && !points.empty()) {
-    bool moved = false;
-    motion = SearchScanMatchedAlias(motion, points, &moved);
-    gap_corrections_ += moved;
-    step.odometry_rejected = step.odometry_rejected || moved;
-  }
+  const Pose2 motion = ChooseMotion(pending, after_gap, points, &step.odometry_rejected);
   const double weight_exponent = WeightExponent(points);
   step.weight_exponent = weight_exponent;
   if (options_.weight_correlation_per_point && !points.empty()) {

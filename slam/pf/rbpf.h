@@ -110,16 +110,25 @@ class Rbpf {
                       bool* failed) const;
 
   void Resample(const std::vector<double>& weights);
+  /// The increment the particles move by: `pending` (the odometry since the last update), or
+  /// after a gap the search's (SearchAfterGap), or the odometry check's (CheckOdometry), then
+  /// with scan-matched increments the alias search's; counts what it replaced, and sets
+  /// `*rejected` when the odometry check or the alias search did.
+  Pose2 ChooseMotion(const Pose2& pending, bool after_gap, const std::vector<MatchPoint>& points,
+                     bool* rejected);
   /// The odometry check: `motion`, or the increment the best particle's wide match gives where
-  /// the mixture model finds that more likely (then `*rejected` is set).
-  Pose2 CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& points,
-                      bool* rejected) const;
+  /// the mixture model finds that more likely (then `*rejected` is set). `near`, when given,
+  /// receives the best particle's climb from the prediction with the motion prior.
+  Pose2 CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& points, bool* rejected,
+                      ClimbResult* near = nullptr) const;
   /// Where the increments are scan matches (RbpfOptions::scan_matched_window_m): the increment
   /// to the best place within the window at every heading on the best particle's map, where the
   /// match near the prediction falls short of the long-term matched fraction and the place found,
-  /// unique among the headings, does not (`*moved`); `motion` itself otherwise.
+  /// unique among the headings, does not (`*moved`); `motion` itself otherwise. `near`: the
+  /// climb from `motion`'s prediction where the caller has it (CheckOdometry's, when it kept
+  /// the increment), else climbed here.
   Pose2 SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchPoint>& points,
-                               bool* moved) const;
+                               const std::optional<ClimbResult>& near, bool* moved) const;
   /// The share of `points` at `pose` that the matcher counts as matched on `map`.
   double MatchedFraction(const TiledGrid& map, const std::vector<MatchPoint>& points,
                          const Pose2& pose) const;
