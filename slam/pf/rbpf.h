@@ -124,11 +124,11 @@ class Rbpf {
   /// Where the increments are scan matches (RbpfOptions::scan_matched_window_m): the increment
   /// to the best place within the window at every heading on the best particle's map, where the
   /// match near the prediction falls short of the long-term matched fraction and the place found,
-  /// unique among the headings, does not (`*moved`); `motion` itself otherwise. `near`: the
+  /// unique among the headings, does not (`*moved`); `motion` itself otherwise. `climbed`: the
   /// climb from `motion`'s prediction where the caller has it (CheckOdometry's, when it kept
   /// the increment), else climbed here.
   Pose2 SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchPoint>& points,
-                               const std::optional<ClimbResult>& near, bool* moved) const;
+                               const std::optional<ClimbResult>& climbed, bool* moved) const;
   /// The share of `points` at `pose` that the matcher counts as matched on `map`.
   double MatchedFraction(const TiledGrid& map, const std::vector<MatchPoint>& points,
                          const Pose2& pose) const;
