@@ -66,7 +66,7 @@ TEST(WorldYamlTest, ABadWorldFileGivesOneLineNamingFileLineAndKey) {
        "bad.yaml:3:35: walls[0].sise_m: unknown key"},
       {"negative friction",
        "name: t\nzones:\n  - name: z\n    shape: {type: circle, radius_m: 1.0}\n    mu: -0.2\n",
-       "bad.yaml:3:5: zones[0].mu = -0.2; must be >= 0"},
+       "bad.yaml:5:9: zones[0].mu = -0.2; must be >= 0"},
       {"self-intersecting polygon",
        "name: t\nwalls:\n  - type: polygon\n    points_m: [[0, 0], [2, 2], [2, 0], [0, 2]]\n",
        "bad.yaml:3:5: walls[0].points_m: edges 0 and 2 cross"},
@@ -116,13 +116,13 @@ TEST(RobotYamlTest, ABadRobotFileGivesOneLineNamingFileLineAndKey) {
       {"unknown key", "name: r\nlidar:\n  num_beems: 10\n",
        "bad_robot.yaml:3:3: lidar.num_beems: unknown key"},
       {"out of range", "name: r\nlidar:\n  num_beams: 0\n",
-       "bad_robot.yaml:3:3: lidar.num_beams = 0; must be > 1"},
+       "bad_robot.yaml:3:14: lidar.num_beams = 0; must be > 1"},
       {"negative torque", "name: r\nmotor: {max_torque_n_m: -1}\n",
-       "bad_robot.yaml:2:8: motor.max_torque_n_m = -1; must be > 0"},
+       "bad_robot.yaml:2:25: motor.max_torque_n_m = -1; must be > 0"},
       {"wrong type", "name: r\nwheels:\n  per_side: two\n",
        "bad_robot.yaml:3:13: wheels.per_side: expected an integer, got 'two'"},
       {"nested imu", "name: r\nimu:\n  gyro: {scale_error: -2}\n",
-       "bad_robot.yaml:3:9: imu.gyro.scale_error = -2; must be > -1"},
+       "bad_robot.yaml:3:23: imu.gyro.scale_error = -2; must be > -1"},
   };
   for (const BadFile& c : cases) {
     const std::string path = WriteFile("bad_robot.yaml", c.text);

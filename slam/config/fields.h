@@ -12,7 +12,8 @@
 //                                   (a list of texts: a command's arguments)
 //   v.Enum(key, e, {{E::kA, "a"}})  an enum by name; absent keeps the default
 //   v.RequiredEnum(key, e, names)   the same, but the key must be there
-//   v.Struct(key, s)                a nested map (its own VisitFields and Validate())
+//   v.Struct(key, s)                a nested map (its own VisitFields and Validate(), whose keys
+//                                   are relative to s: the reader prefixes the path)
 //   v.OptionalStruct(key, opt)      a nested map that may be absent (std::optional)
 //   v.List(key, vector)             a list of maps
 

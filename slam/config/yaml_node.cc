@@ -98,7 +98,24 @@ void YamlNode::ThrowIfInvalid(const std::vector<std::string>& errors) const {
       }
     }
   }
-  throw ConfigError(MarkString(usage_->file, node_.Mark()) + ": " + joined);
+  // Otherwise by the deepest node of this map that the first broken key reaches.
+  const std::string field = errors.front().substr(0, errors.front().find(" = "));
+  std::string relative = field;
+  if (!path_.empty()) {
+    const bool below = field.size() > path_.size() && field.compare(0, path_.size(), path_) == 0 &&
+                       field[path_.size()] == '.';
+    relative = below ? field.substr(path_.size() + 1) : std::string();
+  }
+  YAML::Node located = node_;
+  for (std::size_t start = 0; !relative.empty() && start <= relative.size();) {
+    const std::size_t dot = std::min(relative.find('.', start), relative.size());
+    const std::string key = relative.substr(start, dot - start);
+    const YAML::Node parent = located;  // const: a missing key must not be created
+    if (!parent.IsMap() || !parent[key].IsDefined()) break;
+    located.reset(parent[key]);
+    start = dot + 1;
+  }
+  throw ConfigError(MarkString(usage_->file, located.Mark()) + ": " + joined);
 }
 
 std::string YamlNode::Describe() const {

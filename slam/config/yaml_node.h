@@ -82,8 +82,9 @@ class YamlNode {
   std::string Where() const;
   /// Throws ConfigError("<Where()>: <message>").
   [[noreturn]] void Fail(const std::string& message) const;
-  /// Throws one ConfigError listing `errors` (from an options struct's Validate()) at this node;
-  /// does nothing when `errors` is empty.
+  /// Throws one ConfigError listing `errors` (from an options struct's Validate(), keys under this
+  /// node's path) at the deepest node the first broken key reaches (at least this node); does
+  /// nothing when `errors` is empty.
   void ThrowIfInvalid(const std::vector<std::string>& errors) const;
 
   const std::string& path() const { return path_; }

@@ -28,11 +28,8 @@
 namespace slamrig::slam {
 std::vector<std::string> GraphSlamOptions::Validate() const {
   Rules rules;
-  const std::string prefix = "icp_odometry.";
-  for (std::string e : odometry.Validate()) {
-    rules.Add("odometry_icp." + (e.rfind(prefix, 0) == 0 ? e.substr(prefix.size()) : e));
-  }
-  rules.NonNegative("keyframe_distance_m", keyframe_distance_m)
+  rules.Nested("odometry_icp", odometry.Validate())
+      .NonNegative("keyframe_distance_m", keyframe_distance_m)
       .NonNegative("keyframe_angle_rad", keyframe_angle_rad)
       .NonNegative("edge_sigma_xy_per_m", edge_sigma_xy_per_m)
       .Positive("edge_sigma_xy_floor_m", edge_sigma_xy_floor_m)
@@ -58,9 +55,9 @@ std::vector<std::string> GraphSlamOptions::Validate() const {
       .Positive("submap_resolution_m", submap_resolution_m)
       .Positive("submap_blur_m", submap_blur_m)
       .AtLeast("query_keyframes", query_keyframes, 1)
-      .Nested("", correlative.Validate());
-  for (std::string e : loop_icp.Validate()) rules.Add("loop_" + e);
-  rules.Fraction("loop_min_icp_score", loop_min_icp_score)
+      .Nested("correlative", correlative.Validate())
+      .Nested("loop_icp", loop_icp.Validate())
+      .Fraction("loop_min_icp_score", loop_min_icp_score)
       .Positive("loop_max_refinement_m", loop_max_refinement_m)
       .Positive("loop_max_search_stddev_m", loop_max_search_stddev_m)
       .Require(loop_max_covariance_ratio > 1.0, "loop_max_covariance_ratio",

@@ -22,7 +22,7 @@ std::vector<std::string> PoseGraphOptimizerOptions::Validate() const {
                                     {"parameter_tolerance", parameter_tolerance}}) {
     rules.Require(finite_non_negative(value), name, value, "must be finite and >= 0");
   }
-  return PrefixErrors("graph", rules.errors());
+  return rules.errors();
 }
 
 const char* RobustLossName(RobustLoss loss) {

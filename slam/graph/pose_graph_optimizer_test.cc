@@ -306,12 +306,11 @@ TEST(PoseGraphOptimizerOptionsTest, ValidateNamesFieldValueAndRule) {
   o.initial_trust_region_radius = 0.0;
   o.num_threads = 0;
   o.function_tolerance = std::nan("");
-  EXPECT_THAT(o.Validate(),
-              ElementsAre("graph.max_iterations = 0; must be >= 1",
-                          "graph.robust_loss_scale = -1; must be finite and > 0",
-                          "graph.initial_trust_region_radius = 0; must be finite and > 0",
-                          "graph.num_threads = 0; must be >= 1",
-                          "graph.function_tolerance = nan; must be finite and >= 0"));
+  EXPECT_THAT(o.Validate(), ElementsAre("max_iterations = 0; must be >= 1",
+                                        "robust_loss_scale = -1; must be finite and > 0",
+                                        "initial_trust_region_radius = 0; must be finite and > 0",
+                                        "num_threads = 0; must be >= 1",
+                                        "function_tolerance = nan; must be finite and >= 0"));
 }
 
 }  // namespace

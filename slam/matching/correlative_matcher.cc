@@ -89,7 +89,7 @@ std::vector<std::string> CorrelativeMatcherOptions::Validate() const {
       .AtLeast("covariance_half_cells", covariance_half_cells, 1)
       .AtLeast("covariance_half_steps", covariance_half_steps, 1)
       .Positive("covariance_score_scale", covariance_score_scale);
-  return PrefixErrors("correlative", rules.errors());
+  return rules.errors();
 }
 
 CorrelativeMatcher::CorrelativeMatcher(const CorrelativeMatcherOptions& options,

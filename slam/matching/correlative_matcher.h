@@ -33,7 +33,7 @@ struct CorrelativeMatcherOptions {
   /// ... by exp((score - best score) / covariance_score_scale).
   double covariance_score_scale = 0.02;
 
-  /// One message per broken rule (prefixed "correlative.").
+  /// One message per broken rule, keys relative to this struct (the container names it).
   std::vector<std::string> Validate() const;
 };
 

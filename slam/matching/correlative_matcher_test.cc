@@ -386,9 +386,9 @@ TEST(CorrelativeMatcherOptionsTest, ValidateNamesEveryBrokenField) {
   options.covariance_score_scale = 0.0;
   const std::vector<std::string> errors = options.Validate();
   ASSERT_EQ(errors.size(), 3u);
-  EXPECT_EQ(errors[0], "correlative.linear_window_m = -1; must be >= 0");
-  EXPECT_EQ(errors[1], "correlative.branch_and_bound_depth = 0; must be in [1, 12]");
-  EXPECT_EQ(errors[2], "correlative.covariance_score_scale = 0; must be > 0");
+  EXPECT_EQ(errors[0], "linear_window_m = -1; must be >= 0");
+  EXPECT_EQ(errors[1], "branch_and_bound_depth = 0; must be in [1, 12]");
+  EXPECT_EQ(errors[2], "covariance_score_scale = 0; must be > 0");
 }
 
 }  // namespace

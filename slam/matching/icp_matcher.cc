@@ -175,7 +175,7 @@ std::vector<std::string> IcpOptions::Validate() const {
       .AtLeast("normal_neighbors", normal_neighbors, 3)
       .Positive("normal_radius_m", normal_radius_m)
       .AtLeast("min_correspondences", min_correspondences, 3);
-  return PrefixErrors("icp", rules.errors());
+  return rules.errors();
 }
 
 IcpMatcher::IcpMatcher(const IcpOptions& options, std::vector<Eigen::Vector2d> reference)

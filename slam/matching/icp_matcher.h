@@ -56,7 +56,7 @@ struct IcpOptions {
   double normal_radius_m = 0.5;
   int min_correspondences = 10;  ///< fewer pairs in an iteration: the match fails
 
-  /// One message per broken rule (prefixed "icp.").
+  /// One message per broken rule, keys relative to this struct (the container names it).
   std::vector<std::string> Validate() const;
 };
 

@@ -313,9 +313,9 @@ TEST(IcpOptionsTest, ValidateNamesEveryBrokenField) {
   options.normal_neighbors = 2;
   const std::vector<std::string> errors = options.Validate();
   ASSERT_EQ(errors.size(), 3u);
-  EXPECT_EQ(errors[0], "icp.max_correspondence_distance_m = -1; must be > 0");
-  EXPECT_EQ(errors[1], "icp.trim_fraction = 0; must be in (0, 1]");
-  EXPECT_EQ(errors[2], "icp.normal_neighbors = 2; must be >= 3");
+  EXPECT_EQ(errors[0], "max_correspondence_distance_m = -1; must be > 0");
+  EXPECT_EQ(errors[1], "trim_fraction = 0; must be in (0, 1]");
+  EXPECT_EQ(errors[2], "normal_neighbors = 2; must be >= 3");
 }
 
 }  // namespace

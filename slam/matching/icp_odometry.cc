@@ -53,11 +53,10 @@ std::vector<std::string> IcpOdometryOptions::Validate() const {
       .NonNegative("sigma_yaw_per_m", sigma_yaw_per_m)
       .NonNegative("sigma_yaw_floor_rad", sigma_yaw_floor_rad)
       .Nested("search", search.Validate())
-      .Nested("calibration", calibration.Validate());
-  std::vector<std::string> errors = icp.Validate();
-  AppendErrors(&errors, points.Validate());
-  AppendErrors(&errors, PrefixErrors("icp_odometry", rules.errors()));
-  return errors;
+      .Nested("calibration", calibration.Validate())
+      .Nested("icp", icp.Validate())
+      .Nested("points", points.Validate());
+  return rules.errors();
 }
 
 IcpOdometry::IcpOdometry(const IcpOdometryOptions& options)

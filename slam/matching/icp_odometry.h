@@ -116,7 +116,7 @@ struct IcpOdometryOptions {
   /// noise scales them (sigma_xy_* and sigma_yaw_* above).
   Eigen::Vector2d IncrementSigmas(const Pose2& increment) const;
 
-  /// One message per broken rule (prefixed "icp_odometry."; the ICP and point options' own).
+  /// One message per broken rule, keys relative to this struct ("icp.", "points." nested).
   std::vector<std::string> Validate() const;
 };
 

@@ -308,8 +308,8 @@ TEST(IcpOdometryOptionsTest, ValidateIncludesTheNestedOptions) {
   options.icp.trim_fraction = 2.0;
   const std::vector<std::string> errors = options.Validate();
   ASSERT_EQ(errors.size(), 2u);
-  EXPECT_EQ(errors[0], "icp.trim_fraction = 2; must be in (0, 1]");
-  EXPECT_EQ(errors[1], "icp_odometry.local_map_keyframes = 0; must be >= 1");
+  EXPECT_EQ(errors[0], "local_map_keyframes = 0; must be >= 1");
+  EXPECT_EQ(errors[1], "icp.trim_fraction = 2; must be in (0, 1]");
 }
 
 }  // namespace

@@ -101,5 +101,35 @@ TEST(EstimatorConfigTest, ErrorsNameFileLineAndKey) {
               ::testing::HasSubstr("correlation.xy_half_width_cells = 99"));
 }
 
+// Each options struct names its keys relative to itself; the reader adds the path once, however
+// deep the struct sits (a struct that named itself too would read "odometry_icp.icp.icp."), and
+// the error points at the broken value.
+TEST(EstimatorConfigTest, ANestedStructsBrokenRuleIsNamedByItsPathOnce) {
+  const auto error = [](const std::string& text) {
+    try {
+      const YamlNode node = YamlNode::LoadString(text, "s.yaml");
+      ParseEstimatorConfig("e", node);
+      node.CheckAllKeysUsed();
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error("algorithm: graph\nodometry_icp:\n  icp: {trim_fraction: 2}\n"),
+            "s.yaml:3:24: odometry_icp.icp.trim_fraction = 2; must be in (0, 1]");
+  EXPECT_EQ(error("algorithm: graph\nodometry_icp: {local_map_keyframes: 0}\n"),
+            "s.yaml:2:37: odometry_icp.local_map_keyframes = 0; must be >= 1");
+  EXPECT_EQ(error("algorithm: graph\nloop_icp: {trim_fraction: 2}\n"),
+            "s.yaml:2:27: loop_icp.trim_fraction = 2; must be in (0, 1]");
+  EXPECT_EQ(error("algorithm: graph\ncorrelative: {linear_window_m: -1}\n"),
+            "s.yaml:2:32: correlative.linear_window_m = -1; must be >= 0");
+  EXPECT_EQ(error("algorithm: graph\noptimizer: {max_iterations: 0}\n"),
+            "s.yaml:2:29: optimizer.max_iterations = 0; must be >= 1");
+  EXPECT_EQ(error("algorithm: icp-odometry\nicp: {max_iterations: 0}\n"),
+            "s.yaml:2:23: icp.max_iterations = 0; must be >= 1");
+  EXPECT_EQ(error("algorithm: icp-odometry\nlocal_map_keyframes: 0\n"),
+            "s.yaml:2:22: local_map_keyframes = 0; must be >= 1");
+}
+
 }  // namespace
 }  // namespace slamrig::slam

@@ -7,13 +7,9 @@
 namespace slamrig::slam {
 
 std::vector<std::string> IcpOdometryEstimatorOptions::Validate() const {
-  // The odometry's keys sit at the top level of this table: drop its own "icp_odometry." prefix.
+  // The odometry's keys sit at the top level of this table.
   Rules rules;
-  const std::string prefix = "icp_odometry.";
-  for (std::string e : icp_odometry.Validate()) {
-    rules.Add(e.rfind(prefix, 0) == 0 ? e.substr(prefix.size()) : e);
-  }
-  rules.Nested("map", map.Validate());
+  rules.Nested("", icp_odometry.Validate()).Nested("map", map.Validate());
   return rules.errors();
 }
 
