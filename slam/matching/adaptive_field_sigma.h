@@ -45,7 +45,7 @@ struct AdaptiveSigmaOptions {
   /// move recomputes the whole field.
   double change_ratio = 0.1;
 
-  /// One message per broken rule (prefixed "adaptive_sigma.").
+  /// One message per broken rule, keys relative to this struct (the container names it).
   std::vector<std::string> Validate() const;
 };
 

@@ -18,7 +18,7 @@ struct LikelihoodFieldOptions {
   float occupied_threshold = 0.0f;  ///< log-odds above this is a wall
   double cutoff_sigmas = 3.0;       ///< walls further than this many sigmas count as "none near"
 
-  /// One message per broken rule (prefixed "likelihood_field.").
+  /// One message per broken rule, keys relative to this struct (the container names it).
   std::vector<std::string> Validate() const;
 };
 

@@ -45,7 +45,7 @@ struct MapCorrelatorOptions {
   int side() const { return 2 * xy_half_width_cells + 1; }
   /// Number of yaw shifts, 2n + 1.
   int num_yaws() const { return 2 * yaw_half_steps + 1; }
-  /// One message per broken rule (prefixed "correlation.").
+  /// One message per broken rule, keys relative to this struct (the container names it).
   std::vector<std::string> Validate() const;
 };
 

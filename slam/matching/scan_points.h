@@ -23,7 +23,7 @@ struct ScanPointsOptions {
   /// see-through returns in buildings) does not arise where there is nothing near. 0: never.
   double sparse_fraction = 0.0;
 
-  /// One message per broken rule (prefixed "points.").
+  /// One message per broken rule, keys relative to this struct (the container names it).
   std::vector<std::string> Validate() const;
 };
 

@@ -34,7 +34,7 @@ struct ScanRefinerOptions {
   bool maximise_score = false;
   int max_halvings = 5;  ///< with maximise_score: step halvings tried before giving up
 
-  /// One message per broken rule (prefixed "refine.").
+  /// One message per broken rule, keys relative to this struct (the container names it).
   std::vector<std::string> Validate() const;
 };
 

@@ -38,7 +38,7 @@ struct OdometryCalibrationOptions {
   /// 0 = always applied.
   double min_significance = 3.0;
 
-  /// One message per broken rule (prefixed "odometry_calibration.").
+  /// One message per broken rule, keys relative to this struct (the container names it).
   std::vector<std::string> Validate() const;
 };
 

@@ -111,7 +111,7 @@ struct RelocalisationOptions {
   double reset_sigma_xy_m = 0.02;      ///< particles are redrawn around the match with this
   double reset_sigma_yaw_rad = 0.005;  ///< spread
 
-  /// One message per broken rule (prefixed "relocalisation.").
+  /// One message per broken rule, keys relative to this struct (the container names it).
   std::vector<std::string> Validate() const;
 };
 

@@ -43,7 +43,7 @@ struct RbpfMatcherOptions {
   /// the odometry model alone.
   double min_matched_fraction = 0.3;
 
-  /// One message per broken rule (prefixed "matcher.").
+  /// One message per broken rule, keys relative to this struct (the container names it).
   std::vector<std::string> Validate() const;
 };
 

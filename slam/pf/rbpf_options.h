@@ -22,7 +22,7 @@ struct RbpfMotionNoise {
   double min_xy_m = 0.01;      ///< floor on sigma_xy
   double min_yaw_rad = 0.005;  ///< floor on sigma_yaw
 
-  /// One message per broken rule (prefixed "motion.").
+  /// One message per broken rule, keys relative to this struct (the container names it).
   std::vector<std::string> Validate() const;
 };
 
