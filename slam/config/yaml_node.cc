@@ -1,5 +1,6 @@
 #include "slam/config/yaml_node.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -91,20 +92,16 @@ void YamlNode::ThrowIfInvalid(const std::vector<std::string>& errors) const {
   for (const auto& e : errors) {
     const std::string field = e.substr(0, e.find(" = "));
     for (const auto& [path, origin] : usage_->overridden) {
-      if (field == path ||
-          (field.size() > path.size() && field.compare(0, path.size(), path) == 0 &&
-           field[path.size()] == '.')) {
-        throw ConfigError(origin + ": " + joined);
-      }
+      if (IsAtOrBelow(field, path)) throw ConfigError(origin + ": " + joined);
     }
   }
   // Otherwise by the deepest node of this map that the first broken key reaches.
   const std::string field = errors.front().substr(0, errors.front().find(" = "));
-  std::string relative = field;
-  if (!path_.empty()) {
-    const bool below = field.size() > path_.size() && field.compare(0, path_.size(), path_) == 0 &&
-                       field[path_.size()] == '.';
-    relative = below ? field.substr(path_.size() + 1) : std::string();
+  std::string relative;
+  if (path_.empty()) {
+    relative = field;
+  } else if (field != path_ && IsAtOrBelow(field, path_) && field[path_.size()] == '.') {
+    relative = field.substr(path_.size() + 1);
   }
   YAML::Node located = node_;
   for (std::size_t start = 0; !relative.empty() && start <= relative.size();) {
