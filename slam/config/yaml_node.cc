@@ -1,11 +1,12 @@
 #include "slam/config/yaml_node.h"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
+#include <vector>
 
 namespace slamrig {
 namespace {
@@ -21,6 +22,39 @@ bool IsAtOrBelow(const std::string& path, const std::string& ancestor) {
   return path == ancestor ||
          (path.size() > ancestor.size() && path.compare(0, ancestor.size(), ancestor) == 0 &&
           (path[ancestor.size()] == '.' || path[ancestor.size()] == '['));
+}
+
+// One step of a key path: a map key, or (index >= 0) a list element.
+struct KeyStep {
+  std::string key;
+  long index = -1;
+};
+
+// "a.b[2].c" (or ".c", "[2].c": the rest of a longer path) as its steps; an unclosed '[' or an
+// index that is not a number is a std::invalid_argument naming which.
+std::vector<KeyStep> SplitKeyPath(const std::string& key_path) {
+  std::vector<KeyStep> steps;
+  std::string token;
+  for (std::size_t i = 0; i <= key_path.size(); ++i) {
+    const char c = i < key_path.size() ? key_path[i] : '.';
+    if (c == '.' || c == '[') {
+      if (!token.empty()) steps.push_back({token, -1});
+      token.clear();
+      if (c == '[') {
+        const std::size_t close = key_path.find(']', i);
+        if (close == std::string::npos) throw std::invalid_argument("unclosed '['");
+        try {
+          steps.push_back({"", std::stol(key_path.substr(i + 1, close - i - 1))});
+        } catch (const std::logic_error&) {
+          throw std::invalid_argument("bad index");
+        }
+        i = close;
+      }
+    } else {
+      token += c;
+    }
+  }
+  return steps;
 }
 
 }  // namespace
@@ -97,20 +131,22 @@ void YamlNode::ThrowIfInvalid(const std::vector<std::string>& errors) const {
   }
   // Otherwise by the deepest node of this map that the first broken key reaches.
   const std::string field = errors.front().substr(0, errors.front().find(" = "));
-  std::string relative;
-  if (path_.empty()) {
-    relative = field;
-  } else if (field != path_ && IsAtOrBelow(field, path_) && field[path_.size()] == '.') {
-    relative = field.substr(path_.size() + 1);
+  std::vector<KeyStep> steps;
+  if (path_.empty() || (field != path_ && IsAtOrBelow(field, path_))) {
+    try {
+      steps = SplitKeyPath(field.substr(path_.size()));
+    } catch (const std::invalid_argument&) {
+      // Not a key path: the error stays at this node.
+    }
   }
+  // Map keys only: a key whose element is named ("walls[0]") stays at the map that holds it (a
+  // rule about a list element, such as a wall holding the spawn point, is the document's).
   YAML::Node located = node_;
-  for (std::size_t start = 0; !relative.empty() && start <= relative.size();) {
-    const std::size_t dot = std::min(relative.find('.', start), relative.size());
-    const std::string key = relative.substr(start, dot - start);
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    if (steps[i].index >= 0 || (i + 1 < steps.size() && steps[i + 1].index >= 0)) break;
     const YAML::Node parent = located;  // const: a missing key must not be created
-    if (!parent.IsMap() || !parent[key].IsDefined()) break;
-    located.reset(parent[key]);
-    start = dot + 1;
+    if (!parent.IsMap() || !parent[steps[i].key].IsDefined()) break;
+    located.reset(parent[steps[i].key]);
   }
   throw ConfigError(MarkString(usage_->file, located.Mark()) + ": " + joined);
 }
@@ -200,31 +236,11 @@ void YamlNode::Override(const std::string& key_path, const std::string& value,
   } else {
     usage_->path_base[full_path] = base_dir;
   }
-  // Split "a.b[2].c" into steps: names and indices.
-  struct Step {
-    std::string key;
-    long index = -1;
-  };
-  std::vector<Step> steps;
-  std::string token;
-  for (std::size_t i = 0; i <= key_path.size(); ++i) {
-    const char c = i < key_path.size() ? key_path[i] : '.';
-    if (c == '.' || c == '[') {
-      if (!token.empty()) steps.push_back({token, -1});
-      token.clear();
-      if (c == '[') {
-        const std::size_t close = key_path.find(']', i);
-        if (close == std::string::npos) throw ConfigError(where + "unclosed '['");
-        try {
-          steps.push_back({"", std::stol(key_path.substr(i + 1, close - i - 1))});
-        } catch (const std::exception&) {
-          throw ConfigError(where + "bad index");
-        }
-        i = close;
-      }
-    } else {
-      token += c;
-    }
+  std::vector<KeyStep> steps;
+  try {
+    steps = SplitKeyPath(key_path);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(where + e.what());
   }
   if (steps.empty()) throw ConfigError(where + "empty key");
   YAML::Node parsed;
