@@ -79,17 +79,21 @@ TEST(EstimatorConfigTest, ReadsWritesAndRereadsEveryField) {
   EXPECT_THAT(json.Finish(), ::testing::HasSubstr("\"particles\": 33"));
 }
 
+// The error reading `text` (file "s.yaml") as the estimator configuration `name` gives, or
+// "no error".
+std::string ConfigErrorOf(const std::string& text, const std::string& name) {
+  try {
+    const YamlNode node = YamlNode::LoadString(text, "s.yaml");
+    ParseEstimatorConfig(name, node);
+    node.CheckAllKeysUsed();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
 TEST(EstimatorConfigTest, ErrorsNameFileLineAndKey) {
-  const auto error = [](const std::string& text) {
-    try {
-      const YamlNode node = YamlNode::LoadString(text, "s.yaml");
-      ParseEstimatorConfig("pf", node);
-      node.CheckAllKeysUsed();
-    } catch (const ConfigError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
+  const auto error = [](const std::string& text) { return ConfigErrorOf(text, "pf"); };
   EXPECT_THAT(error("algorithm: nope\n"), ::testing::HasSubstr("s.yaml:1:"));
   EXPECT_THAT(error("algorithm: nope\n"), ::testing::HasSubstr("unknown algorithm 'nope'"));
   EXPECT_THAT(error("algorithm: pf\nparticles: 0\n"), ::testing::HasSubstr("particles = 0"));
@@ -105,16 +109,7 @@ TEST(EstimatorConfigTest, ErrorsNameFileLineAndKey) {
 // deep the struct sits (a struct that named itself too would read "odometry_icp.icp.icp."), and
 // the error points at the broken value.
 TEST(EstimatorConfigTest, ANestedStructsBrokenRuleIsNamedByItsPathOnce) {
-  const auto error = [](const std::string& text) {
-    try {
-      const YamlNode node = YamlNode::LoadString(text, "s.yaml");
-      ParseEstimatorConfig("e", node);
-      node.CheckAllKeysUsed();
-    } catch (const ConfigError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
+  const auto error = [](const std::string& text) { return ConfigErrorOf(text, "e"); };
   EXPECT_EQ(error("algorithm: graph\nodometry_icp:\n  icp: {trim_fraction: 2}\n"),
             "s.yaml:3:24: odometry_icp.icp.trim_fraction = 2; must be in (0, 1]");
   EXPECT_EQ(error("algorithm: graph\nodometry_icp: {local_map_keyframes: 0}\n"),
