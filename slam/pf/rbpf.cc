@@ -25,6 +25,14 @@ namespace {
 
 // A prior's standard deviation that leaves the climb free along it.
 constexpr double kNoPrior = 1e6;
+// Updates before the long-term matched fraction is a level to judge a match against.
+constexpr int kLevelWarmupUpdates = 20;
+// A match below this share of the long-term matched fraction is a poor one: it does not lower
+// that level, and it sends the map check searching.
+constexpr double kPoorMatchShare = 0.5;
+// The alias search and the map check rank their grid twice as coarse as the gap search's in
+// position and in heading: an eighth of its cost over four times its area.
+constexpr int kSearchCoarsening = 2;
 
 // About 48 of `points`, spread along the scan: ranks a grid of poses, for a climb from the best,
 // at a fraction of every point's cost.
@@ -36,7 +44,34 @@ std::vector<MatchPoint> SpreadSubset(const std::vector<MatchPoint>& points) {
   return sparse;
 }
 
+// Of the points at `pose` with no wall (a cell of positive log-odds) within a cell of their hit,
+// the share whose hit cell the map has seen free (negative log-odds) rather than never seen; 0
+// when every point finds a wall.
+double SeenFreeShare(const TiledGrid& map, const std::vector<MatchPoint>& points,
+                     const Pose2& pose) {
+  int unmatched = 0;
+  int seen_free = 0;
+  for (const MatchPoint& p : points) {
+    const Eigen::Array2i cell = map.WorldToCell(pose * p.hit);
+    bool wall = false;
+    for (int dy = -1; dy <= 1 && !wall; ++dy) {
+      for (int dx = -1; dx <= 1 && !wall; ++dx)
+        wall = map.LogOdds(cell.x() + dx, cell.y() + dy) > 0.0f;
+    }
+    if (wall) continue;
+    ++unmatched;
+    seen_free += map.LogOdds(cell) < 0.0f;
+  }
+  return unmatched == 0 ? 0.0 : static_cast<double>(seen_free) / unmatched;
+}
+
 }  // namespace
+
+double RingOffsetRms(const Pose2& a, const Pose2& b, double radius_m) {
+  const double squared = (a.translation() - b.translation()).squaredNorm() +
+                         2.0 * (1.0 - std::cos(a.theta() - b.theta())) * radius_m * radius_m;
+  return std::sqrt(squared);
+}
 
 RbpfPoseNode::~RbpfPoseNode() {
   std::shared_ptr<RbpfPoseNode> next = std::move(parent);
@@ -268,14 +303,31 @@ double Rbpf::MatchedFraction(const TiledGrid& map, const std::vector<MatchPoint>
                               static_cast<double>(points.size());
 }
 
+std::optional<Pose2> Rbpf::PlaceInBestMap(const std::vector<MatchPoint>& points,
+                                          const Pose2& center, double half_m, double yaw_half_rad,
+                                          double near_fraction) const {
+  const RbpfParticle& best = particles_[best_];
+  double ll = 0.0;
+  double other_ll = 0.0;
+  const Pose2 far =
+      BestAtAnyHeading(best.map, points, center, half_m, yaw_half_rad,
+                       PosePrior{center, kNoPrior, kNoPrior}, &ll, &other_ll, kSearchCoarsening);
+  const double far_fraction = MatchedFraction(best.map, points, far);
+  // Only a place the scan picks out: where another heading matches within the odds of a failed
+  // increment (the turn check's rule), the poor match is more likely new ground than an alias.
+  const double eps = options_.odometry_failure_probability;
+  const bool unique = options_.observation_scale * (ll - other_ll) > std::log((1.0 - eps) / eps);
+  if (!unique || far_fraction < options_.scan_matched_accept_ratio * matched_level_ ||
+      !(far_fraction > near_fraction + options_.scan_matched_win_margin * matched_level_)) {
+    return std::nullopt;
+  }
+  return far;
+}
+
 Pose2 Rbpf::SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchPoint>& points,
                                    const std::optional<ClimbResult>& climbed, bool* moved) const {
   *moved = false;
-  constexpr int kWarmupUpdates = 20;
-  // The grid that picks where to climb from, twice as coarse as the gap search's in position and
-  // in heading: an eighth of its cost over four times its area.
-  constexpr int kScanMatchedCoarsening = 2;
-  if (matched_samples_ < kWarmupUpdates) return motion;
+  if (matched_samples_ < kLevelWarmupUpdates) return motion;
   const RbpfParticle& best = particles_[best_];
   const Pose2 predicted = best.pose * motion;
   const auto [sigma_xy, sigma_yaw] = MotionSigmas(motion);
@@ -283,24 +335,34 @@ Pose2 Rbpf::SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchP
                                    : matcher_.Climb(best.map, points, predicted,
                                                     PosePrior{predicted, sigma_xy, sigma_yaw});
   const double near_fraction = MatchedFraction(best.map, points, near.pose);
-  const double bar = options_.scan_matched_accept_ratio * matched_level_;
-  if (near_fraction >= bar) return motion;
-  double ll = 0.0;
-  double other_ll = 0.0;
-  const Pose2 far = BestAtAnyHeading(best.map, points, predicted, options_.scan_matched_window_m,
-                                     std::numbers::pi, PosePrior{predicted, kNoPrior, kNoPrior},
-                                     &ll, &other_ll, kScanMatchedCoarsening);
-  const double far_fraction = MatchedFraction(best.map, points, far);
-  // Only a place the scan picks out: where another heading matches within the odds of a failed
-  // increment (the turn check's rule), the poor match is more likely new ground than an alias.
-  const double eps = options_.odometry_failure_probability;
-  const bool unique = options_.observation_scale * (ll - other_ll) > std::log((1.0 - eps) / eps);
-  if (!unique || far_fraction < bar ||
-      !(far_fraction > near_fraction + options_.scan_matched_win_margin * matched_level_)) {
-    return motion;
-  }
+  if (near_fraction >= options_.scan_matched_accept_ratio * matched_level_) return motion;
+  const std::optional<Pose2> far = PlaceInBestMap(points, predicted, options_.scan_matched_window_m,
+                                                  std::numbers::pi, near_fraction);
+  if (!far) return motion;
   *moved = true;
-  return best.pose.Between(far);
+  return best.pose.Between(*far);
+}
+
+std::optional<Pose2> Rbpf::CheckMap(const Pose2& motion,
+                                    const std::vector<MatchPoint>& points) const {
+  if (options_.map_check_window_m <= 0.0 || options_.odometry_failure_probability <= 0.0 ||
+      matched_samples_ < kLevelWarmupUpdates || points.empty()) {
+    return std::nullopt;
+  }
+  const RbpfParticle& best = particles_[best_];
+  const Pose2 predicted = best.pose * motion;
+  const auto [sigma_xy, sigma_yaw] = MotionSigmas(motion);
+  const ClimbResult near =
+      matcher_.Climb(best.map, points, predicted, PosePrior{predicted, sigma_xy, sigma_yaw});
+  const double near_fraction = MatchedFraction(best.map, points, near.pose);
+  if (!(near_fraction < kPoorMatchShare * matched_level_)) return std::nullopt;
+  // New ground is no contradiction: only where most of the points that find no wall land on
+  // cells the map has seen free does the map say the robot is not there.
+  if (!(SeenFreeShare(best.map, points, near.pose) > 0.5)) return std::nullopt;
+  // Within a quarter turn of the prediction, the turn check's failed turn: further round, a
+  // match is a building's symmetry (a corridor seen from its other end), not the wheels' error.
+  return PlaceInBestMap(points, predicted, options_.map_check_window_m, std::numbers::pi / 2.0,
+                        near_fraction);
 }
 
 Pose2 Rbpf::ChooseMotion(const Pose2& pending, bool after_gap,
@@ -492,6 +554,7 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
     return step;
   }
   const Pose2 pending = pending_motion_;
+  update_odometry_.push_back(pending);
   pending_motion_ = Pose2();
   pending_gap_s_ = 0.0;
   step.updated = true;
@@ -507,6 +570,8 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
     AssignIndependenceWeights(points, options_.weight_correlation_length_m);
   }
   const Pose2 motion = ChooseMotion(pending, after_gap, points, &step.odometry_rejected);
+  // Before the particles write the scan into their maps: the map's own place for it.
+  const std::optional<Pose2> witness = CheckMap(motion, points);
   const double weight_exponent = WeightExponent(points);
   step.weight_exponent = weight_exponent;
   if (options_.weight_correlation_per_point && !points.empty()) {
@@ -554,8 +619,12 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
     if (particles_[i].path_log_likelihood > particles_[best_].path_log_likelihood) best_ = i;
   }
   step.best_pose = particles_[best_].pose;
+  if (witness) {
+    step.map_contradiction_m = RingOffsetRms(step.best_pose, *witness, kContradictionRadiusM);
+    map_witnesses_.push_back({update_count_ - 1, *witness});
+  }
   step.matched_fraction = MatchedFraction(particles_[best_].map, points, step.best_pose);
-  if (!points.empty() && !(step.matched_fraction < 0.5 * matched_level_)) {
+  if (!points.empty() && !(step.matched_fraction < kPoorMatchShare * matched_level_)) {
     constexpr double kLevelRate = 0.02;
     matched_level_ = matched_samples_ == 0
                          ? step.matched_fraction
@@ -575,6 +644,34 @@ std::vector<Pose2> Rbpf::BestUpdatePoses() const {
   }
   std::reverse(poses.begin(), poses.end());
   return poses;
+}
+
+double Rbpf::MapContradictionM() const {
+  if (map_witnesses_.empty()) return 0.0;
+  const std::vector<Pose2> path = BestUpdatePoses();
+  SLAMRIG_CHECK(update_odometry_.size() + 1 == path.size(),
+                "rbpf: one odometry increment per update after the first");
+  double worst = 0.0;
+  for (const RbpfMapWitness& w : map_witnesses_) {
+    SLAMRIG_CHECK(w.update >= 1 && static_cast<std::size_t>(w.update) < path.size(),
+                  "rbpf: a map witness names an update the best path does not hold");
+    // The witness carried on by the odometry: a path that came back to the map's place within
+    // kContradictionRadiusM of travel took the contradiction back.
+    Pose2 carried = w.place;
+    double travel_m = 0.0;
+    double least = std::numeric_limits<double>::infinity();
+    for (auto j = static_cast<std::size_t>(w.update); j < path.size(); ++j) {
+      if (j > static_cast<std::size_t>(w.update)) {
+        const Pose2& increment = update_odometry_[j - 1];
+        carried = carried * increment;
+        travel_m += increment.translation().norm();
+      }
+      least = std::min(least, RingOffsetRms(path[j], carried, kContradictionRadiusM));
+      if (travel_m >= kContradictionRadiusM) break;
+    }
+    worst = std::max(worst, least);
+  }
+  return worst;
 }
 
 int Rbpf::DistinctTiles() const {

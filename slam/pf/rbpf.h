@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -54,6 +55,23 @@ struct RbpfStep {
   /// The exponent the weights took this update (weight_exponent times the independent-point
   /// factor of weight_correlation_length_m; per point, times the points' mean factor).
   double weight_exponent = 1.0;
+  /// The map check's (RbpfOptions::map_check_window_m) witness at this update, if it found one:
+  /// how far the best particle is from the place its map holds for the scan (RingOffsetRms at
+  /// Rbpf::kContradictionRadiusM; 0: no witness).
+  double map_contradiction_m = 0.0;
+};
+
+/// How far apart two poses put the robot, heading included: the root mean square, over the points
+/// of a circle of `radius_m` about the robot, of the distance between each point placed at `a` and
+/// at `b`, sqrt(|t(a) - t(b)|^2 + 2 (1 - cos(a - b)) radius^2) (the cross term averages out
+/// around the circle). The translation's difference alone at radius 0; a heading's adds the
+/// chord it sweeps at that radius.
+double RingOffsetRms(const Pose2& a, const Pose2& b, double radius_m);
+
+/// Where the map check found the map holding a scan (RbpfOptions::map_check_window_m).
+struct RbpfMapWitness {
+  int update = 0;  ///< the update, counted as BestUpdatePoses() is indexed
+  Pose2 place;     ///< the scan's place on the best particle's map
 };
 
 /// A Rao-Blackwellised particle filter with per-particle maps, GMapping's method (Grisetti,
@@ -95,6 +113,20 @@ class Rbpf {
   /// (RbpfOptions::scan_matched_window_m).
   int gap_corrections() const { return gap_corrections_; }
   const RbpfOptions& options() const { return options_; }
+  /// The map check's witnesses so far (RbpfOptions::map_check_window_m).
+  const std::vector<RbpfMapWitness>& map_witnesses() const { return map_witnesses_; }
+  /// The odometry's travel after a map witness within which the best path may come back to the
+  /// place its map held (an update or two after a wrong step: the odometry check's window or a
+  /// particle's later match), and the radius at which a contradiction is measured: a heading
+  /// error counts by the chord it sweeps over that travel.
+  static constexpr double kContradictionRadiusM = 2.0;
+  /// How far the best path contradicts the best particle's map: the largest, over the map
+  /// check's witnesses, of the least distance (RingOffsetRms at kContradictionRadiusM) between
+  /// the final best path and the witness's place carried on by the odometry, over the updates
+  /// within kContradictionRadiusM of travel from the witness's. A contradiction the path took
+  /// back (a later match, or a resampling that kept a path agreeing with the witness) does not
+  /// count. 0 without witnesses.
+  double MapContradictionM() const;
 
  private:
   /// What every particle's update of one scan shares.
@@ -127,8 +159,22 @@ class Rbpf {
   /// unique among the headings, does not (`*moved`); `motion` itself otherwise. `climbed`: the
   /// climb from `motion`'s prediction where the caller has it (CheckOdometry's, when it kept
   /// the increment), else climbed here.
+  /// The place within +-`half_m` of `center` and +-`yaw_half_rad` of its heading (pi: every
+  /// heading) where `points` fit the best particle's map by the alias search's rules
+  /// (scan_matched_window_m): a matched fraction of at least scan_matched_accept_ratio of the
+  /// long-term level, above `near_fraction` by scan_matched_win_margin of it, and no other
+  /// heading within the odds of a failed increment.
+  std::optional<Pose2> PlaceInBestMap(const std::vector<MatchPoint>& points, const Pose2& center,
+                                      double half_m, double yaw_half_rad,
+                                      double near_fraction) const;
   Pose2 SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchPoint>& points,
                                const std::optional<ClimbResult>& climbed, bool* moved) const;
+  /// The map check (RbpfOptions::map_check_window_m): the place the best particle's map holds
+  /// for the scan, where the particle's match near `motion`'s prediction falls below half the
+  /// long-term matched fraction, most of its points that find no wall land on cells the map has
+  /// seen free (not new ground), and the search within a quarter turn finds one by the alias
+  /// search's rules.
+  std::optional<Pose2> CheckMap(const Pose2& motion, const std::vector<MatchPoint>& points) const;
   /// The share of `points` at `pose` that the matcher counts as matched on `map`.
   double MatchedFraction(const TiledGrid& map, const std::vector<MatchPoint>& points,
                          const Pose2& pose) const;
@@ -174,6 +220,8 @@ class Rbpf {
   double matched_level_ = 0.0;
   int matched_samples_ = 0;
   double pending_gap_s_ = 0.0;  // the longest odometry gap since the last update
+  std::vector<RbpfMapWitness> map_witnesses_;
+  std::vector<Pose2> update_odometry_;  // the odometry from each update to the next
 };
 
 }  // namespace slamrig::slam

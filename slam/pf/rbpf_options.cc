@@ -40,6 +40,7 @@ std::vector<std::string> RbpfOptions::Validate() const {
       .NonNegative("scan_matched_win_margin", scan_matched_win_margin)
       .Require(below_one(odometry_degenerate_ratio), "odometry_degenerate_ratio",
                odometry_degenerate_ratio, "must be in [0, 1)")
+      .NonNegative("map_check_window_m", map_check_window_m)
       .Fraction("resample_neff_ratio", resample_neff_ratio)
       .Nested("map", map.Validate())
       // The particles' tiled maps write every hit to its end cell (TiledGrid::InsertScan).

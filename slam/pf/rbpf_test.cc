@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <numbers>
+#include <random>
 
 #include "slam/odometry/scan_sync.h"
 #include "slam/pf/testing/rbpf_run.h"
@@ -244,6 +247,36 @@ std::vector<SyncedScan> WithMissedTurn(const std::vector<SyncedScan>& scans,
   return out;
 }
 
+// The closed form of RingOffsetRms against the circle's points themselves, over random pose
+// pairs (turns up to a half turn, shifts of metres) and radii.
+TEST(RbpfTest, RingOffsetIsTheRootMeanSquareOfTheCirclesDisplacement) {
+  RandomEngine rng(11);
+  std::uniform_real_distribution<double> shift(-3.0, 3.0);
+  std::uniform_real_distribution<double> turn(-3.1, 3.1);
+  std::uniform_real_distribution<double> radius(0.0, 5.0);
+  constexpr int kPoints = 360;
+  for (int trial = 0; trial < 200; ++trial) {
+    std::array<double, 7> draws;  // drawn in order: one seed, one case
+    for (int k = 0; k < 6; ++k) draws[k] = k % 3 == 2 ? turn(rng) : shift(rng);
+    draws[6] = radius(rng);
+    const Pose2 a(draws[0], draws[1], draws[2]);
+    const Pose2 b(draws[3], draws[4], draws[5]);
+    const double r = draws[6];
+    double sum = 0.0;
+    for (int k = 0; k < kPoints; ++k) {
+      const double angle = 2.0 * std::numbers::pi * k / kPoints;
+      const Eigen::Vector2d p(r * std::cos(angle), r * std::sin(angle));
+      sum += ((a * p) - (b * p)).squaredNorm();
+    }
+    EXPECT_NEAR(RingOffsetRms(a, b, r), std::sqrt(sum / kPoints), 1e-9) << "trial " << trial;
+    EXPECT_DOUBLE_EQ(RingOffsetRms(a, a, r), 0.0);
+  }
+  // Radius 0: the positions alone; a pure turn: the chord it sweeps.
+  EXPECT_DOUBLE_EQ(RingOffsetRms(Pose2(1.0, 2.0, 0.3), Pose2(4.0, 6.0, -1.0), 0.0), 5.0);
+  EXPECT_NEAR(RingOffsetRms(Pose2(0.0, 0.0, 0.5), Pose2(0.0, 0.0, -0.5), 2.0),
+              2.0 * 2.0 * std::sin(0.5), 1e-12);
+}
+
 TEST(RbpfTest, TheTurnCheckFindsATurnTheWheelsMissed) {
   const ShortRun& run = GetShortRun();
   const std::vector<GroundTruthPose>& truth = run.run.truth;
@@ -270,6 +303,45 @@ TEST(RbpfTest, TheTurnCheckFindsATurnTheWheelsMissed) {
   EXPECT_GT(unchecked.heading_rad, 0.5);
   RecordProperty("turn_rad", std::to_string(truth[turn.to].map_from_base.theta() -
                                             truth[turn.from].map_from_base.theta()));
+}
+
+// The map check judges the same missed turn without moving anything: the filter without the
+// turn check goes on from the wrong heading (as above), and the scan after the turn, which its
+// map holds at the right heading, is its witness, the scan's points placed metres from where the
+// map holds them. On the run as recorded the best path agrees with its map wherever it looked.
+TEST(RbpfTest, TheMapCheckSaysWhereThePathContradictsItsMap) {
+  const ShortRun& run = GetShortRun();
+  const std::vector<GroundTruthPose>& truth = run.run.truth;
+  const slam::testing::Stretch turn = slam::testing::FirstTurn(truth, 1.0, 30, 30);
+  ASSERT_GT(turn.to, turn.from) << "no turn in the run";
+  struct Judged {
+    slam::testing::EndError end;
+    std::size_t witnesses;
+    double contradiction_m;
+  };
+  auto judge = [&](const std::vector<SyncedScan>& scans, double window_m) {
+    RbpfOptions options = FastOptions();
+    options.num_particles = 5;  // the check is the best particle's: a few keep the test fast
+    options.map_check_window_m = window_m;
+    Rbpf filter(options);
+    const slam::testing::EndError end = EndErrorAfter(filter, scans, truth);
+    return Judged{end, filter.map_witnesses().size(), filter.MapContradictionM()};
+  };
+  const std::vector<SyncedScan> missed = WithMissedTurn(run.scans, turn);
+  const Judged wrong = judge(missed, RbpfOptions().map_check_window_m);
+  EXPECT_GT(wrong.end.heading_rad, 0.5);
+  EXPECT_GE(wrong.witnesses, 1u);
+  EXPECT_GT(wrong.contradiction_m, 1.0);
+  const Judged right = judge(run.scans, RbpfOptions().map_check_window_m);
+  EXPECT_LT(right.end.heading_rad, 0.1);
+  EXPECT_LT(right.contradiction_m, 0.2);
+  // The check only judges: the same path without it, and no witness.
+  const Judged unchecked = judge(missed, 0.0);
+  EXPECT_EQ(unchecked.witnesses, 0u);
+  EXPECT_EQ(unchecked.contradiction_m, 0.0);
+  EXPECT_EQ(unchecked.end.position_m, wrong.end.position_m);
+  EXPECT_EQ(unchecked.end.heading_rad, wrong.end.heading_rad);
+  RecordProperty("contradiction_m", std::to_string(wrong.contradiction_m));
 }
 
 // Without odometry the increments are scan matches, and the prior's failure is an alias of its

@@ -74,7 +74,8 @@ ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
                          {"matched_fraction_ratio", matched_ratio_.ratio()},
                          {"failed_match_share", step.failed_matches / particles},
                          {"see_through_fraction", see_through_},
-                         {"wall_crossed_m", wall_crossings_.extent_m()}},
+                         {"wall_crossed_m", wall_crossings_.extent_m()},
+                         {"map_contradiction_m", step.map_contradiction_m}},
                         std::nullopt,
                         lost_ || contradicts};
   wheels_.AppendTrace(&estimate.trace);
@@ -105,7 +106,7 @@ const std::vector<std::string>& RbpfEstimator::StatisticNames() {
   static const std::vector<std::string> names = WheelCheck::WithStatisticNames(
       {"mean_neff", "resamples", "updates", "failed_matches", "odometry_rejections",
        "gap_corrections", "mean_weight_exponent", "map_tiles", "map_tiles_per_particle",
-       "wall_crossed_m", "lost", "diverged"});
+       "wall_crossed_m", "map_witnesses", "map_contradiction_m", "lost", "diverged"});
   return names;
 }
 
@@ -126,13 +127,17 @@ std::map<std::string, double> RbpfEstimator::Statistics() const {
            ? 0.0
            : static_cast<double>(tiles) / static_cast<double>(filter_.particles().size())},
       {"wall_crossed_m", wall_crossings_.worst_m()},
+      {"map_witnesses", static_cast<double>(filter_.map_witnesses().size())},
+      {"map_contradiction_m", filter_.MapContradictionM()},
       {"lost", health_.losses()},
       {"diverged", Diverged() ? 1.0 : 0.0}};
   wheels_.AppendStatistics(&statistics);
   return statistics;
 }
 
-bool RbpfEstimator::Diverged() const { return health_.Diverged() || wheels_.Diverged(); }
+bool RbpfEstimator::Diverged() const {
+  return health_.Diverged() || wheels_.Diverged() || filter_.MapContradictionM() > kDivergedErrorM;
+}
 
 EstimatorView RbpfEstimator::View() const {
   EstimatorView view;

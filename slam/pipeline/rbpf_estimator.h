@@ -26,8 +26,9 @@ class RbpfEstimator final : public Estimator {
   /// mean_neff, resamples, updates, failed_matches (particle matches that fell back on the
   /// odometry), odometry_rejections (updates whose increment the odometry check replaced),
   /// mean_weight_exponent (the weights' exponent, RbpfStep::weight_exponent, over updates),
-  /// map_tiles (distinct tiles over all particles at the end) and map_tiles_per_particle; lost
-  /// (losses) and diverged (HealthRecord::Diverged()).
+  /// map_tiles (distinct tiles over all particles at the end) and map_tiles_per_particle;
+  /// map_witnesses and map_contradiction_m (the map check's, Rbpf::MapContradictionM); lost
+  /// (losses) and diverged.
   std::map<std::string, double> Statistics() const override;
   /// The names Statistics() reports, without an instance: the algorithm table's list (and so
   /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
@@ -35,8 +36,9 @@ class RbpfEstimator final : public Estimator {
   EstimatorView View() const override;
 
  private:
-  // Lost at the end or on more than kDivergedLostShare of the scans, or the estimate contradicted
-  // the wheels (WheelCheck::Diverged).
+  // Lost at the end or on more than kDivergedLostShare of the scans, the estimate contradicted
+  // the wheels (WheelCheck::Diverged), or the best path its own map by more than kDivergedErrorM
+  // (Rbpf::MapContradictionM).
   bool Diverged() const;
   static RbpfOptions Seeded(RbpfOptions options, std::uint64_t seed);
 
