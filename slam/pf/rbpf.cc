@@ -303,16 +303,15 @@ double Rbpf::MatchedFraction(const TiledGrid& map, const std::vector<MatchPoint>
                               static_cast<double>(points.size());
 }
 
-std::optional<Pose2> Rbpf::PlaceInBestMap(const std::vector<MatchPoint>& points,
-                                          const Pose2& center, double half_m, double yaw_half_rad,
-                                          double near_fraction) const {
-  const RbpfParticle& best = particles_[best_];
+std::optional<Pose2> Rbpf::PlaceInMap(const TiledGrid& map, const std::vector<MatchPoint>& points,
+                                      const Pose2& center, double half_m, double yaw_half_rad,
+                                      double near_fraction) const {
   double ll = 0.0;
   double other_ll = 0.0;
   const Pose2 far =
-      BestAtAnyHeading(best.map, points, center, half_m, yaw_half_rad,
+      BestAtAnyHeading(map, points, center, half_m, yaw_half_rad,
                        PosePrior{center, kNoPrior, kNoPrior}, &ll, &other_ll, kSearchCoarsening);
-  const double far_fraction = MatchedFraction(best.map, points, far);
+  const double far_fraction = MatchedFraction(map, points, far);
   // Only a place the scan picks out: where another heading matches within the odds of a failed
   // increment (the turn check's rule), the poor match is more likely new ground than an alias.
   const double eps = options_.odometry_failure_probability;
@@ -336,15 +335,15 @@ Pose2 Rbpf::SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchP
                                                     PosePrior{predicted, sigma_xy, sigma_yaw});
   const double near_fraction = MatchedFraction(best.map, points, near.pose);
   if (near_fraction >= options_.scan_matched_accept_ratio * matched_level_) return motion;
-  const std::optional<Pose2> far = PlaceInBestMap(points, predicted, options_.scan_matched_window_m,
-                                                  std::numbers::pi, near_fraction);
+  const std::optional<Pose2> far = PlaceInMap(
+      best.map, points, predicted, options_.scan_matched_window_m, std::numbers::pi, near_fraction);
   if (!far) return motion;
   *moved = true;
   return best.pose.Between(*far);
 }
 
-std::optional<Pose2> Rbpf::CheckMap(const Pose2& motion,
-                                    const std::vector<MatchPoint>& points) const {
+std::optional<Rbpf::MapCheck> Rbpf::StartMapCheck(const Pose2& motion,
+                                                  const std::vector<MatchPoint>& points) const {
   if (options_.map_check_window_m <= 0.0 || options_.odometry_failure_probability <= 0.0 ||
       matched_samples_ < kLevelWarmupUpdates || points.empty()) {
     return std::nullopt;
@@ -359,10 +358,22 @@ std::optional<Pose2> Rbpf::CheckMap(const Pose2& motion,
   // New ground is no contradiction: only where most of the points that find no wall land on
   // cells the map has seen free does the map say the robot is not there.
   if (!(SeenFreeShare(best.map, points, near.pose) > 0.5)) return std::nullopt;
+  // A copy shares the map's tiles: the particles write theirs, this one keeps the map as it was.
+  return MapCheck{best.map, predicted, near_fraction};
+}
+
+std::optional<Pose2> Rbpf::FinishMapCheck(const MapCheck& check,
+                                          const std::vector<MatchPoint>& points,
+                                          const Pose2& chosen) const {
+  // Where the particles found a place the map holds after all, the path agrees with it here.
+  if (MatchedFraction(check.map, points, chosen) >=
+      options_.scan_matched_accept_ratio * matched_level_) {
+    return std::nullopt;
+  }
   // Within a quarter turn of the prediction, the turn check's failed turn: further round, a
   // match is a building's symmetry (a corridor seen from its other end), not the wheels' error.
-  return PlaceInBestMap(points, predicted, options_.map_check_window_m, std::numbers::pi / 2.0,
-                        near_fraction);
+  return PlaceInMap(check.map, points, check.predicted, options_.map_check_window_m,
+                    std::numbers::pi / 2.0, check.near_fraction);
 }
 
 Pose2 Rbpf::ChooseMotion(const Pose2& pending, bool after_gap,
@@ -570,8 +581,9 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
     AssignIndependenceWeights(points, options_.weight_correlation_length_m);
   }
   const Pose2 motion = ChooseMotion(pending, after_gap, points, &step.odometry_rejected);
-  // Before the particles write the scan into their maps: the map's own place for it.
-  const std::optional<Pose2> witness = CheckMap(motion, points);
+  // Before the particles write the scan into their maps: the map as it was, where the scan
+  // fits it poorly.
+  const std::optional<MapCheck> map_check = StartMapCheck(motion, points);
   const double weight_exponent = WeightExponent(points);
   step.weight_exponent = weight_exponent;
   if (options_.weight_correlation_per_point && !points.empty()) {
@@ -619,6 +631,8 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
     if (particles_[i].path_log_likelihood > particles_[best_].path_log_likelihood) best_ = i;
   }
   step.best_pose = particles_[best_].pose;
+  const std::optional<Pose2> witness =
+      map_check ? FinishMapCheck(*map_check, points, step.best_pose) : std::nullopt;
   if (witness) {
     step.map_contradiction_m = RingOffsetRms(step.best_pose, *witness, kContradictionRadiusM);
     map_witnesses_.push_back({update_count_ - 1, *witness});

@@ -160,21 +160,31 @@ class Rbpf {
   /// climb from `motion`'s prediction where the caller has it (CheckOdometry's, when it kept
   /// the increment), else climbed here.
   /// The place within +-`half_m` of `center` and +-`yaw_half_rad` of its heading (pi: every
-  /// heading) where `points` fit the best particle's map by the alias search's rules
-  /// (scan_matched_window_m): a matched fraction of at least scan_matched_accept_ratio of the
-  /// long-term level, above `near_fraction` by scan_matched_win_margin of it, and no other
-  /// heading within the odds of a failed increment.
-  std::optional<Pose2> PlaceInBestMap(const std::vector<MatchPoint>& points, const Pose2& center,
-                                      double half_m, double yaw_half_rad,
-                                      double near_fraction) const;
+  /// heading) where `points` fit `map` by the alias search's rules (scan_matched_window_m): a
+  /// matched fraction of at least scan_matched_accept_ratio of the long-term level, above
+  /// `near_fraction` by scan_matched_win_margin of it, and no other heading within the odds of a
+  /// failed increment.
+  std::optional<Pose2> PlaceInMap(const TiledGrid& map, const std::vector<MatchPoint>& points,
+                                  const Pose2& center, double half_m, double yaw_half_rad,
+                                  double near_fraction) const;
   Pose2 SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchPoint>& points,
                                const std::optional<ClimbResult>& climbed, bool* moved) const;
-  /// The map check (RbpfOptions::map_check_window_m): the place the best particle's map holds
-  /// for the scan, where the particle's match near `motion`'s prediction falls below half the
-  /// long-term matched fraction, most of its points that find no wall land on cells the map has
-  /// seen free (not new ground), and the search within a quarter turn finds one by the alias
-  /// search's rules.
-  std::optional<Pose2> CheckMap(const Pose2& motion, const std::vector<MatchPoint>& points) const;
+  /// The map check (RbpfOptions::map_check_window_m), in two halves around the particles'
+  /// update. Start: where the best particle's match near `motion`'s prediction falls below half
+  /// the long-term matched fraction and most of its points that find no wall land on cells the
+  /// map has seen free (not new ground), that particle's map as it was before the scan.
+  struct MapCheck {
+    TiledGrid map;  ///< shares its tiles with the particle's map at the start
+    Pose2 predicted;
+    double near_fraction;
+  };
+  std::optional<MapCheck> StartMapCheck(const Pose2& motion,
+                                        const std::vector<MatchPoint>& points) const;
+  /// Finish: where the pose the filter chose (`chosen`) fits that map poorly too, the place the
+  /// map holds for the scan, searched within a quarter turn of the prediction by the alias
+  /// search's rules (PlaceInMap): the witness.
+  std::optional<Pose2> FinishMapCheck(const MapCheck& check, const std::vector<MatchPoint>& points,
+                                      const Pose2& chosen) const;
   /// The share of `points` at `pose` that the matcher counts as matched on `map`.
   double MatchedFraction(const TiledGrid& map, const std::vector<MatchPoint>& points,
                          const Pose2& pose) const;
