@@ -323,16 +323,22 @@ std::optional<Pose2> Rbpf::PlaceInMap(const TiledGrid& map, const std::vector<Ma
   return far;
 }
 
+ClimbResult Rbpf::NearClimb(const Pose2& motion, const std::vector<MatchPoint>& points,
+                            const std::optional<ClimbResult>& climbed) const {
+  if (climbed) return *climbed;
+  const RbpfParticle& best = particles_[best_];
+  const Pose2 predicted = best.pose * motion;
+  const auto [sigma_xy, sigma_yaw] = MotionSigmas(motion);
+  return matcher_.Climb(best.map, points, predicted, PosePrior{predicted, sigma_xy, sigma_yaw});
+}
+
 Pose2 Rbpf::SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchPoint>& points,
                                    const std::optional<ClimbResult>& climbed, bool* moved) const {
   *moved = false;
   if (matched_samples_ < kLevelWarmupUpdates) return motion;
   const RbpfParticle& best = particles_[best_];
   const Pose2 predicted = best.pose * motion;
-  const auto [sigma_xy, sigma_yaw] = MotionSigmas(motion);
-  const ClimbResult near = climbed ? *climbed
-                                   : matcher_.Climb(best.map, points, predicted,
-                                                    PosePrior{predicted, sigma_xy, sigma_yaw});
+  const ClimbResult near = NearClimb(motion, points, climbed);
   const double near_fraction = MatchedFraction(best.map, points, near.pose);
   if (near_fraction >= options_.scan_matched_accept_ratio * matched_level_) return motion;
   const std::optional<Pose2> far = PlaceInMap(
@@ -343,16 +349,15 @@ Pose2 Rbpf::SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchP
 }
 
 std::optional<Rbpf::MapCheck> Rbpf::StartMapCheck(const Pose2& motion,
-                                                  const std::vector<MatchPoint>& points) const {
+                                                  const std::vector<MatchPoint>& points,
+                                                  const std::optional<ClimbResult>& climbed) const {
   if (options_.map_check_window_m <= 0.0 || options_.odometry_failure_probability <= 0.0 ||
       matched_samples_ < kLevelWarmupUpdates || points.empty()) {
     return std::nullopt;
   }
   const RbpfParticle& best = particles_[best_];
   const Pose2 predicted = best.pose * motion;
-  const auto [sigma_xy, sigma_yaw] = MotionSigmas(motion);
-  const ClimbResult near =
-      matcher_.Climb(best.map, points, predicted, PosePrior{predicted, sigma_xy, sigma_yaw});
+  const ClimbResult near = NearClimb(motion, points, climbed);
   const double near_fraction = MatchedFraction(best.map, points, near.pose);
   if (!(near_fraction < kPoorMatchShare * matched_level_)) return std::nullopt;
   // New ground is no contradiction: only where most of the points that find no wall land on
@@ -377,7 +382,9 @@ std::optional<Pose2> Rbpf::FinishMapCheck(const MapCheck& check,
 }
 
 Pose2 Rbpf::ChooseMotion(const Pose2& pending, bool after_gap,
-                         const std::vector<MatchPoint>& points, bool* rejected) {
+                         const std::vector<MatchPoint>& points, bool* rejected,
+                         std::optional<ClimbResult>* near_climb_out) {
+  near_climb_out->reset();
   if (points.empty()) return pending;
   Pose2 motion = pending;
   std::optional<ClimbResult> near_climb;  // the best particle's climb from `motion`'s prediction
@@ -398,7 +405,9 @@ Pose2 Rbpf::ChooseMotion(const Pose2& pending, bool after_gap,
     motion = SearchScanMatchedAlias(motion, points, near_climb, &moved);
     gap_corrections_ += moved;
     *rejected = *rejected || moved;
+    if (moved) near_climb.reset();
   }
+  *near_climb_out = near_climb;
   return motion;
 }
 
@@ -580,10 +589,12 @@ RbpfStep Rbpf::AddScan(const LaserScan& scan, const Pose2& odometry_increment,
   if (options_.weight_correlation_per_point) {
     AssignIndependenceWeights(points, options_.weight_correlation_length_m);
   }
-  const Pose2 motion = ChooseMotion(pending, after_gap, points, &step.odometry_rejected);
+  std::optional<ClimbResult> near_climb;
+  const Pose2 motion =
+      ChooseMotion(pending, after_gap, points, &step.odometry_rejected, &near_climb);
   // Before the particles write the scan into their maps: the map as it was, where the scan
   // fits it poorly.
-  const std::optional<MapCheck> map_check = StartMapCheck(motion, points);
+  const std::optional<MapCheck> map_check = StartMapCheck(motion, points, near_climb);
   const double weight_exponent = WeightExponent(points);
   step.weight_exponent = weight_exponent;
   if (options_.weight_correlation_per_point && !points.empty()) {

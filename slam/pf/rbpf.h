@@ -146,19 +146,15 @@ class Rbpf {
   /// after a gap the search's (SearchAfterGap), or the odometry check's (CheckOdometry), then
   /// with scan-matched increments the alias search's; counts what it replaced, and sets
   /// `*rejected` when the odometry check or the alias search did.
+  /// `*near_climb`: the best particle's climb from the returned increment's prediction where one
+  /// of them made it (the odometry check's, when the increment is the one it kept), else empty.
   Pose2 ChooseMotion(const Pose2& pending, bool after_gap, const std::vector<MatchPoint>& points,
-                     bool* rejected);
+                     bool* rejected, std::optional<ClimbResult>* near_climb);
   /// The odometry check: `motion`, or the increment the best particle's wide match gives where
   /// the mixture model finds that more likely (then `*rejected` is set). `near`, when given,
   /// receives the best particle's climb from the prediction with the motion prior.
   Pose2 CheckOdometry(const Pose2& motion, const std::vector<MatchPoint>& points, bool* rejected,
                       ClimbResult* near = nullptr) const;
-  /// Where the increments are scan matches (RbpfOptions::scan_matched_window_m): the increment
-  /// to the best place within the window at every heading on the best particle's map, where the
-  /// match near the prediction falls short of the long-term matched fraction and the place found,
-  /// unique among the headings, does not (`*moved`); `motion` itself otherwise. `climbed`: the
-  /// climb from `motion`'s prediction where the caller has it (CheckOdometry's, when it kept
-  /// the increment), else climbed here.
   /// The place within +-`half_m` of `center` and +-`yaw_half_rad` of its heading (pi: every
   /// heading) where `points` fit `map` by the alias search's rules (scan_matched_window_m): a
   /// matched fraction of at least scan_matched_accept_ratio of the long-term level, above
@@ -167,6 +163,16 @@ class Rbpf {
   std::optional<Pose2> PlaceInMap(const TiledGrid& map, const std::vector<MatchPoint>& points,
                                   const Pose2& center, double half_m, double yaw_half_rad,
                                   double near_fraction) const;
+  /// The best particle's climb from `motion`'s prediction with the motion prior: `climbed` where
+  /// the caller has it, else climbed here.
+  ClimbResult NearClimb(const Pose2& motion, const std::vector<MatchPoint>& points,
+                        const std::optional<ClimbResult>& climbed) const;
+  /// Where the increments are scan matches (RbpfOptions::scan_matched_window_m): the increment
+  /// to the best place within the window at every heading on the best particle's map, where the
+  /// match near the prediction falls short of the long-term matched fraction and the place found,
+  /// unique among the headings, does not (`*moved`); `motion` itself otherwise. `climbed`: the
+  /// climb from `motion`'s prediction where the caller has it (CheckOdometry's, when it kept
+  /// the increment), else climbed here.
   Pose2 SearchScanMatchedAlias(const Pose2& motion, const std::vector<MatchPoint>& points,
                                const std::optional<ClimbResult>& climbed, bool* moved) const;
   /// The map check (RbpfOptions::map_check_window_m), in two halves around the particles'
@@ -178,8 +184,9 @@ class Rbpf {
     Pose2 predicted;
     double near_fraction;
   };
-  std::optional<MapCheck> StartMapCheck(const Pose2& motion,
-                                        const std::vector<MatchPoint>& points) const;
+  /// `climbed`: as for NearClimb.
+  std::optional<MapCheck> StartMapCheck(const Pose2& motion, const std::vector<MatchPoint>& points,
+                                        const std::optional<ClimbResult>& climbed) const;
   /// Finish: where the pose the filter chose (`chosen`) fits that map poorly too, the place the
   /// map holds for the scan, searched within a quarter turn of the prediction by the alias
   /// search's rules (PlaceInMap): the witness.

@@ -137,14 +137,14 @@ struct RbpfOptions {
   /// clean logs it costs edmonton (0.45 to 1.29 m) and intel (0.094 to 0.146 m) more than it
   /// gives belgioioso (0.33 to 0.25 m) (docs/studies/rbpf-turns.md).
   bool odometry_turn_check = false;
-  /// The map check, which judges and moves nothing: an update whose best particle matches
-  /// near the prediction less than half the long-term matched fraction searches that particle's
-  /// map (before the scan is written into it) within this half-width at every heading. A place
-  /// found there by the alias search's rules (scan_matched_accept_ratio,
-  /// scan_matched_win_margin, unique among headings within the odds of
-  /// odometry_failure_probability) is where the map holds the scan: a witness. Where the best
-  /// path, at the end, put the scan far from its witness, the map contradicts the path
-  /// (Rbpf::MapContradictionM). 0: never searched.
+  /// The map check, which judges and moves nothing: on an update whose best particle matches
+  /// near the prediction less than half the long-term matched fraction, on ground its map has
+  /// seen free, and whose chosen pose fits that map (as it was before the scan) poorly too, the
+  /// map is searched within this half-width and a quarter turn of the prediction. A place found
+  /// there by the alias search's rules (scan_matched_accept_ratio, scan_matched_win_margin,
+  /// unique among headings within the odds of odometry_failure_probability) is where the map
+  /// holds the scan: a witness. Where the best path, at the end, put the scan far from its
+  /// witness, the map contradicts the path (Rbpf::MapContradictionM). 0: never searched.
   double map_check_window_m = 2.0;
 
   ResamplingScheme resampling = ResamplingScheme::kSystematic;
