@@ -26,6 +26,7 @@ std::vector<std::string> IcpOdometrySearchOptions::Validate() const {
       .NonNegative("prior_weight", prior_weight)
       .Fraction("adapt_rate", adapt_rate)
       .NonNegative("gap_s", gap_s)
+      .AtLeast("blind_scans", blind_scans, 0)
       .NonNegative("wide_window_m", wide_window_m)
       .Require(wide_window_rad >= 0.0 && wide_window_rad <= std::numbers::pi, "wide_window_rad",
                wide_window_rad, "must be in [0, pi]");
@@ -76,9 +77,12 @@ Eigen::Matrix3d IcpOdometry::IncrementCovariance(const Pose2& increment) const {
 }
 
 Eigen::Vector2d IcpOdometryOptions::IncrementSigmas(const Pose2& increment) const {
-  const double d = increment.translation().norm();
-  return {sigma_xy_per_m * d + sigma_xy_floor_m, sigma_yaw_per_rad * std::abs(increment.theta()) +
-                                                     sigma_yaw_per_m * d + sigma_yaw_floor_rad};
+  return StretchSigmas(increment.translation().norm(), std::abs(increment.theta()));
+}
+
+Eigen::Vector2d IcpOdometryOptions::StretchSigmas(double distance_m, double turn_rad) const {
+  return {sigma_xy_per_m * distance_m + sigma_xy_floor_m,
+          sigma_yaw_per_rad * turn_rad + sigma_yaw_per_m * distance_m + sigma_yaw_floor_rad};
 }
 
 void IcpOdometry::MeasureNoise(const Pose2& prior, const Pose2& matched, const Pose2& increment) {
@@ -103,9 +107,26 @@ void IcpOdometry::MeasureNoise(const Pose2& prior, const Pose2& matched, const P
 
 Eigen::Vector2d IcpOdometry::SearchWindow(const Pose2& increment) const {
   const IcpOdometrySearchOptions& o = options_.search;
-  const Eigen::Vector2d sigma = options_.IncrementSigmas(increment).cwiseProduct(noise_scale_);
+  // Sigmas summed over the stretch, not added in quadrature: a blind step's error is one draw,
+  // not averaged out by the next, and the window stays conservative.
+  const Eigen::Vector2d sigma =
+      options_
+          .StretchSigmas(blind_distance_m_ + increment.translation().norm(),
+                         blind_turn_rad_ + std::abs(increment.theta()))
+          .cwiseProduct(noise_scale_);
   return {std::min(o.max_window_m, o.sigmas * sigma.x()),
           std::min(o.max_window_rad, o.sigmas * sigma.y())};
+}
+
+bool IcpOdometry::HoldsMapWhileBlind(const Pose2& increment) const {
+  const IcpOdometrySearchOptions& o = options_.search;
+  if (blind_scans_ >= o.blind_scans || o.sigmas <= 0.0) return false;
+  const double sigma_xy = options_
+                              .StretchSigmas(blind_distance_m_ + increment.translation().norm(),
+                                             blind_turn_rad_ + std::abs(increment.theta()))
+                              .x() *
+                          noise_scale_.x();
+  return o.sigmas * sigma_xy < o.max_window_m;
 }
 
 std::optional<MatchResult> IcpOdometry::SearchedMatch(const std::vector<Eigen::Vector2d>& points,
@@ -166,16 +187,16 @@ std::optional<MatchResult> IcpOdometry::SearchedMatch(const std::vector<Eigen::V
 }
 
 std::pair<int, std::vector<KeyframeShareOf>> IcpOdometry::AddKeyframe(
-    const std::vector<Eigen::Vector2d>& points_base) {
+    const std::vector<Eigen::Vector2d>& points_base, const Pose2& pose) {
   std::vector<Eigen::Vector2d> scan;
   scan.reserve(points_base.size());
-  for (const Eigen::Vector2d& p : points_base) scan.push_back(pose_ * p);
+  for (const Eigen::Vector2d& p : points_base) scan.push_back(pose * p);
   // The shares of the map this scan was matched against (none before the first map, none for
   // point-to-point ICP).
   std::vector<KeyframeShareOf> shares;
   if (matcher_ && matcher_->has_normals() && !matcher_->reference().empty()) {
     const std::vector<Eigen::Matrix3d> weights = FrameWeights(KeyframeInformations(
-        map_, *matcher_, static_cast<int>(keyframes_.size()), scan, pose_.translation()));
+        map_, *matcher_, static_cast<int>(keyframes_.size()), scan, pose.translation()));
     for (std::size_t j = 0; j < keyframes_.size(); ++j) {
       shares.push_back({.id = keyframes_[j].id, .share = weights[j]});
     }
@@ -190,8 +211,101 @@ std::pair<int, std::vector<KeyframeShareOf>> IcpOdometry::AddKeyframe(
   map_ = ComposeLocalMap(points, options_.local_map_voxel_m);
   matcher_.emplace(options_.icp, map_.points);
   raster_.reset();
-  last_keyframe_ = pose_;
+  last_keyframe_ = pose;
   return {keyframes_.back().id, std::move(shares)};
+}
+
+void IcpOdometry::JoinHeldScans() {
+  for (const HeldScan& held : held_) AddKeyframe(held.points_base, held.pose);
+  held_.clear();
+}
+
+std::optional<MatchResult> IcpOdometry::EndBlindStretch(const std::vector<Eigen::Vector2d>& points,
+                                                        const Pose2& prior, const Pose2& increment,
+                                                        std::optional<MatchResult> held_map_match) {
+  // The map as it would be had the held scans joined it (newest first, as AddKeyframe composes).
+  std::vector<std::vector<Eigen::Vector2d>> newest_first;
+  for (auto it = held_.rbegin(); it != held_.rend(); ++it) {
+    std::vector<Eigen::Vector2d>& scan = newest_first.emplace_back();
+    scan.reserve(it->points_base.size());
+    for (const Eigen::Vector2d& p : it->points_base) scan.push_back(it->pose * p);
+  }
+  for (auto it = keyframes_.rbegin();
+       it != keyframes_.rend() &&
+       static_cast<int>(newest_first.size()) < options_.local_map_keyframes;
+       ++it) {
+    newest_first.push_back(it->points);
+  }
+  const LocalMapPoints joined = ComposeLocalMap(newest_first, options_.local_map_voxel_m);
+  // ICP from the prior over the increment's own window, as the scan would have been matched.
+  std::optional<MatchResult> with_held =
+      IcpMatcher(options_.icp, joined.points).Match(points, prior);
+  const Eigen::Vector2d own_window =
+      options_.search.sigmas * options_.IncrementSigmas(increment).cwiseProduct(noise_scale_);
+  if (with_held && !WithinGates(*with_held, prior, own_window)) with_held.reset();
+  // The better score wins; where the two are within search.min_gain the scores cannot tell, and
+  // the prior decides: each match's score less its prior penalty, as the search chooses
+  // (SearchedMatch). A held-map match turned far beyond the stretch's own noise, scoring no better,
+  // is a map without the failed scan's view, not a wheel error taken back.
+  auto posterior = [&](const MatchResult& match, const Eigen::Vector2d& window) {
+    const Eigen::Vector2d sigma = window / options_.search.sigmas;
+    const Pose2 d = prior.Between(match.pose);
+    return match.score -
+           options_.search.prior_weight * (d.translation().squaredNorm() / (sigma.x() * sigma.x()) +
+                                           d.theta() * d.theta() / (sigma.y() * sigma.y()));
+  };
+  auto with_held_wins = [&] {
+    if (!held_map_match) return true;
+    const double gain = with_held->score - held_map_match->score;
+    if (std::abs(gain) > options_.search.min_gain) return gain > 0.0;
+    return posterior(*with_held, own_window) > posterior(*held_map_match, SearchWindow(increment));
+  };
+  if (with_held && with_held_wins()) {
+    JoinHeldScans();
+    return with_held;
+  }
+  if (held_map_match) held_.clear();  // the held map placed the scan: the held scans go
+  return held_map_match;
+}
+
+void IcpOdometry::Count(IcpOdometryOutcome outcome) {
+  switch (outcome) {
+    case IcpOdometryOutcome::kMatched:
+      ++counts_.matched;
+      break;
+    case IcpOdometryOutcome::kDegenerate:
+      ++counts_.degenerate;
+      break;
+    case IcpOdometryOutcome::kMatchFailed:
+      ++counts_.failed;
+      break;
+    case IcpOdometryOutcome::kNoPoints:
+      ++counts_.no_points;
+      break;
+    case IcpOdometryOutcome::kFirstScan:
+      break;
+  }
+}
+
+bool IcpOdometry::HoldIfBlind(IcpOdometryOutcome outcome,
+                              const std::vector<Eigen::Vector2d>& points, const Pose2& increment,
+                              bool after_gap) {
+  // A scan the wheels placed alone stays out of the local map while the stretch is searchable.
+  const bool blind =
+      outcome == IcpOdometryOutcome::kMatchFailed || outcome == IcpOdometryOutcome::kNoPoints;
+  const bool held = blind && matcher_ && !after_gap && HoldsMapWhileBlind(increment);
+  if (held) {
+    if (!points.empty()) held_.push_back({.points_base = points, .pose = pose_});
+    ++blind_scans_;
+    blind_distance_m_ += increment.translation().norm();
+    blind_turn_rad_ += std::abs(increment.theta());
+  } else {
+    JoinHeldScans();  // a stretch that ends blind keeps the wheels' placement
+    blind_scans_ = 0;
+    blind_distance_m_ = 0.0;
+    blind_turn_rad_ = 0.0;
+  }
+  return held;
 }
 
 IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_increment,
@@ -199,17 +313,20 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const Pose2& odometry_in
   return Add(scan, std::vector<Pose2>{odometry_increment}, odometry_gap_s);
 }
 
+bool IcpOdometry::WithinGates(const MatchResult& match, const Pose2& prior,
+                              const Eigen::Vector2d& window) const {
+  return match.score >= options_.min_score &&
+         (match.pose.translation() - prior.translation()).norm() <=
+             std::max(options_.max_correction_m, window.x()) &&
+         std::abs(NormalizeAngle(match.pose.theta() - prior.theta())) <=
+             std::max(options_.max_correction_rad, window.y());
+}
+
 std::optional<MatchResult> IcpOdometry::GatedMatch(const std::vector<Eigen::Vector2d>& points,
                                                    const Pose2& prior,
                                                    const Eigen::Vector2d& window) const {
   std::optional<MatchResult> match = matcher_->Match(points, prior);
-  if (match && (match->score < options_.min_score ||
-                (match->pose.translation() - prior.translation()).norm() >
-                    std::max(options_.max_correction_m, window.x()) ||
-                std::abs(NormalizeAngle(match->pose.theta() - prior.theta())) >
-                    std::max(options_.max_correction_rad, window.y()))) {
-    match.reset();
-  }
+  if (match && !WithinGates(*match, prior, window)) match.reset();
   return match;
 }
 
@@ -259,7 +376,7 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
     step.pose = pose_;
     step.outcome = IcpOdometryOutcome::kFirstScan;
     if (!points.empty()) {
-      step.keyframe_id = AddKeyframe(points).first;
+      step.keyframe_id = AddKeyframe(points, pose_).first;
       step.keyframe = true;
     }
     return step;
@@ -300,6 +417,8 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
   if (!points.empty() && matcher_) {
     const IcpOdometryCounts before = counts_;
     match = SearchedMatch(points, prior, step.window, std::move(match));
+    if (!held_.empty())
+      match = EndBlindStretch(points, prior, odometry_increment, std::move(match));
     step.searched = counts_.searched > before.searched;
     step.search_chosen = counts_.search_chosen > before.search_chosen;
     step.search_widened = counts_.widened > before.widened;
@@ -321,24 +440,13 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
     step.covariance = match->covariance;
     step.score = match->score;
     step.outcome = degenerate ? IcpOdometryOutcome::kDegenerate : IcpOdometryOutcome::kMatched;
-    if (!degenerate && !after_gap) MeasureNoise(prior, step.pose, odometry_increment);
+    // After a blind stretch the correction is the stretch's, not this increment's alone.
+    const bool after_blind = blind_scans_ > 0;
+    if (!degenerate && !after_gap && !after_blind) {
+      MeasureNoise(prior, step.pose, odometry_increment);
+    }
   }
-  switch (step.outcome) {
-    case IcpOdometryOutcome::kMatched:
-      ++counts_.matched;
-      break;
-    case IcpOdometryOutcome::kDegenerate:
-      ++counts_.degenerate;
-      break;
-    case IcpOdometryOutcome::kMatchFailed:
-      ++counts_.failed;
-      break;
-    case IcpOdometryOutcome::kNoPoints:
-      ++counts_.no_points;
-      break;
-    case IcpOdometryOutcome::kFirstScan:
-      break;
-  }
+  Count(step.outcome);
 
   // The drift is fitted from clear matches following clear matches: the increment between them
   // is the scans' own, not a correction of what a blind stretch let accumulate.
@@ -347,10 +455,12 @@ IcpOdometryStep IcpOdometry::Add(const LaserScan& scan, const std::vector<Pose2>
   }
   last_matched_ = step.outcome == IcpOdometryOutcome::kMatched;
   pose_ = step.pose;
+  const bool held = HoldIfBlind(step.outcome, points, odometry_increment, after_gap);
   const Pose2 since = last_keyframe_.Between(pose_);
-  if (!points.empty() && (!matcher_ || since.translation().norm() >= options_.keyframe_distance_m ||
-                          std::abs(since.theta()) >= options_.keyframe_angle_rad)) {
-    std::tie(step.keyframe_id, step.frame_weights) = AddKeyframe(points);
+  if (!held && !points.empty() &&
+      (!matcher_ || since.translation().norm() >= options_.keyframe_distance_m ||
+       std::abs(since.theta()) >= options_.keyframe_angle_rad)) {
+    std::tie(step.keyframe_id, step.frame_weights) = AddKeyframe(points, pose_);
     step.keyframe = true;
   }
   return step;

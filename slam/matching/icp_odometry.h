@@ -51,6 +51,18 @@ struct IcpOdometrySearchOptions {
   /// runs over max_window_m and every heading, whatever the noise model says, and the update
   /// teaches neither the noise measurement nor the calibration. 0: never.
   double gap_s = 1.0;
+  /// After a failed match the odometry places the scan, and the next scan's prior carries that
+  /// step's error as well as its own. Up to this many failed scans in a row stay out of the local
+  /// map (held), and each next scan's window covers the whole blind stretch since the last match
+  /// (the noise model over its summed distance and turns), so that the stretch's error can be
+  /// found against the map the last match placed. The scan that ends the stretch is matched both
+  /// ways, against that map over the stretch's window and against the map with the held scans
+  /// where the wheels placed them over its own window (what 0 does); the better score wins, the
+  /// prior where the scores are within min_gain. A wheel error in the blind step is taken back by
+  /// the first, a view the held map does not hold is matched by the second. A stretch whose window
+  /// would pass max_window_m, or longer than this, ends with the wheels' placement kept: the held
+  /// scans join the map (docs/studies/front-end-search.md).
+  int blind_scans = 1;
 
   /// One message per broken rule (unprefixed; IcpOdometryOptions nests them under "search").
   std::vector<std::string> Validate() const;
@@ -115,6 +127,8 @@ struct IcpOdometryOptions {
   /// The noise model's standard deviations (x and y, yaw) of `increment`, before any measured
   /// noise scales them (sigma_xy_* and sigma_yaw_* above).
   Eigen::Vector2d IncrementSigmas(const Pose2& increment) const;
+  /// The same for a stretch of increments summing to this distance and these absolute turns.
+  Eigen::Vector2d StretchSigmas(double distance_m, double turn_rad) const;
 
   /// One message per broken rule, keys relative to this struct ("icp.", "points." nested).
   std::vector<std::string> Validate() const;
@@ -200,14 +214,32 @@ class IcpOdometry {
     int id = 0;
     std::vector<Eigen::Vector2d> points;  // odom frame
   };
-  /// Adds a keyframe at pose_; its number and the shares of the map it joined, as its scan saw
+  /// Adds a keyframe at `pose`; its number and the shares of the map it joined, as its scan saw
   /// them (IcpOdometryStep::frame_weights).
   std::pair<int, std::vector<KeyframeShareOf>> AddKeyframe(
-      const std::vector<Eigen::Vector2d>& points_base);
+      const std::vector<Eigen::Vector2d>& points_base, const Pose2& pose);
+  /// Counts one scan's outcome.
+  void Count(IcpOdometryOutcome outcome);
+  /// After pose_ took a scan's placement: holds a blind scan out of the local map while its
+  /// stretch is searchable (search.blind_scans), else ends the stretch; whether it held it.
+  bool HoldIfBlind(IcpOdometryOutcome outcome, const std::vector<Eigen::Vector2d>& points,
+                   const Pose2& increment, bool after_gap);
+  /// The held scans join the local map where the wheels placed them.
+  void JoinHeldScans();
+  /// The match that ends a blind stretch: `held_map_match` (against the map without the held
+  /// scans, over the stretch's window) or ICP from `prior` against the map with the held scans,
+  /// the better score (within search.min_gain, the better posterior); in the second case the held
+  /// scans join the map, else they are dropped.
+  std::optional<MatchResult> EndBlindStretch(const std::vector<Eigen::Vector2d>& points,
+                                             const Pose2& prior, const Pose2& increment,
+                                             std::optional<MatchResult> held_map_match);
   /// The increment's noise model, scaled by the measured noise, in the previous base frame.
   Eigen::Matrix3d IncrementCovariance(const Pose2& increment) const;
-  /// The search window (x and y, yaw) of `increment`'s prior: +-sigmas of its measured noise.
+  /// The search window (x and y, yaw) of `increment`'s prior: +-sigmas of its measured noise,
+  /// over the blind stretch before it as well (search.blind_scans).
   Eigen::Vector2d SearchWindow(const Pose2& increment) const;
+  /// Whether a failed scan stays out of the local map: its blind stretch is still searchable.
+  bool HoldsMapWhileBlind(const Pose2& increment) const;
   /// The better of `from_prior` (ICP's match from `prior`, nothing when it failed) and a
   /// correlative search within `window` of `prior` refined by ICP, when the window is beyond ICP's
   /// basin or ICP failed.
@@ -216,8 +248,6 @@ class IcpOdometry {
                                            std::optional<MatchResult> from_prior);
   /// Updates noise_scale_ from a clear match's correction of the prior.
   void MeasureNoise(const Pose2& prior, const Pose2& matched, const Pose2& increment);
-  /// The local map's match from `prior`, or nothing when it fails the score or the correction
-  /// gates (max_correction_m and _rad, or `window` where that is wider).
   /// The match's correction of `fallback`'s position (odom frame) less its part along the
   /// directions where the odometry stands (a degenerate covariance, a weakly seen direction with a
   /// correction beyond the gate); `degenerate` set when any was taken out.
@@ -225,8 +255,13 @@ class IcpOdometry {
                                  const Eigen::Matrix3d& prior_covariance,
                                  const std::vector<Eigen::Vector2d>& points,
                                  bool* degenerate) const;
+  /// The local map's match from `prior`, or nothing when it fails the score or the correction
+  /// gates (max_correction_m and _rad, or `window` where that is wider).
   std::optional<MatchResult> GatedMatch(const std::vector<Eigen::Vector2d>& points,
                                         const Pose2& prior, const Eigen::Vector2d& window) const;
+  /// Whether `match` passes the score and the correction gates (GatedMatch).
+  bool WithinGates(const MatchResult& match, const Pose2& prior,
+                   const Eigen::Vector2d& window) const;
 
   IcpOdometryOptions options_;
   Pose2 pose_;
@@ -242,6 +277,17 @@ class IcpOdometry {
   std::optional<CorrelativeMatcher> searcher_;
   OdometryCalibration calibration_;
   bool last_matched_ = false;  // the previous scan's match was clear (kMatched)
+  // The scans the odometry placed alone since the last match whose points stayed out of the
+  // local map (search.blind_scans): how many, their points, and the odometry's travel and
+  // absolute turns over them.
+  struct HeldScan {
+    std::vector<Eigen::Vector2d> points_base;
+    Pose2 pose;  // odom frame, the wheels' placement
+  };
+  int blind_scans_ = 0;
+  std::vector<HeldScan> held_;
+  double blind_distance_m_ = 0.0;
+  double blind_turn_rad_ = 0.0;
   Eigen::Vector2d noise_scale_{1.0, 1.0};
   Eigen::Vector2d noise_mean_size_{1.0, 1.0};
   IcpOdometryCounts counts_;

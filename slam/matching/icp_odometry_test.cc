@@ -266,6 +266,96 @@ TEST(IcpOdometryTest, ABlindStretchDriftsByTheCalibratedOdometryOnly) {
   EXPECT_LT(yaw_error[1], 0.3 * yaw_error[0]);
 }
 
+// A scan the match cannot place (the lidar blocked by someone standing close in front) is placed
+// by the odometry alone, here 0.25 rad short of a turn on the spot. It stays out of the local map,
+// and the next scan's window covers the blind step's noise as well as its own, so that the step's
+// error is searched for against the map the last match placed. Without: the blind scan joins the
+// map and the next window is its own step's.
+TEST(IcpOdometryTest, AFailedScanStaysOutOfTheMapAndWidensTheNextWindow) {
+  const SegmentWorld office = SegmentWorld::Office();
+  const Pose2 start(1.5, 1.5, 0.0);        // the office's south-west corner
+  auto blocked = [](const Pose2& robot) {  // a person-sized box 0.5 m in front
+    SegmentWorld world({});
+    const Eigen::Vector2d c = robot * Eigen::Vector2d(0.65, 0.0);
+    world.AddBox(c.x() - 0.15, c.y() - 0.15, c.x() + 0.15, c.y() + 0.15);
+    return world;
+  };
+  struct Outcome {
+    bool map_kept;
+    IcpOdometryStep blind, next;
+    double yaw_error;
+  };
+  auto run = [&](int blind_scans) {
+    IcpOdometryOptions options;
+    options.search.blind_scans = blind_scans;
+    IcpOdometry icp(options);
+    RandomEngine rng(41);
+    const Pose2 turn(0.0, 0.0, 0.3);
+    Pose2 truth = start;
+    icp.Add(office.Scan(truth, Time(), RangeFinderSpec{}, &rng), Pose2());
+    for (int k = 0; k < 3; ++k) {
+      truth = truth * turn;
+      icp.Add(office.Scan(truth, Time(), RangeFinderSpec{}, &rng), turn);
+    }
+    const std::size_t map_size = icp.local_map().size();
+    truth = truth * Pose2(0.0, 0.0, 0.55);  // the wheels report 0.3
+    Outcome outcome;
+    outcome.blind = icp.Add(blocked(truth).Scan(truth, Time(), RangeFinderSpec{}, &rng), turn);
+    outcome.map_kept = icp.local_map().size() == map_size;
+    truth = truth * turn;
+    outcome.next = icp.Add(office.Scan(truth, Time(), RangeFinderSpec{}, &rng), turn);
+    outcome.yaw_error =
+        std::abs(NormalizeAngle((start.Inverse() * truth).theta() - outcome.next.pose.theta()));
+    return outcome;
+  };
+  const Outcome on = run(1), off = run(0);
+  for (const Outcome* o : {&on, &off}) {
+    ASSERT_EQ(o->blind.outcome, IcpOdometryOutcome::kMatchFailed);
+    ASSERT_EQ(o->next.outcome, IcpOdometryOutcome::kMatched);
+  }
+  EXPECT_TRUE(on.map_kept);
+  EXPECT_FALSE(on.blind.keyframe);
+  EXPECT_FALSE(off.map_kept);
+  // The next window: the noise model (sigma_yaw_per_rad 0.2 of each turn, plus the floor) at 3
+  // sigma over the blind turn and its own, against over its own.
+  const IcpOdometryOptions defaults;
+  EXPECT_NEAR(on.next.window.y(), 3.0 * defaults.StretchSigmas(0.0, 0.6).y(), 1e-12);
+  EXPECT_NEAR(off.next.window.y(), 3.0 * defaults.StretchSigmas(0.0, 0.3).y(), 1e-12);
+  EXPECT_LT(on.yaw_error, 0.01);
+}
+
+// While the lidar stays blocked the blind stretch grows up to search.blind_scans scans, or less
+// where its window would pass max_window_m; then the wheels' placement is kept: the blind scan
+// joins the map and the stretch starts again.
+TEST(IcpOdometryTest, ABlindStretchEndsAfterItsScansOrWhereItsWindowPassesTheMaximum) {
+  SegmentWorld hall({});  // walls far from anything the blocked scans see
+  hall.AddBox(-20.0, -20.0, 20.0, 20.0);
+  auto joined_at = [&](int blind_scans) {
+    IcpOdometryOptions options;
+    options.search.blind_scans = blind_scans;
+    IcpOdometry icp(options);
+    RandomEngine rng(43);
+    Pose2 truth(-6.0, 0.0, 0.0);
+    icp.Add(hall.Scan(truth, Time(), RangeFinderSpec{}, &rng), Pose2());
+    const Pose2 step(0.5, 0.0, 0.0);
+    for (int k = 1; k <= 40; ++k) {
+      truth = truth * step;
+      SegmentWorld blocked({});
+      blocked.AddBox(truth.x() + 0.5, truth.y() - 0.15, truth.x() + 0.8, truth.y() + 0.15);
+      const IcpOdometryStep placed =
+          icp.Add(blocked.Scan(truth, Time(), RangeFinderSpec{}, &rng), step);
+      EXPECT_EQ(placed.outcome, IcpOdometryOutcome::kMatchFailed) << k;
+      if (placed.keyframe) return k;
+    }
+    return 0;
+  };
+  EXPECT_EQ(joined_at(0), 1);
+  EXPECT_EQ(joined_at(1), 2);
+  EXPECT_EQ(joined_at(5), 6);
+  // 3 sigma of 0.05 m per m plus 0.005 m reaches 2 m after 13.2 m: the 27th step of 0.5 m.
+  EXPECT_EQ(joined_at(100), 27);
+}
+
 // Same scans and increments, same bits.
 TEST(IcpOdometryTest, SameInputSameBits) {
   const SegmentWorld world = SegmentWorld::Office();

@@ -46,6 +46,7 @@ void VisitFields(V& v, IcpOdometrySearchOptions& o) {
   v("prior_weight", o.prior_weight);
   v("adapt_rate", o.adapt_rate);
   v("gap_s", o.gap_s);
+  v("blind_scans", o.blind_scans);
 }
 
 /// The field table of IcpOdometryOptions.

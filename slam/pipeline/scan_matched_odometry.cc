@@ -26,6 +26,9 @@ IcpOdometryOptions WideGates() {
   // The windows are the prediction's own, every scan: a failed or far-moved match is a robot's
   // change of mind, not a wheel's under-reported turn to search wider for.
   o.search.wide_window_rad = 0.0;
+  // For the same reason a failed scan joins the map where the prediction placed it: the next
+  // prediction is no better for the held map.
+  o.search.blind_scans = 0;
   o.calibration.enabled = false;
   return o;
 }
