@@ -12,6 +12,27 @@
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
+namespace {
+
+// `pose`'s squared Mahalanobis distance from `prior` with independent x, y (sigma.x()) and yaw
+// (sigma.y()) deviations.
+double SquaredMahalanobis(const Pose2& prior, const Pose2& pose, const Eigen::Vector2d& sigma) {
+  const Pose2 d = prior.Between(pose);
+  return d.translation().squaredNorm() / (sigma.x() * sigma.x()) +
+         d.theta() * d.theta() / (sigma.y() * sigma.y());
+}
+
+// `points_base` (base frame) placed at `pose`.
+std::vector<Eigen::Vector2d> Placed(const std::vector<Eigen::Vector2d>& points_base,
+                                    const Pose2& pose) {
+  std::vector<Eigen::Vector2d> placed;
+  placed.reserve(points_base.size());
+  for (const Eigen::Vector2d& p : points_base) placed.push_back(pose * p);
+  return placed;
+}
+
+}  // namespace
+
 std::vector<std::string> IcpOdometrySearchOptions::Validate() const {
   Rules rules;
   rules.NonNegative("sigmas", sigmas)
@@ -107,13 +128,7 @@ void IcpOdometry::MeasureNoise(const Pose2& prior, const Pose2& matched, const P
 
 Eigen::Vector2d IcpOdometry::SearchWindow(const Pose2& increment) const {
   const IcpOdometrySearchOptions& o = options_.search;
-  // Sigmas summed over the stretch, not added in quadrature: a blind step's error is one draw,
-  // not averaged out by the next, and the window stays conservative.
-  const Eigen::Vector2d sigma =
-      options_
-          .StretchSigmas(blind_distance_m_ + increment.translation().norm(),
-                         blind_turn_rad_ + std::abs(increment.theta()))
-          .cwiseProduct(noise_scale_);
+  const Eigen::Vector2d sigma = StretchNoise(increment);
   return {std::min(o.max_window_m, o.sigmas * sigma.x()),
           std::min(o.max_window_rad, o.sigmas * sigma.y())};
 }
@@ -121,12 +136,16 @@ Eigen::Vector2d IcpOdometry::SearchWindow(const Pose2& increment) const {
 bool IcpOdometry::HoldsMapWhileBlind(const Pose2& increment) const {
   const IcpOdometrySearchOptions& o = options_.search;
   if (blind_scans_ >= o.blind_scans || o.sigmas <= 0.0) return false;
-  const double sigma_xy = options_
-                              .StretchSigmas(blind_distance_m_ + increment.translation().norm(),
-                                             blind_turn_rad_ + std::abs(increment.theta()))
-                              .x() *
-                          noise_scale_.x();
-  return o.sigmas * sigma_xy < o.max_window_m;
+  return o.sigmas * StretchNoise(increment).x() < o.max_window_m;
+}
+
+Eigen::Vector2d IcpOdometry::StretchNoise(const Pose2& increment) const {
+  // Sigmas summed over the stretch, not added in quadrature: a blind step's error is one draw,
+  // not averaged out by the next, and the window stays conservative.
+  return options_
+      .StretchSigmas(blind_distance_m_ + increment.translation().norm(),
+                     blind_turn_rad_ + std::abs(increment.theta()))
+      .cwiseProduct(noise_scale_);
 }
 
 std::optional<MatchResult> IcpOdometry::SearchedMatch(const std::vector<Eigen::Vector2d>& points,
@@ -175,10 +194,8 @@ std::optional<MatchResult> IcpOdometry::SearchedMatch(const std::vector<Eigen::V
   // raster as the log-likelihood up to scale and the prior's Gaussian (sigma = window / sigmas).
   const Eigen::Vector2d sigma = window / o.sigmas;
   auto posterior = [&](const Pose2& pose) {
-    const Pose2 d = prior.Between(pose);
-    const double m2 = d.translation().squaredNorm() / (sigma.x() * sigma.x()) +
-                      d.theta() * d.theta() / (sigma.y() * sigma.y());
-    return RasterScore(*raster_, query, pose) - o.prior_weight * m2;
+    return RasterScore(*raster_, query, pose) -
+           o.prior_weight * SquaredMahalanobis(prior, pose, sigma);
   };
   const double searched = posterior(refined->pose);
   if (from_prior && searched <= posterior(from_prior->pose) + o.min_gain) return from_prior;
@@ -188,9 +205,7 @@ std::optional<MatchResult> IcpOdometry::SearchedMatch(const std::vector<Eigen::V
 
 std::pair<int, std::vector<KeyframeShareOf>> IcpOdometry::AddKeyframe(
     const std::vector<Eigen::Vector2d>& points_base, const Pose2& pose) {
-  std::vector<Eigen::Vector2d> scan;
-  scan.reserve(points_base.size());
-  for (const Eigen::Vector2d& p : points_base) scan.push_back(pose * p);
+  std::vector<Eigen::Vector2d> scan = Placed(points_base, pose);
   // The shares of the map this scan was matched against (none before the first map, none for
   // point-to-point ICP).
   std::vector<KeyframeShareOf> shares;
@@ -226,9 +241,7 @@ std::optional<MatchResult> IcpOdometry::EndBlindStretch(const std::vector<Eigen:
   // The map as it would be had the held scans joined it (newest first, as AddKeyframe composes).
   std::vector<std::vector<Eigen::Vector2d>> newest_first;
   for (auto it = held_.rbegin(); it != held_.rend(); ++it) {
-    std::vector<Eigen::Vector2d>& scan = newest_first.emplace_back();
-    scan.reserve(it->points_base.size());
-    for (const Eigen::Vector2d& p : it->points_base) scan.push_back(it->pose * p);
+    newest_first.push_back(Placed(it->points_base, it->pose));
   }
   for (auto it = keyframes_.rbegin();
        it != keyframes_.rend() &&
@@ -248,11 +261,8 @@ std::optional<MatchResult> IcpOdometry::EndBlindStretch(const std::vector<Eigen:
   // (SearchedMatch). A held-map match turned far beyond the stretch's own noise, scoring no better,
   // is a map without the failed scan's view, not a wheel error taken back.
   auto posterior = [&](const MatchResult& match, const Eigen::Vector2d& window) {
-    const Eigen::Vector2d sigma = window / options_.search.sigmas;
-    const Pose2 d = prior.Between(match.pose);
-    return match.score -
-           options_.search.prior_weight * (d.translation().squaredNorm() / (sigma.x() * sigma.x()) +
-                                           d.theta() * d.theta() / (sigma.y() * sigma.y()));
+    return match.score - options_.search.prior_weight *
+                             SquaredMahalanobis(prior, match.pose, window / options_.search.sigmas);
   };
   auto with_held_wins = [&] {
     if (!held_map_match) return true;

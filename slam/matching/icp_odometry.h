@@ -238,6 +238,9 @@ class IcpOdometry {
   /// The search window (x and y, yaw) of `increment`'s prior: +-sigmas of its measured noise,
   /// over the blind stretch before it as well (search.blind_scans).
   Eigen::Vector2d SearchWindow(const Pose2& increment) const;
+  /// The noise model's sigmas (x and y, yaw), scaled by the measured noise, over the blind
+  /// stretch and `increment` after it.
+  Eigen::Vector2d StretchNoise(const Pose2& increment) const;
   /// Whether a failed scan stays out of the local map: its blind stretch is still searchable.
   bool HoldsMapWhileBlind(const Pose2& increment) const;
   /// The better of `from_prior` (ICP's match from `prior`, nothing when it failed) and a
