@@ -2,7 +2,8 @@
 // (a lost interval at the kidnapping, in metrics.json and the report), `expect: {pf: {lost_max:
 // 0}}` must then fail the run and nothing else, and having recovered it must not call its run
 // diverged. Graph SLAM on intel's start with doubled odometry noise, which ends 2 m off from one
-// failed match, must call itself diverged; on the clean start it must not. A gap in seattle's
+// failed match, must call itself diverged; on the clean start it must not; nor on intel whole,
+// where it must when four times the noise draws the building twice. A gap in seattle's
 // odometry must be searched after by the pf and the rbpf.
 
 #include <gtest/gtest.h>
@@ -122,6 +123,35 @@ TEST(SelfDiagnosisTest, GraphCallsATurnTheWheelsDidNotMakeDiverged) {
   EXPECT_GT(failed["ate_rmse_m"].as<double>(), 1.0);  // the failure the verdict must see
   EXPECT_GT(failed["wheel_heading_contradiction_rad"].as<double>(), 1.0);
   EXPECT_EQ(failed["diverged"].as<double>(), 1.0);
+}
+
+// Intel with four times its odometry noise, seed 2: the graph draws the building twice, the
+// second copy crossing the first (ATE 11 m), every edge consistent and no turn the wheels (as
+// noisy) contradict. Where its final poses come back to a place, the two views share almost
+// nothing: the map against itself says so. The clean run agrees at every revisit.
+TEST(SelfDiagnosisTest, GraphCallsAMapDrawnTwiceDiverged) {
+  SLAMRIG_REQUIRE_DATASET(log, "carmen_corrected/intel-corrected.log.gz");
+  testing::TempDir dir;
+  auto graph = [&](const std::string& name, const std::string& args) {
+    const auto run =
+        testing::RunCommand(std::string(SLAMRIG_BINARY) + " slam " + log +
+                            " --algorithm graph --quiet " + args + " --out " + dir.File(name));
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    return YAML::LoadFile(dir.File(name + "/metrics.json"))["configs"]["graph"];
+  };
+  const YAML::Node clean = graph("clean", "");
+  EXPECT_LT(clean["ate_rmse_m"].as<double>(), 0.1);
+  EXPECT_GT(clean["revisits"].as<double>(), 100.0);
+  EXPECT_EQ(clean["revisits_disagreeing"].as<double>(), 0.0);
+  EXPECT_EQ(clean["diverged"].as<double>(), 0.0);
+  const YAML::Node twice =
+      graph("twice",
+            "--seed 2 --perturb odometry.noise_per_m=0.2932 "
+            "--perturb odometry.noise_per_rad=0.7789 --perturb scans.drop_fraction=0.1");
+  EXPECT_GT(twice["ate_rmse_m"].as<double>(), 1.0);  // the failure the verdict must see
+  EXPECT_GE(twice["revisits_disagreeing_places"].as<double>(), 5.0);
+  EXPECT_GT(twice["revisits_disagreeing"].as<double>(), 0.02 * twice["revisits"].as<double>());
+  EXPECT_EQ(twice["diverged"].as<double>(), 1.0);
 }
 
 // Seattle's log has no ODOM line for 3 s while the robot turns 1.4 rad on the spot: the reader

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "slam/matching/scan_points.h"
 #include "slam/types/validation.h"
 
 namespace slamrig::slam {
@@ -71,6 +72,16 @@ void GraphSlamEstimator::Finish() {
     map_.InsertScan(node_scans_[k], graph.pose(static_cast<int>(k)));
   }
   JudgeTurnsAgainstWheels();
+  // The nodes' views where the final poses say the robot came back.
+  std::vector<Pose2> poses;
+  std::vector<std::vector<Eigen::Vector2d>> points;
+  poses.reserve(node_scans_.size());
+  points.reserve(node_scans_.size());
+  for (std::size_t k = 0; k < node_scans_.size(); ++k) {
+    poses.push_back(graph.pose(static_cast<int>(k)));
+    points.push_back(ScanToBasePoints(node_scans_[k], options_.graph.odometry.points));
+  }
+  revisits_ = CheckRevisits(poses, points);
 }
 
 void GraphSlamEstimator::JudgeTurnsAgainstWheels() {
@@ -170,7 +181,10 @@ const std::vector<std::string>& GraphSlamEstimator::StatisticNames() {
                                                  "unrepaired_losses",
                                                  "unrepaired_error_bound_m",
                                                  "wheel_heading_contradiction_rad",
-                                                 "wheel_heading_noise_scale"};
+                                                 "wheel_heading_noise_scale",
+                                                 "revisits",
+                                                 "revisits_disagreeing",
+                                                 "revisits_disagreeing_places"};
   return names;
 }
 
@@ -179,10 +193,10 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
   const std::vector<double> unrepaired = UnrepairedLossBounds();
   const double bound_m =
       unrepaired.empty() ? 0.0 : *std::max_element(unrepaired.begin(), unrepaired.end());
-  // Strained edges, a loss that may have left more than kDivergedErrorM, or a turn the wheels
-  // contradict.
-  const bool diverged =
-      c.diverged || bound_m > kDivergedErrorM || wheel_heading_contradiction_rad_ > 0.0;
+  // Strained edges, a loss that may have left more than kDivergedErrorM, a turn the wheels
+  // contradict, or a map that contradicts itself where the robot came back.
+  const bool diverged = c.diverged || bound_m > kDivergedErrorM ||
+                        wheel_heading_contradiction_rad_ > 0.0 || revisits_.contradicts({});
   return {{"keyframes", c.keyframes},
           {"loop_closures", c.loop_closures},
           {"loop_candidates", c.loop_candidates},
@@ -205,7 +219,10 @@ std::map<std::string, double> GraphSlamEstimator::Statistics() const {
           {"unrepaired_losses", static_cast<double>(unrepaired.size())},
           {"unrepaired_error_bound_m", bound_m},
           {"wheel_heading_contradiction_rad", wheel_heading_contradiction_rad_},
-          {"wheel_heading_noise_scale", wheel_heading_noise_scale_}};
+          {"wheel_heading_noise_scale", wheel_heading_noise_scale_},
+          {"revisits", revisits_.revisits},
+          {"revisits_disagreeing", revisits_.disagreeing},
+          {"revisits_disagreeing_places", revisits_.disagreeing_places}};
 }
 
 }  // namespace slamrig::slam

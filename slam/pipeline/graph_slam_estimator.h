@@ -11,6 +11,7 @@
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
 #include "slam/pipeline/health.h"
+#include "slam/pipeline/revisits.h"
 
 namespace slamrig::slam {
 
@@ -91,6 +92,7 @@ class GraphSlamEstimator final : public Estimator {
   std::vector<bool> odometry_gaps_;      // per scan, the odometry was silent before it
   double wheel_heading_contradiction_rad_ = 0.0;
   double wheel_heading_noise_scale_ = 1.0;  // that median scale
+  RevisitAgreement revisits_;               // the final map against itself, at Finish()
 };
 
 }  // namespace slamrig::slam

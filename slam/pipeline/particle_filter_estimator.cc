@@ -43,6 +43,10 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
   const bool contradicts = wheels_.Judge(scan.scan, scan.increment,
                                          previous_estimate_.Between(step.best_pose), step.updated);
   previous_estimate_ = step.best_pose;
+  online_.push_back(step.best_pose);
+  if (views_.Offer(step.best_pose)) {
+    views_.Keep(ScanToBasePoints(scan.scan, filter_.options().points));
+  }
   const bool lost = step.lost || contradicts;
   ScanEstimate estimate{step.best_pose,
                         step.mean_pose,
@@ -58,31 +62,40 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
   return estimate;
 }
 
+void ParticleFilterEstimator::Finish() { revisits_ = views_.Check(online_); }
+
 const std::vector<std::string>& ParticleFilterEstimator::StatisticNames() {
   static const std::vector<std::string> names = WheelCheck::WithStatisticNames(
       {"mean_neff", "resamples", "updates", "lost", "relocalisations", "resumed", "lost_at_s",
-       "relocalised_at_s", "field_sigma_m", "wall_distance_m", "diverged", "gap_corrections"});
+       "relocalised_at_s", "field_sigma_m", "wall_distance_m", "diverged", "gap_corrections",
+       "revisits", "revisits_disagreeing", "revisits_disagreeing_places"});
   return names;
 }
 
 std::map<std::string, double> ParticleFilterEstimator::Statistics() const {
-  std::map<std::string, double> statistics = {{"mean_neff", scans_ > 0 ? neff_sum_ / scans_ : 0.0},
-                                              {"resamples", filter_.resample_count()},
-                                              {"updates", updates_},
-                                              {"lost", filter_.lost_count()},
-                                              {"relocalisations", filter_.relocalisation_count()},
-                                              {"resumed", filter_.resumed_count()},
-                                              {"lost_at_s", lost_at_s_},
-                                              {"gap_corrections", filter_.gap_correction_count()},
-                                              {"relocalised_at_s", relocalised_at_s_},
-                                              {"field_sigma_m", filter_.field_sigma_m()},
-                                              {"wall_distance_m", filter_.wall_distance_m()},
-                                              {"diverged", Diverged() ? 1.0 : 0.0}};
+  std::map<std::string, double> statistics = {
+      {"mean_neff", scans_ > 0 ? neff_sum_ / scans_ : 0.0},
+      {"resamples", filter_.resample_count()},
+      {"updates", updates_},
+      {"lost", filter_.lost_count()},
+      {"relocalisations", filter_.relocalisation_count()},
+      {"resumed", filter_.resumed_count()},
+      {"lost_at_s", lost_at_s_},
+      {"gap_corrections", filter_.gap_correction_count()},
+      {"relocalised_at_s", relocalised_at_s_},
+      {"field_sigma_m", filter_.field_sigma_m()},
+      {"wall_distance_m", filter_.wall_distance_m()},
+      {"revisits", revisits_.revisits},
+      {"revisits_disagreeing", revisits_.disagreeing},
+      {"revisits_disagreeing_places", revisits_.disagreeing_places},
+      {"diverged", Diverged() ? 1.0 : 0.0}};
   wheels_.AppendStatistics(&statistics);
   return statistics;
 }
 
-bool ParticleFilterEstimator::Diverged() const { return health_.Diverged() || wheels_.Diverged(); }
+bool ParticleFilterEstimator::Diverged() const {
+  return health_.Diverged() || wheels_.Diverged() || revisits_.contradicts({});
+}
 
 EstimatorView ParticleFilterEstimator::View() const {
   EstimatorView view;

@@ -63,6 +63,9 @@ ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
   }
   const bool contradicts =
       wheels_.Judge(scan.scan, scan.increment, estimate_increment, step.updated);
+  if (views_.Offer(step.best_pose)) {
+    views_.Keep(ScanToBasePoints(scan.scan, filter_.options().points));
+  }
   health_.Add(lost_ || contradicts);
   const double particles =
       static_cast<double>(std::max<std::size_t>(filter_.particles().size(), 1));
@@ -81,6 +84,8 @@ ScanEstimate RbpfEstimator::AddScan(const SyncedScan& scan) {
   wheels_.AppendTrace(&estimate.trace);
   return estimate;
 }
+
+void RbpfEstimator::Finish() { revisits_ = views_.Check(*RevisedPoses()); }
 
 std::optional<std::vector<Pose2>> RbpfEstimator::RevisedPoses() const {
   const std::vector<Pose2> updates = filter_.BestUpdatePoses();
@@ -106,7 +111,8 @@ const std::vector<std::string>& RbpfEstimator::StatisticNames() {
   static const std::vector<std::string> names = WheelCheck::WithStatisticNames(
       {"mean_neff", "resamples", "updates", "failed_matches", "odometry_rejections",
        "gap_corrections", "mean_weight_exponent", "map_tiles", "map_tiles_per_particle",
-       "wall_crossed_m", "map_witnesses", "map_contradiction_m", "lost", "diverged"});
+       "wall_crossed_m", "map_witnesses", "map_contradiction_m", "revisits", "revisits_disagreeing",
+       "revisits_disagreeing_places", "lost", "diverged"});
   return names;
 }
 
@@ -129,6 +135,9 @@ std::map<std::string, double> RbpfEstimator::Statistics() const {
       {"wall_crossed_m", wall_crossings_.worst_m()},
       {"map_witnesses", static_cast<double>(filter_.map_witnesses().size())},
       {"map_contradiction_m", filter_.MapContradictionM()},
+      {"revisits", revisits_.revisits},
+      {"revisits_disagreeing", revisits_.disagreeing},
+      {"revisits_disagreeing_places", revisits_.disagreeing_places},
       {"lost", health_.losses()},
       {"diverged", Diverged() ? 1.0 : 0.0}};
   wheels_.AppendStatistics(&statistics);
@@ -136,7 +145,8 @@ std::map<std::string, double> RbpfEstimator::Statistics() const {
 }
 
 bool RbpfEstimator::Diverged() const {
-  return health_.Diverged() || wheels_.Diverged() || filter_.MapContradictionM() > kDivergedErrorM;
+  return health_.Diverged() || wheels_.Diverged() ||
+         filter_.MapContradictionM() > kDivergedErrorM || revisits_.contradicts({});
 }
 
 EstimatorView RbpfEstimator::View() const {

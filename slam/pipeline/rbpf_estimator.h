@@ -8,6 +8,7 @@
 #include "slam/pipeline/algorithm.h"
 #include "slam/pipeline/estimator.h"
 #include "slam/pipeline/health.h"
+#include "slam/pipeline/revisits.h"
 
 namespace slamrig::slam {
 
@@ -20,6 +21,8 @@ class RbpfEstimator final : public Estimator {
   RbpfEstimator(const RbpfOptions& options, const EstimatorContext& context);
 
   ScanEstimate AddScan(const SyncedScan& scan) override;
+  /// The map check (CheckRevisits) on the revised poses.
+  void Finish() override;
   std::optional<std::vector<Pose2>> RevisedPoses() const override;
   /// The best particle's map, converted when asked for after it changed.
   const OccupancyGrid& map() const override;
@@ -27,8 +30,9 @@ class RbpfEstimator final : public Estimator {
   /// odometry), odometry_rejections (updates whose increment the odometry check replaced),
   /// mean_weight_exponent (the weights' exponent, RbpfStep::weight_exponent, over updates),
   /// map_tiles (distinct tiles over all particles at the end) and map_tiles_per_particle;
-  /// map_witnesses and map_contradiction_m (the map check's, Rbpf::MapContradictionM); lost
-  /// (losses) and diverged.
+  /// map_witnesses and map_contradiction_m (the witness check's, Rbpf::MapContradictionM);
+  /// revisits, revisits_disagreeing and revisits_disagreeing_places (the map check's, after
+  /// Finish()); lost (losses) and diverged.
   std::map<std::string, double> Statistics() const override;
   /// The names Statistics() reports, without an instance: the algorithm table's list (and so
   /// the expectations'); EstimatorRunner checks every run's Statistics() against it.
@@ -38,7 +42,7 @@ class RbpfEstimator final : public Estimator {
  private:
   // Lost at the end or on more than kDivergedLostShare of the scans, the estimate contradicted
   // the wheels (WheelCheck::Diverged), or the best path its own map by more than kDivergedErrorM
-  // (Rbpf::MapContradictionM).
+  // (Rbpf::MapContradictionM), or the final map contradicts itself where the robot came back.
   bool Diverged() const;
   static RbpfOptions Seeded(RbpfOptions options, std::uint64_t seed);
 
@@ -57,6 +61,8 @@ class RbpfEstimator final : public Estimator {
   WallCrossings wall_crossings_;
   HealthRecord health_;
   WheelCheck wheels_;
+  RevisitViews views_;
+  RevisitAgreement revisits_;  // at Finish()
   mutable OccupancyGrid map_;
   mutable int map_version_ = -1;  // update count the map was converted at
 };
