@@ -150,7 +150,7 @@ TEST(SelfDiagnosisTest, GraphCallsAMapDrawnTwiceDiverged) {
             "--perturb odometry.noise_per_rad=0.7789 --perturb scans.drop_fraction=0.1");
   EXPECT_GT(twice["ate_rmse_m"].as<double>(), 1.0);  // the failure the verdict must see
   EXPECT_GE(twice["revisits_disagreeing_places"].as<double>(), 5.0);
-  EXPECT_GT(twice["revisits_disagreeing"].as<double>(), 0.02 * twice["revisits"].as<double>());
+  EXPECT_GT(twice["revisits_disagreeing"].as<double>(), 0.01 * twice["revisits"].as<double>());
   EXPECT_EQ(twice["diverged"].as<double>(), 1.0);
 }
 

@@ -20,14 +20,16 @@ CellKey KeyOf(const Eigen::Vector2d& p, double cell) {
              static_cast<std::int64_t>(std::floor(p.y() / cell)));
 }
 
-// The share of `later`'s points within reach of `earlier` that fall in or beside a cell of
-// `earlier_cells`, or -1 when fewer than rules.min_points are within reach.
+// The share of `later`'s points, moved by `shift`, within reach of `earlier` that fall in or
+// beside a cell of `earlier_cells`, or -1 when fewer than rules.min_points are within reach.
 double Overlap(const std::vector<Eigen::Vector2d>& later, const Pose2& earlier,
-               const std::unordered_set<CellKey>& earlier_cells, const RevisitRules& rules) {
+               const std::unordered_set<CellKey>& earlier_cells, const RevisitRules& rules,
+               const Eigen::Vector2d& shift = Eigen::Vector2d::Zero()) {
   int counted = 0;
   int agreeing = 0;
   const double reach_sq = rules.reach_m * rules.reach_m;
-  for (const Eigen::Vector2d& p : later) {
+  for (const Eigen::Vector2d& point : later) {
+    const Eigen::Vector2d p = point + shift;
     if ((p - earlier.translation()).squaredNorm() > reach_sq) continue;
     ++counted;
     const auto ix = static_cast<std::int64_t>(std::floor(p.x() / rules.cell_m));
@@ -42,6 +44,23 @@ double Overlap(const std::vector<Eigen::Vector2d>& later, const Pose2& earlier,
   }
   if (counted < rules.min_points) return -1.0;
   return static_cast<double>(agreeing) / counted;
+}
+
+// The best overlap of `later`'s points with `earlier`'s over the shifts of at most
+// rules.max_shift_m (on a grid of cell_m).
+double BestShiftedOverlap(const std::vector<Eigen::Vector2d>& later, const Pose2& earlier,
+                          const std::unordered_set<CellKey>& earlier_cells,
+                          const RevisitRules& rules) {
+  const int steps = static_cast<int>(std::floor(rules.max_shift_m / rules.cell_m + 1e-9));
+  double best = 0.0;
+  for (int ix = -steps; ix <= steps; ++ix) {
+    for (int iy = -steps; iy <= steps; ++iy) {
+      const Eigen::Vector2d shift(ix * rules.cell_m, iy * rules.cell_m);
+      if (shift.norm() > rules.max_shift_m + 1e-9) continue;
+      best = std::max(best, Overlap(later, earlier, earlier_cells, rules, shift));
+    }
+  }
+  return best;
 }
 
 }  // namespace
@@ -99,12 +118,23 @@ RevisitAgreement CheckRevisits(const std::vector<Pose2>& poses,
       candidates.resize(static_cast<std::size_t>(rules.max_candidates));
     }
     double best = -1.0;
+    int best_view = -1;
     for (const auto& [d, i] : candidates) {
-      best = std::max(best, Overlap(world[j], poses[i], cells[i], rules));
+      const double overlap = Overlap(world[j], poses[i], cells[i], rules);
+      if (overlap > best) {
+        best = overlap;
+        best_view = i;
+      }
     }
     if (best < 0.0) continue;
     ++agreement.revisits;
-    if (best < rules.min_overlap) {
+    if (best >= rules.min_overlap) continue;
+    // Off by less than max_shift_m: a map a little out, not a second copy. The bar is higher than
+    // min_overlap: the best of some 80 shifts of an unrelated view reaches 0.2-0.5 by chance.
+    const double shifted = BestShiftedOverlap(world[j], poses[best_view], cells[best_view], rules);
+    if (shifted >= rules.min_shifted_overlap) {
+      ++agreement.shifted;
+    } else {
       ++agreement.disagreeing;
       agreement.disagreeing_views.push_back(static_cast<int>(j));
       disagreeing_places.insert(Key(cx, cy));

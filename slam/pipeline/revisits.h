@@ -23,18 +23,23 @@ struct RevisitRules {
   double min_path_m = 5.0;    ///< driven between them: not the same pass
   double reach_m = 15.0;      ///< the later view's points within this of the earlier pose count
   double cell_m = 0.2;        ///< a point agrees within a cell's neighbourhood of the other's
-  double min_overlap = 0.2;   ///< a revisit whose best earlier view shares less disagrees
-  int min_points = 20;        ///< fewer counted points: no verdict on that pair
-  int max_candidates = 5;     ///< earlier views compared per revisit (the nearest)
-  double max_disagreeing_share = 0.02;  ///< above this share of revisits, and ...
+  double min_overlap = 0.2;   ///< a revisit whose best earlier view shares less disagrees ...
+  double max_shift_m = 1.0;   ///< ... unless a shift this small brings it to
+  double min_shifted_overlap = 0.6;     ///< this share (a map off by less than kDivergedErrorM,
+                                        ///< not a second copy; above chance over the shifts)
+  int min_points = 20;                  ///< fewer counted points: no verdict on that pair
+  int max_candidates = 5;               ///< earlier views compared per revisit (the nearest)
+  double max_disagreeing_share = 0.01;  ///< above this share of revisits, and ...
   int min_disagreeing_places = 5;       ///< ... in this many places (radius_m squares), the map
                                         ///< contradicts itself
 };
 
 /// The verdict over a run's views (poses with their scans' points in the base frame).
 struct RevisitAgreement {
-  int revisits = 0;            ///< views with at least one earlier view to compare with
-  int disagreeing = 0;         ///< of them, those that share under min_overlap with every such view
+  int revisits = 0;     ///< views with at least one earlier view to compare with
+  int disagreeing = 0;  ///< of them, those that share under min_overlap with every such view,
+                        ///< even shifted by up to max_shift_m
+  int shifted = 0;      ///< of the revisits, those a shift of up to max_shift_m reconciles
   int disagreeing_places = 0;  ///< the radius_m squares the disagreeing views stand in
   /// The views that disagree, by index.
   std::vector<int> disagreeing_views;

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <vector>
 
 namespace slamrig::slam {
@@ -24,6 +26,28 @@ std::vector<Eigen::Vector2d> Room() {
   box(0.0, 0.0, 12.0, 8.0);
   box(4.0, 3.5, 5.0, 4.5);
   box(7.5, 3.0, 8.0, 5.0);
+  return walls;
+}
+
+// Somewhere else: short walls at random (seeded) around the room, none within 1.5 m of it, so
+// that no shift within max_shift_m lays them on the room's. What the robot sees when its
+// estimate says it is back but it is not.
+std::vector<Eigen::Vector2d> Elsewhere() {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> x(-8.0, 20.0), y(-8.0, 16.0), angle(0.0, M_PI);
+  std::vector<Eigen::Vector2d> walls;
+  for (int w = 0; w < 200; ++w) {
+    const double ax = x(random);
+    const double ay = y(random);
+    const Eigen::Vector2d a(ax, ay);
+    const double t = angle(random);
+    for (int i = 0; i <= 20; ++i) {
+      const Eigen::Vector2d p = a + 0.05 * i * Eigen::Vector2d(std::cos(t), std::sin(t));
+      const double dx = std::max({-p.x(), 0.0, p.x() - 12.0});
+      const double dy = std::max({-p.y(), 0.0, p.y() - 8.0});
+      if (std::hypot(dx, dy) >= 1.5) walls.push_back(p);
+    }
+  }
   return walls;
 }
 
@@ -62,7 +86,7 @@ struct Views {
 };
 
 // Scans taken at the true poses; the second lap's estimate moved by `second_lap_error` (applied
-// on the left: a map-frame error, as a second copy of the map has).
+// on the left: a map-frame error, as a map out of true has).
 Views TwoLapsWithSecondLapOff(const Pose2& second_lap_error) {
   const std::vector<Eigen::Vector2d> room = Room();
   const std::vector<Pose2> truth = TwoLaps();
@@ -71,6 +95,16 @@ Views TwoLapsWithSecondLapOff(const Pose2& second_lap_error) {
     const bool second_lap = k >= truth.size() / 2;
     run.estimate.push_back(second_lap ? second_lap_error * truth[k] : truth[k]);
     run.points.push_back(View(room, truth[k]));
+  }
+  return run;
+}
+
+// The second lap driven elsewhere, its estimate laid over the first lap's: a map drawn twice.
+Views SecondLapElsewhere() {
+  Views run = TwoLapsWithSecondLapOff(Pose2());
+  const std::vector<Eigen::Vector2d> elsewhere = Elsewhere();
+  for (std::size_t k = run.points.size() / 2; k < run.points.size(); ++k) {
+    run.points[k] = View(elsewhere, run.estimate[k]);
   }
   return run;
 }
@@ -86,15 +120,29 @@ TEST(RevisitsTest, AMapThatIsRightAgreesWhereverTheRobotCameBack) {
 }
 
 TEST(RevisitsTest, ASecondCopyOfTheMapDisagreesAtEveryRevisit) {
-  // Half a metre off along both axes (0.71 m, within the 1 m radius): no wall of the second lap
-  // lands on the first's.
+  const Views twice = SecondLapElsewhere();
+  const RevisitAgreement agreement = CheckRevisits(twice.estimate, twice.points);
+  EXPECT_GE(agreement.revisits, 48);
+  EXPECT_EQ(agreement.disagreeing, agreement.revisits);
+  EXPECT_EQ(agreement.shifted, 0);
+  EXPECT_TRUE(agreement.contradicts({}));
+  ASSERT_FALSE(agreement.disagreeing_views.empty());
+  EXPECT_GE(agreement.disagreeing_views.front(), 48);
+}
+
+TEST(RevisitsTest, AMapOffByLessThanTheShiftIsOutNotTwice) {
+  // Half a metre off along both axes (0.71 m): no wall of the second lap lands on the first's
+  // until the shift that undoes it.
   const Views off = TwoLapsWithSecondLapOff(Pose2(0.5, 0.5, 0.0));
-  const RevisitAgreement shifted = CheckRevisits(off.estimate, off.points);
-  EXPECT_GE(shifted.revisits, 48);
-  EXPECT_EQ(shifted.disagreeing, shifted.revisits);
-  EXPECT_TRUE(shifted.contradicts({}));
-  ASSERT_FALSE(shifted.disagreeing_views.empty());
-  EXPECT_GE(shifted.disagreeing_views.front(), 48);
+  const RevisitAgreement agreement = CheckRevisits(off.estimate, off.points);
+  EXPECT_GE(agreement.revisits, 48);
+  EXPECT_EQ(agreement.shifted, agreement.revisits);
+  EXPECT_EQ(agreement.disagreeing, 0);
+  RevisitRules no_shift;
+  no_shift.max_shift_m = 0.0;
+  const RevisitAgreement unshifted = CheckRevisits(off.estimate, off.points, no_shift);
+  EXPECT_EQ(unshifted.disagreeing, unshifted.revisits);
+  EXPECT_TRUE(unshifted.contradicts(no_shift));
 }
 
 TEST(RevisitsTest, AnErrorUnderACellAgrees) {
@@ -127,11 +175,11 @@ TEST(RevisitsTest, OnlyViewsFarAlongThePathAndFacingAlikeAreCompared) {
 }
 
 TEST(RevisitsTest, DisagreementInOnePlaceIsClutterNotASecondCopy) {
-  // The second lap half a metre off over its first 4 m only (a passer-by, a turn on the spot
+  // The second lap sees something else over its first 4 m only (a passer-by, a turn on the spot
   // scanning the floor): its views there disagree, in 4-5 places of 1 m.
   Views run = TwoLapsWithSecondLapOff(Pose2());
-  const Views off = TwoLapsWithSecondLapOff(Pose2(0.5, 0.5, 0.0));
-  for (int k = 48; k < 56; ++k) run.estimate[k] = off.estimate[k];
+  const Views twice = SecondLapElsewhere();
+  for (int k = 48; k < 56; ++k) run.points[k] = twice.points[k];
   const RevisitAgreement agreement = CheckRevisits(run.estimate, run.points);
   EXPECT_GE(agreement.disagreeing, 6);
   EXPECT_LE(agreement.disagreeing_places, 5);
@@ -139,7 +187,7 @@ TEST(RevisitsTest, DisagreementInOnePlaceIsClutterNotASecondCopy) {
   rules.min_disagreeing_places = agreement.disagreeing_places + 1;
   EXPECT_FALSE(agreement.contradicts(rules));
   rules.min_disagreeing_places = agreement.disagreeing_places;
-  EXPECT_TRUE(agreement.contradicts(rules));  // 8 of 48: over 2 %
+  EXPECT_TRUE(agreement.contradicts(rules));  // 8 of 48: over 1 %
   rules.max_disagreeing_share = 0.2;
   EXPECT_FALSE(agreement.contradicts(rules));
 }
@@ -170,11 +218,17 @@ TEST(RevisitsTest, AFilterKeepsAViewEveryHalfMetreAndChecksItsFinalPoses) {
   const RevisitAgreement right = views.Check(truth);
   EXPECT_GE(right.revisits, 40);
   EXPECT_EQ(right.disagreeing, 0);
-  // The final poses put the second lap half a metre off: the views disagree there.
-  std::vector<Pose2> off = truth;
-  for (std::size_t k = off.size() / 2; k < off.size(); ++k) off[k] = Pose2(0.5, 0.5, 0.0) * off[k];
-  const RevisitAgreement wrong = views.Check(off);
-  EXPECT_GE(wrong.disagreeing, 40);
+  // The second lap driven elsewhere, its final poses laid over the first lap's: the views
+  // disagree there.
+  const std::vector<Eigen::Vector2d> other = Elsewhere();
+  RevisitViews elsewhere;
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    if (elsewhere.Offer(truth[k])) {
+      elsewhere.Keep(View(k < truth.size() / 2 ? room : other, truth[k]));
+    }
+  }
+  const RevisitAgreement wrong = elsewhere.Check(truth);
+  EXPECT_GE(wrong.disagreeing, 10);
   EXPECT_TRUE(wrong.contradicts({}));
 }
 
