@@ -47,18 +47,27 @@ double Overlap(const std::vector<Eigen::Vector2d>& later, const Pose2& earlier,
 }
 
 // The best overlap of `later`'s points with `earlier`'s over the shifts of at most
-// rules.max_shift_m (on a grid of cell_m).
+// rules.max_shift_m (on a grid of cell_m), nearest shifts first; the first to reach
+// rules.min_shifted_overlap ends the search.
 double BestShiftedOverlap(const std::vector<Eigen::Vector2d>& later, const Pose2& earlier,
                           const std::unordered_set<CellKey>& earlier_cells,
                           const RevisitRules& rules) {
   const int steps = static_cast<int>(std::floor(rules.max_shift_m / rules.cell_m + 1e-9));
-  double best = 0.0;
+  std::vector<Eigen::Vector2d> shifts;
   for (int ix = -steps; ix <= steps; ++ix) {
     for (int iy = -steps; iy <= steps; ++iy) {
       const Eigen::Vector2d shift(ix * rules.cell_m, iy * rules.cell_m);
-      if (shift.norm() > rules.max_shift_m + 1e-9) continue;
-      best = std::max(best, Overlap(later, earlier, earlier_cells, rules, shift));
+      if (shift.norm() <= rules.max_shift_m + 1e-9) shifts.push_back(shift);
     }
+  }
+  std::stable_sort(shifts.begin(), shifts.end(),
+                   [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+                     return a.squaredNorm() < b.squaredNorm();
+                   });
+  double best = 0.0;
+  for (const Eigen::Vector2d& shift : shifts) {
+    best = std::max(best, Overlap(later, earlier, earlier_cells, rules, shift));
+    if (best >= rules.min_shifted_overlap) break;
   }
   return best;
 }

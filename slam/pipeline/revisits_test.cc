@@ -36,7 +36,7 @@ std::vector<Eigen::Vector2d> Elsewhere() {
   std::mt19937 random(11);
   std::uniform_real_distribution<double> x(-8.0, 20.0), y(-8.0, 16.0), angle(0.0, M_PI);
   std::vector<Eigen::Vector2d> walls;
-  for (int w = 0; w < 200; ++w) {
+  for (int w = 0; w < 80; ++w) {
     const double ax = x(random);
     const double ay = y(random);
     const Eigen::Vector2d a(ax, ay);
