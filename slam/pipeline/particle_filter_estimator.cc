@@ -65,31 +65,28 @@ ScanEstimate ParticleFilterEstimator::AddScan(const SyncedScan& scan) {
 void ParticleFilterEstimator::Finish() { revisits_ = views_.Check(online_); }
 
 const std::vector<std::string>& ParticleFilterEstimator::StatisticNames() {
-  static const std::vector<std::string> names = WheelCheck::WithStatisticNames(
-      {"mean_neff", "resamples", "updates", "lost", "relocalisations", "resumed", "lost_at_s",
-       "relocalised_at_s", "field_sigma_m", "wall_distance_m", "diverged", "gap_corrections",
-       "revisits", "revisits_disagreeing", "revisits_disagreeing_places"});
+  static const std::vector<std::string> names =
+      RevisitAgreement::WithStatisticNames(WheelCheck::WithStatisticNames(
+          {"mean_neff", "resamples", "updates", "lost", "relocalisations", "resumed", "lost_at_s",
+           "relocalised_at_s", "field_sigma_m", "wall_distance_m", "diverged", "gap_corrections"}));
   return names;
 }
 
 std::map<std::string, double> ParticleFilterEstimator::Statistics() const {
-  std::map<std::string, double> statistics = {
-      {"mean_neff", scans_ > 0 ? neff_sum_ / scans_ : 0.0},
-      {"resamples", filter_.resample_count()},
-      {"updates", updates_},
-      {"lost", filter_.lost_count()},
-      {"relocalisations", filter_.relocalisation_count()},
-      {"resumed", filter_.resumed_count()},
-      {"lost_at_s", lost_at_s_},
-      {"gap_corrections", filter_.gap_correction_count()},
-      {"relocalised_at_s", relocalised_at_s_},
-      {"field_sigma_m", filter_.field_sigma_m()},
-      {"wall_distance_m", filter_.wall_distance_m()},
-      {"revisits", revisits_.revisits},
-      {"revisits_disagreeing", revisits_.disagreeing},
-      {"revisits_disagreeing_places", revisits_.disagreeing_places},
-      {"diverged", Diverged() ? 1.0 : 0.0}};
+  std::map<std::string, double> statistics = {{"mean_neff", scans_ > 0 ? neff_sum_ / scans_ : 0.0},
+                                              {"resamples", filter_.resample_count()},
+                                              {"updates", updates_},
+                                              {"lost", filter_.lost_count()},
+                                              {"relocalisations", filter_.relocalisation_count()},
+                                              {"resumed", filter_.resumed_count()},
+                                              {"lost_at_s", lost_at_s_},
+                                              {"gap_corrections", filter_.gap_correction_count()},
+                                              {"relocalised_at_s", relocalised_at_s_},
+                                              {"field_sigma_m", filter_.field_sigma_m()},
+                                              {"wall_distance_m", filter_.wall_distance_m()},
+                                              {"diverged", Diverged() ? 1.0 : 0.0}};
   wheels_.AppendStatistics(&statistics);
+  revisits_.AppendStatistics(&statistics);
   return statistics;
 }
 

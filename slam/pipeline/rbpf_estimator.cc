@@ -108,11 +108,11 @@ const OccupancyGrid& RbpfEstimator::map() const {
 }
 
 const std::vector<std::string>& RbpfEstimator::StatisticNames() {
-  static const std::vector<std::string> names = WheelCheck::WithStatisticNames(
-      {"mean_neff", "resamples", "updates", "failed_matches", "odometry_rejections",
-       "gap_corrections", "mean_weight_exponent", "map_tiles", "map_tiles_per_particle",
-       "wall_crossed_m", "map_witnesses", "map_contradiction_m", "revisits", "revisits_disagreeing",
-       "revisits_disagreeing_places", "lost", "diverged"});
+  static const std::vector<std::string> names =
+      RevisitAgreement::WithStatisticNames(WheelCheck::WithStatisticNames(
+          {"mean_neff", "resamples", "updates", "failed_matches", "odometry_rejections",
+           "gap_corrections", "mean_weight_exponent", "map_tiles", "map_tiles_per_particle",
+           "wall_crossed_m", "map_witnesses", "map_contradiction_m", "lost", "diverged"}));
   return names;
 }
 
@@ -135,12 +135,10 @@ std::map<std::string, double> RbpfEstimator::Statistics() const {
       {"wall_crossed_m", wall_crossings_.worst_m()},
       {"map_witnesses", static_cast<double>(filter_.map_witnesses().size())},
       {"map_contradiction_m", filter_.MapContradictionM()},
-      {"revisits", revisits_.revisits},
-      {"revisits_disagreeing", revisits_.disagreeing},
-      {"revisits_disagreeing_places", revisits_.disagreeing_places},
       {"lost", health_.losses()},
       {"diverged", Diverged() ? 1.0 : 0.0}};
   wheels_.AppendStatistics(&statistics);
+  revisits_.AppendStatistics(&statistics);
   return statistics;
 }
 

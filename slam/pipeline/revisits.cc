@@ -153,6 +153,17 @@ RevisitAgreement CheckRevisits(const std::vector<Pose2>& poses,
   return agreement;
 }
 
+void RevisitAgreement::AppendStatistics(std::map<std::string, double>* statistics) const {
+  (*statistics)["revisits"] = revisits;
+  (*statistics)["revisits_disagreeing"] = disagreeing;
+  (*statistics)["revisits_disagreeing_places"] = disagreeing_places;
+}
+
+std::vector<std::string> RevisitAgreement::WithStatisticNames(std::vector<std::string> names) {
+  names.insert(names.end(), {"revisits", "revisits_disagreeing", "revisits_disagreeing_places"});
+  return names;
+}
+
 bool RevisitViews::Offer(const Pose2& online) {
   const int scan = offered_++;
   if (last_) {

@@ -5,11 +5,13 @@
 // none of them sees a map that holds two copies of one corridor, each consistent on its own (a
 // wrong turn taken early, a loop closure missed). The scans themselves do: where the estimate
 // says the robot stood again, at a similar heading, the two views must share most of their
-// walls. docs/studies/graph.md ("Revisits that disagree") measures it on the ten logs, their
-// noisier copies and the generated worlds.
+// walls. docs/studies/revisits.md measures it on the ten logs, their noisier copies and the
+// generated worlds.
 
 #include <Eigen/Core>
+#include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "slam/types/pose2.h"
@@ -52,6 +54,11 @@ struct RevisitAgreement {
     return disagreeing_places >= rules.min_disagreeing_places &&
            share() > rules.max_disagreeing_share;
   }
+  /// Adds revisits, revisits_disagreeing and revisits_disagreeing_places to an estimator's
+  /// statistics.
+  void AppendStatistics(std::map<std::string, double>* statistics) const;
+  /// `names` with those three appended.
+  static std::vector<std::string> WithStatisticNames(std::vector<std::string> names);
 };
 
 /// Compares each view with the nearest earlier views the rules admit (poses in the map's frame,
